@@ -1,0 +1,31 @@
+# Reference libraries used ONLY by tests and benchmarks (never by the product's contact code):
+# CGAL (AABB_tree closest point), FCL (BVHModel<OBBRSS> distance), Embree (rtcPointQuery).
+# Each is optional: absent -> its oracle tests skip and its benchmark rows are left out.
+# They are wrapped behind one small interface (oracles/closest_point_oracle.h) so their heavy
+# headers compile in one translation unit each.
+find_package(CGAL QUIET)
+find_package(fcl QUIET)
+find_package(embree 3 QUIET)
+message(STATUS "hapsim oracles: CGAL=${CGAL_FOUND} FCL=${fcl_FOUND} Embree=${embree_FOUND}")
+
+set(_oracle_sources "${CMAKE_SOURCE_DIR}/oracles/closest_point_oracle.cpp")
+# Each adapter is added only once its file exists, so a partial checkout still configures.
+add_library(hapsim_oracles STATIC)
+target_include_directories(hapsim_oracles PUBLIC "${CMAKE_SOURCE_DIR}")
+target_link_libraries(hapsim_oracles PUBLIC hapsim::headless)
+if(CGAL_FOUND AND EXISTS "${CMAKE_SOURCE_DIR}/oracles/cgal_oracle.cpp")
+  list(APPEND _oracle_sources "${CMAKE_SOURCE_DIR}/oracles/cgal_oracle.cpp")
+  target_link_libraries(hapsim_oracles PRIVATE CGAL::CGAL)
+  target_compile_definitions(hapsim_oracles PUBLIC HAPSIM_HAVE_CGAL=1)
+endif()
+if(fcl_FOUND AND EXISTS "${CMAKE_SOURCE_DIR}/oracles/fcl_oracle.cpp")
+  list(APPEND _oracle_sources "${CMAKE_SOURCE_DIR}/oracles/fcl_oracle.cpp")
+  target_link_libraries(hapsim_oracles PRIVATE fcl)
+  target_compile_definitions(hapsim_oracles PUBLIC HAPSIM_HAVE_FCL=1)
+endif()
+if(embree_FOUND AND EXISTS "${CMAKE_SOURCE_DIR}/oracles/embree_oracle.cpp")
+  list(APPEND _oracle_sources "${CMAKE_SOURCE_DIR}/oracles/embree_oracle.cpp")
+  target_link_libraries(hapsim_oracles PRIVATE embree)
+  target_compile_definitions(hapsim_oracles PUBLIC HAPSIM_HAVE_EMBREE=1)
+endif()
+target_sources(hapsim_oracles PRIVATE ${_oracle_sources})
