@@ -12,8 +12,8 @@
 namespace hapsim::oracle {
 
 struct OracleAnswer {
-  Vec3 point = Vec3::Zero();      // closest point on the surface
-  double distance = 0.0;          // unsigned
+  Vec3 point = Vec3::Zero();  // closest point on the surface
+  double distance = 0.0;      // unsigned
   std::uint32_t triangle = kNoTriangle;
 };
 

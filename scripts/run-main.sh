@@ -13,5 +13,5 @@ mkdir -p "$OUT"
 # probe path that passes through its surface.
 "$HAPSIM" info builtin:bumpy-sphere --json "$OUT/info.json"
 "$HAPSIM" query builtin:bumpy-sphere --points builtin:probe-path --method spheretree \
-  --out "$OUT/query.csv" --summary "$@"
+  --out "$OUT/query.csv" --json "$OUT/query.json" "$@"
 echo "hapsim: results in $OUT"

@@ -1,15 +1,56 @@
 // The `hapsim` command: one binary, one subcommand per job (info, query, bench, ...).
-#include <CLI/CLI.hpp>
+// Every user-facing failure is one line on stderr and exit status 2.
+#include "commands.h"
 
+#include "hapsim/core/error.h"
+
+#include <spdlog/spdlog.h>
+
+#include <exception>
 #include <iostream>
 
+namespace hapsim::app {
+
+int& exit_status() {
+  static int status = 0;
+  return status;
+}
+
+}  // namespace hapsim::app
+
 int main(int argc, char** argv) {
+  using namespace hapsim::app;
   CLI::App app{"hapsim - real-time haptic simulation"};
+  app.set_version_flag("--version", "hapsim 0.1.0");
   app.require_subcommand(1);
+  spdlog::set_level(spdlog::level::warn);
+  app.add_flag_callback(
+      "-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); }, "More log output");
+  add_info_command(app);
+  add_query_command(app);
+#ifdef HAPSIM_WITH_BENCH
+  add_bench_command(app);
+#endif
   try {
-    app.parse(argc, argv);
+    app.parse(argc, argv);  // subcommand callbacks run inside parse()
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    std::cerr << "hapsim: " << e.what() << " (see hapsim --help)\n";
+    return 2;
+  } catch (const CommandError& e) {
+    std::cerr << "hapsim: " << e.what() << "\n";
+    return 2;
+  } catch (const hapsim::Error& e) {
+    std::cerr << "hapsim: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "hapsim: internal error: " << e.what() << "\n";
+    return 1;
   }
-  return 0;
+  return exit_status();
 }

@@ -113,25 +113,39 @@ Vec3 SignedSurface::edge_pseudo_normal(const TriangleMesh& mesh, std::uint32_t t
     return mesh.face_normal(triangle);
   }
   if (other == kNonManifold) {
-    const auto it = non_manifold_edges_.find(std::uint64_t{triangle} * 3 +
-                                             static_cast<std::uint64_t>(edge));
+    const auto it =
+        non_manifold_edges_.find(std::uint64_t{triangle} * 3 + static_cast<std::uint64_t>(edge));
     return it != non_manifold_edges_.end() ? it->second : mesh.face_normal(triangle);
   }
   return mesh.face_normal(triangle) + mesh.face_normal(other);
 }
 
-SurfacePoint SignedSurface::resolve(const TriangleMesh& mesh, const Vec3& p,
-                                    std::uint32_t triangle, const TriangleClosest& closest) const {
+SurfacePoint SignedSurface::resolve(const TriangleMesh& mesh, const Vec3& p, std::uint32_t triangle,
+                                    const TriangleClosest& closest) const {
   const TriangleIndices& tri = mesh.triangles[triangle];
   Vec3 pseudo_normal = Vec3::Zero();
   switch (closest.feature) {
-    case TriangleFeature::kVertexA: pseudo_normal = vertex_pseudo_normals_[tri[0]]; break;
-    case TriangleFeature::kVertexB: pseudo_normal = vertex_pseudo_normals_[tri[1]]; break;
-    case TriangleFeature::kVertexC: pseudo_normal = vertex_pseudo_normals_[tri[2]]; break;
-    case TriangleFeature::kEdgeAB: pseudo_normal = edge_pseudo_normal(mesh, triangle, 0); break;
-    case TriangleFeature::kEdgeBC: pseudo_normal = edge_pseudo_normal(mesh, triangle, 1); break;
-    case TriangleFeature::kEdgeCA: pseudo_normal = edge_pseudo_normal(mesh, triangle, 2); break;
-    case TriangleFeature::kFace: pseudo_normal = mesh.face_normal(triangle); break;
+    case TriangleFeature::kVertexA:
+      pseudo_normal = vertex_pseudo_normals_[tri[0]];
+      break;
+    case TriangleFeature::kVertexB:
+      pseudo_normal = vertex_pseudo_normals_[tri[1]];
+      break;
+    case TriangleFeature::kVertexC:
+      pseudo_normal = vertex_pseudo_normals_[tri[2]];
+      break;
+    case TriangleFeature::kEdgeAB:
+      pseudo_normal = edge_pseudo_normal(mesh, triangle, 0);
+      break;
+    case TriangleFeature::kEdgeBC:
+      pseudo_normal = edge_pseudo_normal(mesh, triangle, 1);
+      break;
+    case TriangleFeature::kEdgeCA:
+      pseudo_normal = edge_pseudo_normal(mesh, triangle, 2);
+      break;
+    case TriangleFeature::kFace:
+      pseudo_normal = mesh.face_normal(triangle);
+      break;
   }
   SurfacePoint out;
   out.point = closest.point;

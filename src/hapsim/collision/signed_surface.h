@@ -28,8 +28,8 @@ class SignedSurface {
 
   /// Completes a query: sign, outward normal and triangle id from one triangle's closest point.
   /// haptic path: no allocation.
-  [[nodiscard]] SurfacePoint resolve(const TriangleMesh& mesh, const Vec3& p, std::uint32_t triangle,
-                                     const TriangleClosest& closest) const;
+  [[nodiscard]] SurfacePoint resolve(const TriangleMesh& mesh, const Vec3& p,
+                                     std::uint32_t triangle, const TriangleClosest& closest) const;
 
   /// The neighbour of `triangle` across its edge k (0: ab, 1: bc, 2: ca); kNoTriangle on an open
   /// edge, kNonManifold where more than two triangles share the edge.

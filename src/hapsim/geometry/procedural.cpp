@@ -55,14 +55,15 @@ TriangleMesh make_uv_sphere(double radius_m, int segments, int rings) {
   return lat_long_mesh(segments, rings, [radius_m](double, double) { return radius_m; });
 }
 
-TriangleMesh make_bumpy_sphere(std::size_t target_triangles, double radius_m,
-                               double bump_amplitude, int bump_frequency) {
+TriangleMesh make_bumpy_sphere(std::size_t target_triangles, double radius_m, double bump_amplitude,
+                               int bump_frequency) {
   // 2·s·(r−1) triangles with s ≈ 2r (roughly square cells at the equator).
-  const double rings_f = std::sqrt(static_cast<double>(std::max<std::size_t>(target_triangles, 32)) / 4.0);
+  const double rings_f =
+      std::sqrt(static_cast<double>(std::max<std::size_t>(target_triangles, 32)) / 4.0);
   const int rings = std::max(4, static_cast<int>(std::lround(rings_f)));
-  const int segments =
-      std::max(6, static_cast<int>(std::lround(static_cast<double>(target_triangles) /
-                                               (2.0 * (rings - 1)))));
+  const int segments = std::max(
+      6,
+      static_cast<int>(std::lround(static_cast<double>(target_triangles) / (2.0 * (rings - 1)))));
   const double k = bump_frequency;
   return lat_long_mesh(segments, rings, [=](double theta, double phi) {
     return radius_m * (1.0 + bump_amplitude * std::sin(k * theta) * std::sin(k * phi));

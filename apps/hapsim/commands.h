@@ -1,0 +1,25 @@
+// Subcommands of the `hapsim` app, one file each. Each `add_*` registers its CLI11 subcommand;
+// the callback runs it and throws CommandError (exit 2, one line) on bad input.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <stdexcept>
+#include <string>
+
+namespace hapsim::app {
+
+/// A user-facing failure: printed as one line "hapsim: <message>", exit status 2.
+class CommandError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Exit status a subcommand's callback sets for main() to return (0 unless it says otherwise).
+int& exit_status();
+
+void add_info_command(CLI::App& app);
+void add_query_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
+
+}  // namespace hapsim::app

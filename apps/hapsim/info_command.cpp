@@ -1,0 +1,114 @@
+// `hapsim info MESH`: counts, validation, bounds, area and volume, and the cost and quality of
+// both acceleration structures built over it.
+#include "commands.h"
+#include "mesh_argument.h"
+
+#include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/collision/sphere_tree.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+namespace hapsim::app {
+namespace {
+
+struct InfoOptions {
+  std::string mesh;
+  double scale = 1.0;
+  std::string json_path;
+};
+
+nlohmann::json vec_json(const Vec3& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+void run_info(const InfoOptions& opt) {
+  MeshArgument arg = load_mesh_argument(opt.mesh, opt.scale);
+  const TriangleMesh& mesh = arg.mesh;
+  if (mesh.empty()) {
+    throw CommandError(opt.mesh + ": the mesh has no triangles");
+  }
+  const Box3 box = mesh.bounds();
+  const double tri = static_cast<double>(mesh.triangle_count());
+
+  const MeshBvh bvh(mesh);
+  const SphereTree tree(mesh);
+  const BvhStats& b = bvh.stats();
+  const SphereTreeStats& s = tree.stats();
+
+  const Vec3 lo_mm = box.min() * 1e3;
+  const Vec3 hi_mm = box.max() * 1e3;
+  const Vec3 size_mm = hi_mm - lo_mm;
+  std::printf("mesh         %s (x%g to metres)\n", arg.name.c_str(), arg.scale);
+  std::printf("size         %zu triangles, %zu vertices\n", mesh.triangle_count(),
+              mesh.vertex_count());
+  std::printf("bounds       [%.3f, %.3f, %.3f] .. [%.3f, %.3f, %.3f] mm (%.3f x %.3f x %.3f mm)\n",
+              lo_mm.x(), lo_mm.y(), lo_mm.z(), hi_mm.x(), hi_mm.y(), hi_mm.z(), size_mm.x(),
+              size_mm.y(), size_mm.z());
+  std::printf("surface      %.4g mm^2, enclosed volume %.6g mm^3\n", mesh.surface_area() * 1e6,
+              mesh.signed_volume() * 1e9);
+  if (!arg.validation.empty()) {
+    std::printf("validation   %s\n", arg.validation.c_str());
+  }
+  std::printf("exact BVH    %zu nodes, %zu leaves, depth %zu, built in %.2f ms, %.1f B/triangle\n",
+              b.nodes, b.leaves, b.depth, b.build_ms, static_cast<double>(b.memory_bytes) / tri);
+  std::printf(
+      "sphere tree  %zu nodes, %zu leaves, depth %zu, built in %.2f ms, %.1f B/triangle,\n"
+      "             tightness %.3f (leaves) %.3f (inner) [1 = minimal spheres]\n",
+      s.nodes, s.leaves, s.depth, s.build_ms, static_cast<double>(s.memory_bytes) / tri,
+      s.leaf_tightness, s.inner_tightness);
+
+  if (!opt.json_path.empty()) {
+    nlohmann::json j;
+    j["mesh"] = arg.name;
+    j["scale"] = arg.scale;
+    j["triangles"] = mesh.triangle_count();
+    j["vertices"] = mesh.vertex_count();
+    j["bounds_m"] = {{"min", vec_json(box.min())}, {"max", vec_json(box.max())}};
+    j["surface_area_m2"] = mesh.surface_area();
+    j["signed_volume_m3"] = mesh.signed_volume();
+    if (!arg.validation_json.empty()) {
+      j["validation"] = nlohmann::json::parse(arg.validation_json);
+    }
+    j["exact_bvh"] = {{"nodes", b.nodes},
+                      {"leaves", b.leaves},
+                      {"depth", b.depth},
+                      {"build_ms", b.build_ms},
+                      {"memory_bytes", b.memory_bytes}};
+    j["sphere_tree"] = {{"nodes", s.nodes},
+                        {"leaves", s.leaves},
+                        {"depth", s.depth},
+                        {"build_ms", s.build_ms},
+                        {"memory_bytes", s.memory_bytes},
+                        {"leaf_tightness", s.leaf_tightness},
+                        {"inner_tightness", s.inner_tightness}};
+    std::ofstream out(opt.json_path);
+    if (!out) {
+      throw CommandError(opt.json_path + ": cannot write the JSON file");
+    }
+    out << j.dump(2) << "\n";
+  }
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app) {
+  auto opt = std::make_shared<InfoOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "info", "Describe a mesh: counts, validation, bounds, volume, acceleration structures");
+  std::string builtins_help = "Mesh file (OBJ, STL, PLY, glTF, ...) or a built-in:";
+  for (const auto& [name, description] : builtin_meshes()) {
+    builtins_help += "\n  builtin:" + name + "  " + description;
+  }
+  cmd->add_option("mesh", opt->mesh, builtins_help)->required();
+  cmd->add_option("--scale", opt->scale, "Mesh units to metres (e.g. 0.001 for millimetres)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--json", opt->json_path, "Also write the results as JSON to this file");
+  cmd->callback([opt] { run_info(*opt); });
+}
+
+}  // namespace hapsim::app

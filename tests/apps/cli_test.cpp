@@ -1,0 +1,162 @@
+// The `hapsim` command as a user runs it: exit codes, one-line messages naming the bad input,
+// and query output checked against analytic answers on a built-in box.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct RunResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+RunResult run_hapsim(const std::string& args) {
+  const std::string cmd = std::string(HAPSIM_BIN_PATH) + " " + args + " 2>&1";
+  RunResult result;
+  std::FILE* pipe = popen(cmd.c_str(), "r");
+  if (pipe == nullptr) {
+    return result;
+  }
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe) != nullptr) {
+    result.output += buffer.data();
+  }
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+std::filesystem::path temp_file(const std::string& name, const std::string& content) {
+  const auto dir = std::filesystem::temp_directory_path() / "hapsim_cli_test";
+  std::filesystem::create_directories(dir);
+  const auto path = dir / name;
+  std::ofstream(path) << content;
+  return path;
+}
+
+std::vector<std::vector<double>> read_csv_numbers(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // header
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> row;
+    std::stringstream ss(line);
+    std::string field;
+    while (std::getline(ss, field, ',')) {
+      row.push_back(std::stod(field));
+    }
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+TEST(Cli, NoSubcommandExitsTwo) {
+  const RunResult r = run_hapsim("");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+TEST(Cli, UnknownOptionExitsTwoWithOneLine) {
+  const RunResult r = run_hapsim("info builtin:box --no-such-option");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--no-such-option"), std::string::npos) << r.output;
+}
+
+TEST(Cli, MissingMeshFileIsNamed) {
+  const RunResult r = run_hapsim("info /nonexistent/knee.stl");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/knee.stl"), std::string::npos) << r.output;
+}
+
+TEST(Cli, UnknownBuiltinListsKnownOnes) {
+  const RunResult r = run_hapsim("info builtin:teapot");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("builtin:box"), std::string::npos) << r.output;
+}
+
+TEST(Cli, BadPointsFileNamesFileAndLine) {
+  const auto pts = temp_file("bad_points.csv", "x,y,z\n0,0,0\n1,2\n");
+  const RunResult r = run_hapsim("query builtin:box --points " + pts.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(pts.string() + ":3"), std::string::npos) << r.output;
+}
+
+TEST(Cli, NonNumericAndNanPointsAreRejected) {
+  const auto text = temp_file("text_points.csv", "0,0,0\n0,zero,0\n");
+  RunResult r = run_hapsim("query builtin:box --points " + text.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(":2"), std::string::npos) << r.output;
+  const auto nan = temp_file("nan_points.csv", "0,0,0\nnan,0,0\n");
+  r = run_hapsim("query builtin:box --points " + nan.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("finite"), std::string::npos) << r.output;
+}
+
+TEST(Cli, MissingPointsFileAndBadMethodAndBadScale) {
+  RunResult r = run_hapsim("query builtin:box --points /nonexistent/p.csv");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/p.csv"), std::string::npos) << r.output;
+  const auto pts = temp_file("one_point.csv", "0,0,0\n");
+  r = run_hapsim("query builtin:box --method magic --points " + pts.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--method"), std::string::npos) << r.output;
+  r = run_hapsim("query builtin:box --scale -1 --points " + pts.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+}
+
+// The built-in box is 100 x 60 x 40 mm centred at the origin: distances are known exactly.
+TEST(Cli, QueryAnswersMatchTheBoxAnalytically) {
+  for (const std::string method : {"exact", "spheretree"}) {
+    const auto pts =
+        temp_file("box_points.csv", "x,y,z\n0,0,0\n0.08,0,0\n0.06,0.04,0\n0.0,0.0,0.019\n");
+    const auto out = std::filesystem::temp_directory_path() / "hapsim_cli_test" / "box_out.csv";
+    const RunResult r = run_hapsim("query builtin:box --method " + method + " --points " +
+                                   pts.string() + " --out " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const auto rows = read_csv_numbers(out);
+    ASSERT_EQ(rows.size(), 4U);
+    for (const auto& row : rows) {
+      ASSERT_EQ(row.size(), 11U);
+    }
+    EXPECT_NEAR(rows[0][3], -0.02, 1e-12) << method;  // centre: 20 mm inside (half height)
+    EXPECT_NEAR(rows[1][3], 0.03, 1e-12) << method;   // 30 mm beyond the +x face
+    EXPECT_NEAR(rows[1][4], 0.05, 1e-12) << method;   // closest point on that face
+    EXPECT_NEAR(rows[1][7], 1.0, 1e-12) << method;    // normal +x
+    EXPECT_NEAR(rows[2][3], std::hypot(0.01, 0.01), 1e-12) << method;  // nearest the edge
+    EXPECT_NEAR(rows[3][3], -0.001, 1e-12) << method;                  // 1 mm under the top face
+    EXPECT_NEAR(rows[3][9], 1.0, 1e-12) << method;                     // normal +z
+  }
+}
+
+TEST(Cli, ScaleConvertsUnitsBothWays) {
+  // Same box read as millimetres: points and answers stay in mesh units.
+  const auto pts = temp_file("box_points_mm.csv", "80,0,0\n");
+  const auto out = std::filesystem::temp_directory_path() / "hapsim_cli_test" / "box_mm.csv";
+  const RunResult r =
+      run_hapsim("query builtin:box --scale 1 --points " + pts.string() + " --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto rows = read_csv_numbers(out);
+  ASSERT_EQ(rows.size(), 1U);
+  EXPECT_NEAR(rows[0][3], 79.95, 1e-9);  // builtin box is in metres: 80 - 0.05
+}
+
+TEST(Cli, InfoWritesJson) {
+  const auto json = std::filesystem::temp_directory_path() / "hapsim_cli_test" / "info.json";
+  const RunResult r = run_hapsim("info builtin:box --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(json);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_NE(ss.str().find("\"triangles\": 12"), std::string::npos) << ss.str();
+  EXPECT_NE(r.output.find("sphere tree"), std::string::npos) << r.output;
+}
+
+}  // namespace
