@@ -33,6 +33,7 @@ struct SphereTreeOptions {
 struct SphereTreeStats {
   std::size_t nodes = 0;
   std::size_t leaves = 0;
+  /// Number of levels (a tree that is a single leaf has depth 1).
   std::size_t depth = 0;
   double build_ms = 0.0;
   std::size_t memory_bytes = 0;
@@ -53,6 +54,13 @@ struct TreeTraversalCounters {
   std::size_t sphere_tests = 0;
 };
 
+/// Work done by one point query, for tests that assert algorithmic behaviour (not timings).
+struct SphereQueryCounters {
+  std::size_t nodes_visited = 0;
+  std::size_t sphere_tests = 0;
+  std::size_t triangles_tested = 0;
+};
+
 class SphereTree final : public ProximityQuery {
  public:
   /// Keeps a reference to `mesh`: it must outlive the tree; after its vertices move, call refit().
@@ -65,6 +73,12 @@ class SphereTree final : public ProximityQuery {
   void refit() override;
   [[nodiscard]] std::size_t memory_bytes() const override;
   [[nodiscard]] std::string_view method_name() const override { return "spheretree"; }
+
+  /// As closest_point / contact_within, also counting the work done (adds to `counters`).
+  [[nodiscard]] SurfacePoint closest_point_counted(const Vec3& p, QueryHint* hint,
+                                                   SphereQueryCounters* counters) const;
+  bool contact_within_counted(const Vec3& p, double radius, SurfacePoint* out, QueryHint* hint,
+                              SphereQueryCounters* counters) const;
 
   /// Pairs of leaves whose spheres overlap, with `other` placed by X_this_other (other's frame
   /// into this tree's frame). Descends only where parent spheres overlap. Appends to `out`
@@ -83,7 +97,11 @@ class SphereTree final : public ProximityQuery {
   [[nodiscard]] std::span<const std::uint32_t> leaf_triangles(std::size_t leaf) const;
 
   [[nodiscard]] const SphereTreeStats& stats() const { return stats_; }
+  /// Recomputes stats().leaf_tightness / inner_tightness against the minimal spheres of the
+  /// triangles below each node: O(n log n). The constructor calls it; refit() does not.
+  void update_tightness();
   [[nodiscard]] const TriangleMesh& mesh() const { return *mesh_; }
+  [[nodiscard]] const SignedSurface& signed_surface() const { return sign_; }
 
  private:
   struct Impl;
