@@ -1,0 +1,374 @@
+#include "hapsim/geometry/mesh_io.h"
+
+#include "hapsim/core/error.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <spdlog/spdlog.h>
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace hapsim {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kExpected =
+    "expected a readable triangle mesh file (OBJ, STL, PLY, glTF/GLB, or another format Assimp "
+    "reads)";
+
+std::string lower_extension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
+  Eigen::Matrix4d out;
+  for (unsigned r = 0; r < 4; ++r) {
+    for (unsigned c = 0; c < 4; ++c) {
+      out(r, c) = static_cast<double>(m[r][c]);
+    }
+  }
+  return out;
+}
+
+// Appends every triangle of every mesh instance in the node tree (iterative: a hostile file
+// cannot overflow the stack with a deep hierarchy). Returns the number of skipped points/lines.
+std::size_t gather_triangles(const aiScene& scene, TriangleMesh& out) {
+  std::size_t skipped_primitives = 0;
+  std::vector<std::pair<const aiNode*, Eigen::Matrix4d>> stack;
+  if (scene.mRootNode != nullptr) {
+    stack.emplace_back(scene.mRootNode, Eigen::Matrix4d::Identity());
+  }
+  while (!stack.empty()) {
+    const auto [node, parent_X] = stack.back();
+    stack.pop_back();
+    const Eigen::Matrix4d X = parent_X * to_eigen(node->mTransformation);
+    const Eigen::Matrix3d linear = X.topLeftCorner<3, 3>();
+    const Eigen::Vector3d offset = X.topRightCorner<3, 1>();
+    // A mirroring node transform turns winding inside out; swap to keep it outward.
+    const bool mirror = linear.determinant() < 0.0;
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+      if (node->mMeshes[i] >= scene.mNumMeshes) {
+        continue;
+      }
+      const aiMesh* mesh = scene.mMeshes[node->mMeshes[i]];
+      if (mesh == nullptr || mesh->mVertices == nullptr) {
+        continue;
+      }
+      const auto base = static_cast<std::uint32_t>(out.vertices.size());
+      for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+        const aiVector3D& p = mesh->mVertices[v];
+        out.vertices.push_back(linear * Vec3(p.x, p.y, p.z) + offset);
+      }
+      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+        const aiFace& face = mesh->mFaces[f];
+        if (face.mNumIndices != 3 || face.mIndices == nullptr) {
+          ++skipped_primitives;
+          continue;
+        }
+        TriangleIndices tri;
+        for (int k = 0; k < 3; ++k) {
+          // An index past this mesh's vertices stays out of range, for validation to report.
+          tri[k] = face.mIndices[k] < mesh->mNumVertices ? base + face.mIndices[k] : kNoTriangle;
+        }
+        if (mirror) {
+          std::swap(tri[1], tri[2]);
+        }
+        out.triangles.push_back(tri);
+      }
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c) {
+      if (node->mChildren[c] != nullptr) {
+        stack.emplace_back(node->mChildren[c], X);
+      }
+    }
+  }
+  return skipped_primitives;
+}
+
+void check_readable(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) {
+    throw Error(path.string(), std::string("mesh file not found; ") + kExpected);
+  }
+  if (!fs::is_regular_file(path, ec)) {
+    throw Error(path.string(), std::string("not a regular file; ") + kExpected);
+  }
+  const auto size = fs::file_size(path, ec);
+  if (ec) {
+    throw Error(path.string(), "cannot determine file size (" + ec.message() + ")");
+  }
+  if (size == 0) {
+    throw Error(path.string(), std::string("file is empty; ") + kExpected);
+  }
+  if (!std::ifstream(path, std::ios::binary).good()) {
+    throw Error(path.string(), "file cannot be opened for reading (permissions?)");
+  }
+}
+
+// Logs and notes every defect present; throws for those the policy refuses.
+void apply_policy_messages(const fs::path& path, const MeshReport& found,
+                           const ValidationPolicy& policy, MeshReport& notes_to) {
+  std::string refused;
+  for (std::size_t d = 0; d < kMeshDefectCount; ++d) {
+    const auto defect = static_cast<MeshDefect>(d);
+    const std::size_t n = found.count(defect);
+    if (n == 0) {
+      continue;
+    }
+    switch (policy[defect]) {
+      case DefectAction::kIgnore:
+        break;
+      case DefectAction::kRefuse:
+        refused += (refused.empty() ? "" : ", ") + std::string(to_string(defect)) + "=" +
+                   std::to_string(n);
+        break;
+      case DefectAction::kWarn:
+      case DefectAction::kRepair: {
+        const bool repairable =
+            defect != MeshDefect::kOpenEdge && defect != MeshDefect::kNonManifoldEdge;
+        std::string note = std::string(to_string(defect)) + "=" + std::to_string(n);
+        if (policy[defect] == DefectAction::kRepair) {
+          note += repairable ? " (repairing)" : " (no automatic repair; accepted)";
+        } else {
+          note += " (accepted)";
+        }
+        spdlog::warn("{}: {}", path.string(), note);
+        notes_to.notes.push_back(std::move(note));
+        break;
+      }
+    }
+  }
+  if (!refused.empty()) {
+    throw Error(path.string(),
+                "mesh refused by validation policy: " + refused + " (" + found.summary() + ")");
+  }
+}
+
+bool indices_in_range(const TriangleMesh& mesh) {
+  return std::all_of(mesh.triangles.begin(), mesh.triangles.end(), [&](const TriangleIndices& t) {
+    return t[0] < mesh.vertices.size() && t[1] < mesh.vertices.size() &&
+           t[2] < mesh.vertices.size();
+  });
+}
+
+// Assimp's exporter id for an extension.
+std::string export_format(const std::string& ext, bool binary) {
+  if (ext == ".obj") {
+    return "obj";
+  }
+  if (ext == ".stl") {
+    return binary ? "stlb" : "stl";
+  }
+  if (ext == ".ply") {
+    return binary ? "plyb" : "ply";
+  }
+  if (ext == ".gltf") {
+    return "gltf2";
+  }
+  if (ext == ".glb") {
+    return "glb2";
+  }
+  return {};
+}
+
+}  // namespace
+
+bool is_mesh_file_supported(const fs::path& path) {
+  const std::string ext = lower_extension(path);
+  return !ext.empty() && Assimp::Importer().IsExtensionSupported(ext.c_str());
+}
+
+TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& options, MeshReport* report) {
+  const std::string where = path.string();
+  if (!std::isfinite(options.scale) || options.scale == 0.0) {
+    throw Error(where, "load scale must be finite and non-zero (metres per file unit), got " +
+                           std::to_string(options.scale));
+  }
+  check_readable(path);
+  if (!is_mesh_file_supported(path)) {
+    throw Error(where, "unsupported mesh format '" + path.extension().string() + "'; " + kExpected);
+  }
+
+  TriangleMesh mesh;
+  std::size_t skipped_primitives = 0;
+  {
+    Assimp::Importer importer;
+    // Only what is needed to get triangles: no normal generation, no degenerate removal, no
+    // "fixing" of invalid data — validation below must see the file's real defects.
+    unsigned flags = aiProcess_Triangulate | aiProcess_ValidateDataStructure;
+    if (!options.weld) {
+      flags |= aiProcess_JoinIdenticalVertices;  // keep the file's indexing where it has one
+    }
+    const aiScene* scene = nullptr;
+    try {
+      scene = importer.ReadFile(where, flags);
+    } catch (const std::exception& e) {  // e.g. bad_alloc from a lying size field
+      throw Error(where, std::string("mesh importer failed: ") + e.what() + "; " + kExpected);
+    }
+    if (scene == nullptr) {
+      throw Error(where,
+                  std::string("cannot read mesh: ") + importer.GetErrorString() + "; " + kExpected);
+    }
+    if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 && scene->mNumMeshes == 0) {
+      throw Error(where, "file holds no meshes (incomplete scene); expected triangles");
+    }
+    skipped_primitives = gather_triangles(*scene, mesh);
+  }
+  if (mesh.triangles.empty()) {
+    throw Error(where, "file holds no triangles" +
+                           (skipped_primitives > 0
+                                ? " (only " + std::to_string(skipped_primitives) + " points/lines)"
+                                : std::string()) +
+                           "; expected a triangle mesh");
+  }
+
+  mesh.scale(options.scale);
+  std::size_t welded = 0;
+  if (options.weld) {
+    const Box3 box = validate_mesh(mesh).bounds;  // finite vertices only
+    const double diag = box.isEmpty() ? 0.0 : box.diagonal().norm();
+    welded =
+        weld_vertices(mesh, std::max(options.weld_tolerance_m, options.weld_tolerance_rel * diag));
+  }
+
+  MeshReport found = validate_mesh(mesh, options.validation);
+  if (skipped_primitives > 0) {
+    found.notes.push_back("skipped " + std::to_string(skipped_primitives) +
+                          " point/line primitives");
+    spdlog::warn("{}: {}", where, found.notes.back());
+  }
+  apply_policy_messages(path, found, options.policy, found);
+
+  const MeshRepairStats repairs = repair_mesh(mesh, options.policy, options.validation);
+  if (repairs.any()) {
+    found.notes.push_back("repaired: " + repairs.summary());
+    spdlog::warn("{}: {}", where, found.notes.back());
+    // A repair can expose a defect (orientation fixed → component now inside out); refuse
+    // whatever the policy refuses in the result too.
+    MeshReport after = validate_mesh(mesh, options.validation);
+    MeshReport scratch;
+    ValidationPolicy refuse_only = options.policy;
+    for (DefectAction& a : refuse_only.actions) {
+      a = a == DefectAction::kRefuse ? DefectAction::kRefuse : DefectAction::kIgnore;
+    }
+    apply_policy_messages(path, after, refuse_only, scratch);
+    if (mesh.triangles.empty()) {
+      throw Error(where, "no triangles left after repairs (" + repairs.summary() +
+                             "); expected a triangle mesh");
+    }
+  }
+  spdlog::debug("{}: loaded {} (welded {} vertices)", where, found.summary(), welded);
+
+  mesh.vertex_normals.clear();
+  if (options.compute_normals && indices_in_range(mesh)) {
+    mesh.compute_vertex_normals();
+  }
+  if (report != nullptr) {
+    *report = std::move(found);
+  }
+  return mesh;
+}
+
+void save_mesh(const fs::path& path, const TriangleMesh& mesh, const MeshSaveOptions& options) {
+  const std::string where = path.string();
+  const std::string ext = lower_extension(path);
+  const std::string format = export_format(ext, options.binary);
+  if (format.empty()) {
+    throw Error(where, "unsupported output format '" + path.extension().string() +
+                           "'; expected .obj, .stl, .ply, .gltf or .glb");
+  }
+  if (mesh.triangles.empty()) {
+    throw Error(where, "refusing to write a mesh without triangles");
+  }
+  if (!indices_in_range(mesh)) {
+    throw Error(where, "refusing to write a mesh with out-of-range vertex indices");
+  }
+  if (!std::isfinite(options.scale) || options.scale == 0.0) {
+    throw Error(where, "save scale must be finite and non-zero");
+  }
+
+  // aiScene owns and deletes everything below it (allocated with new, as Assimp expects).
+  auto scene = std::make_unique<aiScene>();
+  scene->mRootNode = new aiNode("hapsim_mesh");
+  scene->mRootNode->mNumMeshes = 1;
+  scene->mRootNode->mMeshes = new unsigned[1]{0};
+  scene->mNumMaterials = 1;
+  scene->mMaterials = new aiMaterial* [1] { new aiMaterial() };
+  scene->mNumMeshes = 1;
+  scene->mMeshes = new aiMesh* [1] { new aiMesh() };
+  aiMesh& out = *scene->mMeshes[0];
+  out.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+  out.mMaterialIndex = 0;
+  out.mNumVertices = static_cast<unsigned>(mesh.vertices.size());
+  out.mVertices = new aiVector3D[mesh.vertices.size()];
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Vec3 p = options.scale * mesh.vertices[v];
+    out.mVertices[v] = aiVector3D(static_cast<ai_real>(p.x()), static_cast<ai_real>(p.y()),
+                                  static_cast<ai_real>(p.z()));
+  }
+  if (mesh.vertex_normals.size() == mesh.vertices.size()) {
+    out.mNormals = new aiVector3D[mesh.vertices.size()];
+    const double sign = options.scale < 0.0 ? -1.0 : 1.0;
+    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+      const Vec3 n = sign * mesh.vertex_normals[v];
+      out.mNormals[v] = aiVector3D(static_cast<ai_real>(n.x()), static_cast<ai_real>(n.y()),
+                                   static_cast<ai_real>(n.z()));
+    }
+  }
+  out.mNumFaces = static_cast<unsigned>(mesh.triangles.size());
+  out.mFaces = new aiFace[mesh.triangles.size()];
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    TriangleIndices tri = mesh.triangles[t];
+    if (options.scale < 0.0) {
+      std::swap(tri[1], tri[2]);  // mirrored on writing: keep outward winding
+    }
+    aiFace& face = out.mFaces[t];
+    face.mNumIndices = 3;
+    face.mIndices = new unsigned[3]{tri[0], tri[1], tri[2]};
+  }
+
+  Assimp::Exporter exporter;
+  if (exporter.Export(scene.get(), format, where) != aiReturn_SUCCESS) {
+    throw Error(where, std::string("cannot write mesh: ") + exporter.GetErrorString());
+  }
+}
+
+std::optional<double> metres_per_unit(std::string_view unit) {
+  std::string u(unit);
+  std::transform(u.begin(), u.end(), u.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (u == "m" || u == "metre" || u == "meter" || u == "metres" || u == "meters") {
+    return 1.0;
+  }
+  if (u == "cm") {
+    return 1e-2;
+  }
+  if (u == "mm") {
+    return 1e-3;
+  }
+  if (u == "um" || u == "µm") {
+    return 1e-6;
+  }
+  if (u == "in" || u == "inch") {
+    return 0.0254;
+  }
+  if (u == "ft" || u == "foot" || u == "feet") {
+    return 0.3048;
+  }
+  return std::nullopt;
+}
+
+}  // namespace hapsim
