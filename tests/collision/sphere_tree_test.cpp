@@ -1,5 +1,6 @@
 #include "hapsim/collision/sphere_tree.h"
 
+#include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/collision/point_triangle.h"
 #include "hapsim/geometry/procedural.h"
 
@@ -207,6 +208,25 @@ TEST(SphereTree, ClosestPointMatchesBruteForce) {
       const SphereTree tree(mc.mesh, {branching, 4, {}});
       for (const Vec3& p : sample_points(mc.mesh, 400, 0.004, 17)) {
         expect_same_answer(tree.closest_point(p), brute_force(tree, p), p);
+      }
+    }
+  }
+}
+
+TEST(SphereTree, AgreesWithExactBvh) {
+  // Same kernel and sign data as MeshBvh: same distance, same side, same normal.
+  for (const MeshCase& mc : test_meshes()) {
+    SCOPED_TRACE(mc.name);
+    const SphereTree tree(mc.mesh);
+    const MeshBvh bvh(mc.mesh);
+    QueryHint hint_tree;
+    QueryHint hint_bvh;
+    for (const Vec3& p : sample_points(mc.mesh, 1000, 0.004, 51)) {
+      const SurfacePoint a = tree.closest_point(p, &hint_tree);
+      const SurfacePoint b = bvh.closest_point(p, &hint_bvh);
+      expect_same_answer(a, b, p);
+      if (std::abs(b.signed_distance) > 1e-9) {
+        EXPECT_NEAR((a.normal - b.normal).norm(), 0.0, 1e-9);
       }
     }
   }

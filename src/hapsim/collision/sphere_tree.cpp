@@ -56,6 +56,9 @@ struct SphereTree::Impl {
   std::vector<std::uint32_t> triangle_of_slot;
   // Corners of the triangle in each slot (3 per slot), copied in leaf order for locality.
   std::vector<Vec3> corners;
+  // Minimal sphere of each slot's triangle (SoA): a two-flop lower bound that skips most exact
+  // triangle tests in a leaf whose sphere was only just within reach.
+  std::vector<double> tx, ty, tz, tr;
   std::size_t depth = 0;
   std::size_t point_stack_bound = 0;
 
@@ -215,12 +218,24 @@ void SphereTree::Impl::build_topology(const TriangleMesh& mesh, int branching, i
 }
 
 void SphereTree::Impl::copy_corners(const TriangleMesh& mesh) {
-  corners.resize(triangle_of_slot.size() * 3);
-  for (std::size_t s = 0; s < triangle_of_slot.size(); ++s) {
+  const std::size_t n = triangle_of_slot.size();
+  corners.resize(n * 3);
+  tx.resize(n);
+  ty.resize(n);
+  tz.resize(n);
+  tr.resize(n);
+  for (std::size_t s = 0; s < n; ++s) {
     const TriangleIndices& tri = mesh.triangles[triangle_of_slot[s]];
+    std::array<Vec3, 3> abc;
     for (std::size_t k = 0; k < 3; ++k) {
       corners[3 * s + k] = mesh.vertices[tri[k]];
+      abc[k] = corners[3 * s + k];
     }
+    const Sphere ts = minimal_sphere_inplace(abc, false);
+    tx[s] = ts.center.x();
+    ty[s] = ts.center.y();
+    tz[s] = ts.center.z();
+    tr[s] = ts.radius;
   }
 }
 
@@ -298,6 +313,13 @@ void SphereTree::Impl::search(const TriangleMesh& mesh, const Vec3& p, double li
     }
     if (nd.child_count == 0) {
       for (std::uint32_t s = nd.slot_begin; s < nd.slot_end; ++s) {
+        const double dx = tx[s] - px;
+        const double dy = ty[s] - py;
+        const double dz = tz[s] - pz;
+        const double reach = bound_m + tr[s];
+        if (dx * dx + dy * dy + dz * dz > reach * reach) {
+          continue;  // the triangle's own sphere is out of reach
+        }
         const TriangleClosest tc =
             closest_point_on_triangle(p, corners[3 * s], corners[3 * s + 1], corners[3 * s + 2]);
         if constexpr (kCount) {
@@ -544,8 +566,8 @@ std::size_t SphereTree::memory_bytes() const {
          n * (sizeof(Node) + 4 * sizeof(double) + sizeof(std::uint16_t) +
               2 * sizeof(std::uint32_t)) +
          im.leaf_node.size() * sizeof(std::uint32_t) +
-         im.triangle_of_slot.size() * sizeof(std::uint32_t) + im.corners.size() * sizeof(Vec3) +
-         sign_.memory_bytes();
+         im.triangle_of_slot.size() * (sizeof(std::uint32_t) + 4 * sizeof(double)) +
+         im.corners.size() * sizeof(Vec3) + sign_.memory_bytes();
 }
 
 std::size_t SphereTree::node_count() const {
