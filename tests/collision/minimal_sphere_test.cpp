@@ -169,6 +169,25 @@ TEST(MinimalSphere, LargeRandomSetEnclosedAndTighterThanRitter) {
   EXPECT_LE(s.radius, ritter_sphere(pts).radius);
 }
 
+TEST(MinimalSphere, TriangleClosedFormMatchesWelzl) {
+  std::mt19937 rng(5);
+  int obtuse = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const std::vector<Vec3> abc = random_points(rng, 3, 0.01);
+    const Sphere s = triangle_sphere(abc[0], abc[1], abc[2]);
+    const Sphere w = minimal_sphere(abc);
+    EXPECT_NEAR(s.radius, w.radius, 1e-14);
+    EXPECT_NEAR((s.center - w.center).norm(), 0.0, 1e-12);
+    for (const Vec3& p : abc) {
+      EXPECT_LE((p - s.center).norm(), s.radius);
+    }
+    obtuse += (abc[1] - abc[0]).dot(abc[2] - abc[0]) < 0.0 ? 1 : 0;
+  }
+  EXPECT_GT(obtuse, 100);  // both branches exercised
+  const Sphere degenerate = triangle_sphere(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(3, 0, 0));
+  EXPECT_NEAR(degenerate.radius, 1.5, 1e-15);
+}
+
 TEST(MinimalSphere, SphereThroughSupportSets) {
   // Three points of a right triangle: circumcircle centred on the hypotenuse.
   const std::array<Sphere, 3> tri{Sphere{Vec3(0, 0, 0), 0}, Sphere{Vec3(2, 0, 0), 0},

@@ -34,10 +34,14 @@ inline Sphere as_sphere(const Sphere& s) {
 // boundary point look outside (which would only cost time, never correctness).
 constexpr double kInsideTol = 1e-12;
 
-template <typename T>
-bool outside(const Sphere& ball, const T& x) {
-  const double reach = (center_of(x) - ball.center).norm() + radius_of(x);
-  return reach > ball.radius + kInsideTol * (ball.radius + radius_of(x));
+inline bool outside(const Sphere& ball, const Sphere& x) {
+  const double reach = (x.center - ball.center).norm() + x.radius;
+  return reach > ball.radius + kInsideTol * (ball.radius + x.radius);
+}
+
+// Points: the same test squared (no square root in the hot loop).
+inline bool outside(const Sphere& ball, const Vec3& x) {
+  return (x - ball.center).squaredNorm() > ball.radius * ball.radius * (1.0 + 2.0 * kInsideTol);
 }
 
 // The smallest sphere enclosing both a and b.
@@ -260,6 +264,34 @@ double enclosing_radius(const Vec3& center, std::span<const Sphere> spheres) {
     r = std::max(r, (s.center - center).norm() + s.radius);
   }
   return r;
+}
+
+Sphere triangle_sphere(const Vec3& a, const Vec3& b, const Vec3& c) {
+  // Obtuse or right at a corner: the opposite (longest) edge's diameter sphere.
+  const Vec3 ab = b - a;
+  const Vec3 ac = c - a;
+  const Vec3 bc = c - b;
+  Sphere s;
+  if (ab.dot(ac) <= 0.0) {
+    s = {0.5 * (b + c), 0.0};
+  } else if (-ab.dot(bc) <= 0.0) {
+    s = {0.5 * (a + c), 0.0};
+  } else if (ac.dot(bc) <= 0.0) {
+    s = {0.5 * (a + b), 0.0};
+  } else {
+    // Acute: the circumcircle (Ericson, Real-Time Collision Detection §4.3.4).
+    const Vec3 n = ab.cross(ac);
+    const double n2 = n.squaredNorm();
+    if (n2 > 0.0) {
+      s.center = a + (ac.squaredNorm() * n.cross(ab) + ab.squaredNorm() * ac.cross(n)) / (2.0 * n2);
+    } else {
+      s.center = (a + b + c) / 3.0;
+    }
+  }
+  // Widen to the corners as computed, so containment holds exactly whatever the rounding.
+  s.radius = std::sqrt(std::max(
+      {(a - s.center).squaredNorm(), (b - s.center).squaredNorm(), (c - s.center).squaredNorm()}));
+  return s;
 }
 
 Sphere minimal_sphere_inplace(std::span<Vec3> points, bool shuffle) {

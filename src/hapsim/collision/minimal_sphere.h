@@ -18,6 +18,10 @@ namespace hapsim {
 /// `shuffle`, which makes the expected time linear for large sets). No allocation.
 Sphere minimal_sphere_inplace(std::span<Vec3> points, bool shuffle = true);
 
+/// Minimal sphere of one triangle's corners, in closed form (circumcircle if acute, else the
+/// longest edge's diameter sphere). No allocation.
+Sphere triangle_sphere(const Vec3& a, const Vec3& b, const Vec3& c);
+
 /// Minimal sphere enclosing `points` (copies them; allocates).
 Sphere minimal_sphere(std::span<const Vec3> points);
 

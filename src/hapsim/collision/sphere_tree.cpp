@@ -226,12 +226,10 @@ void SphereTree::Impl::copy_corners(const TriangleMesh& mesh) {
   tr.resize(n);
   for (std::size_t s = 0; s < n; ++s) {
     const TriangleIndices& tri = mesh.triangles[triangle_of_slot[s]];
-    std::array<Vec3, 3> abc;
     for (std::size_t k = 0; k < 3; ++k) {
       corners[3 * s + k] = mesh.vertices[tri[k]];
-      abc[k] = corners[3 * s + k];
     }
-    const Sphere ts = minimal_sphere_inplace(abc, false);
+    const Sphere ts = triangle_sphere(corners[3 * s], corners[3 * s + 1], corners[3 * s + 2]);
     tx[s] = ts.center.x();
     ty[s] = ts.center.y();
     tz[s] = ts.center.z();
