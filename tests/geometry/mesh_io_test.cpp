@@ -324,6 +324,34 @@ TEST_F(MeshIo, PolicyWarnsRepairsOrRefuses) {
   (void)obj;
 }
 
+TEST_F(MeshIo, DegenerateAndDuplicateFacetsAreCountedThenDropped) {
+  // The tetrahedron plus a facet with a repeated corner, a collinear facet and a repeated facet.
+  std::string stl = ascii_stl(1.0);
+  const std::string extra =
+      "  facet normal 0 0 0\n    outer loop\n      vertex 0 0 0\n      vertex 0 0 0\n"
+      "      vertex 1 0 0\n    endloop\n  endfacet\n"
+      "  facet normal 0 0 0\n    outer loop\n      vertex 0 0 0\n      vertex 0.5 0 0\n"
+      "      vertex 1 0 0\n    endloop\n  endfacet\n"
+      "  facet normal 0 0 0\n    outer loop\n      vertex 1 0 0\n      vertex 0 1 0\n"
+      "      vertex 0 0 1\n    endloop\n  endfacet\n";
+  stl.insert(stl.find("endsolid"), extra);
+  const fs::path p = write("dirty.stl", stl);
+  MeshReport report;
+  const TriangleMesh m = load_mesh(p, {}, &report);
+  EXPECT_EQ(report.triangle_count, 7u);
+  EXPECT_EQ(report.degenerate_triangles, 2u);
+  EXPECT_EQ(report.duplicate_triangles, 1u);
+  // Counted once, under their own names: no open or non-manifold edges from the sliver.
+  EXPECT_EQ(report.open_edges, 0u);
+  EXPECT_EQ(report.non_manifold_edges, 0u);
+  EXPECT_FALSE(report.closed);  // not yet: the duplicate would count its volume twice
+  EXPECT_EQ(report.notes.size(), 3u) << report.to_json(1);  // two defects + the repair line
+  expect_tet(m, 1.0);                                       // dropped back to the clean tetrahedron
+  MeshLoadOptions strict;
+  strict.policy = ValidationPolicy::strict();
+  expect_refused(p, strict, "degenerate_triangles=2");
+}
+
 TEST_F(MeshIo, NonFiniteCoordinatesAreRefusedOrReported) {
   // What Assimp makes of "nan"/"inf" text varies by importer; either the importer refuses the
   // file, or validation sees the non-finite vertex and the default policy refuses it.

@@ -120,7 +120,7 @@ void check_readable(const fs::path& path) {
 
 // Logs and notes every defect present; throws for those the policy refuses.
 void apply_policy_messages(const fs::path& path, const MeshReport& found,
-                           const ValidationPolicy& policy, MeshReport& notes_to) {
+                           const ValidationPolicy& policy, std::vector<std::string>& notes) {
   std::string refused;
   for (std::size_t d = 0; d < kMeshDefectCount; ++d) {
     const auto defect = static_cast<MeshDefect>(d);
@@ -146,7 +146,7 @@ void apply_policy_messages(const fs::path& path, const MeshReport& found,
           note += " (accepted)";
         }
         spdlog::warn("{}: {}", path.string(), note);
-        notes_to.notes.push_back(std::move(note));
+        notes.push_back(std::move(note));
         break;
       }
     }
@@ -250,7 +250,9 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& options, Mes
                           " point/line primitives");
     spdlog::warn("{}: {}", where, found.notes.back());
   }
-  apply_policy_messages(path, found, options.policy, found);
+  std::vector<std::string> notes;
+  apply_policy_messages(path, found, options.policy, notes);
+  found.notes.insert(found.notes.end(), notes.begin(), notes.end());
 
   const MeshRepairStats repairs = repair_mesh(mesh, options.policy, options.validation);
   if (repairs.any()) {
@@ -259,7 +261,7 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& options, Mes
     // A repair can expose a defect (orientation fixed → component now inside out); refuse
     // whatever the policy refuses in the result too.
     MeshReport after = validate_mesh(mesh, options.validation);
-    MeshReport scratch;
+    std::vector<std::string> scratch;
     ValidationPolicy refuse_only = options.policy;
     for (DefectAction& a : refuse_only.actions) {
       a = a == DefectAction::kRefuse ? DefectAction::kRefuse : DefectAction::kIgnore;

@@ -140,7 +140,7 @@ Analysis analyse(const TriangleMesh& mesh, const MeshValidationOptions& options)
     std::vector<std::pair<TriangleIndices, std::uint32_t>> sorted;
     sorted.reserve(nt);
     for (std::size_t t = 0; t < nt; ++t) {
-      if (an.bad_index[t] || repeats_index(mesh.triangles[t])) {
+      if (an.bad_index[t] || an.degenerate[t]) {  // a degenerate copy is counted once
         continue;
       }
       TriangleIndices key = mesh.triangles[t];
@@ -156,8 +156,9 @@ Analysis analyse(const TriangleMesh& mesh, const MeshValidationOptions& options)
     }
   }
 
-  // Topology uses in-range triangles with three distinct indices that are not duplicates
-  // (a duplicate is reported once, as a duplicate, not again as three non-manifold edges).
+  // Topology uses in-range triangles that are neither degenerate nor duplicates: each defect is
+  // reported once under its own name (a duplicate is not also three non-manifold edges), and
+  // the edge counts describe the mesh as it is after the default repairs drop those triangles.
   std::vector<char> in_topology(nt, 0);
   UnionFind uf(nv);
   std::vector<char> used_topo(nv, 0);
@@ -169,7 +170,7 @@ Analysis analyse(const TriangleMesh& mesh, const MeshValidationOptions& options)
     const TriangleIndices& tri = mesh.triangles[t];
     uf.unite(tri[0], tri[1]);
     uf.unite(tri[1], tri[2]);
-    if (!repeats_index(tri) && !an.duplicate[t]) {
+    if (!an.degenerate[t] && !an.duplicate[t]) {
       in_topology[t] = 1;
       ++topo_faces;
       for (std::uint32_t v : tri) {

@@ -82,7 +82,8 @@ struct MeshValidationOptions {
 struct MeshReport {
   std::size_t vertex_count = 0;
   std::size_t triangle_count = 0;
-  /// Distinct undirected edges among non-degenerate, in-range triangles.
+  /// Distinct undirected edges. Edge, Euler and closedness facts use the in-range triangles
+  /// that are neither degenerate nor duplicates (each defect is reported once, under its name).
   std::size_t edge_count = 0;
 
   std::size_t non_finite_vertices = 0;
