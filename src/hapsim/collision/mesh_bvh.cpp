@@ -555,6 +555,12 @@ SurfacePoint MeshBvh::closest_point_counted(const Vec3& p, QueryHint* hint,
 // haptic path: no allocation.
 bool MeshBvh::contact_within(const Vec3& p, double radius, SurfacePoint* out,
                              QueryHint* hint) const {
+  return contact_within_counted(p, radius, out, hint, nullptr);
+}
+
+// haptic path: no allocation.
+bool MeshBvh::contact_within_counted(const Vec3& p, double radius, SurfacePoint* out,
+                                     QueryHint* hint, QueryCounters* counters) const {
   if (!(radius >= 0.0)) {
     return false;
   }
@@ -563,7 +569,11 @@ bool MeshBvh::contact_within(const Vec3& p, double radius, SurfacePoint* out,
   Best best;
   best.d2 = std::nextafter(std::nextafter(radius * radius, kInf), kInf);
   seed_from_hint(*mesh_, p, hint, best);
-  traverse<false>(impl_->nodes, impl_->leaf_triangles, *mesh_, p, best, nullptr);
+  if (counters != nullptr) {
+    traverse<true>(impl_->nodes, impl_->leaf_triangles, *mesh_, p, best, counters);
+  } else {
+    traverse<false>(impl_->nodes, impl_->leaf_triangles, *mesh_, p, best, nullptr);
+  }
   if (best.triangle == kNoTriangle || !(std::sqrt(best.d2) <= radius)) {
     return false;
   }

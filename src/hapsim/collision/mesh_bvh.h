@@ -50,6 +50,9 @@ class MeshBvh final : public ProximityQuery {
   /// As closest_point, also counting the work done.
   [[nodiscard]] SurfacePoint closest_point_counted(const Vec3& p, QueryHint* hint,
                                                    QueryCounters* counters) const;
+  /// As contact_within, also counting the work done.
+  bool contact_within_counted(const Vec3& p, double radius, SurfacePoint* out, QueryHint* hint,
+                              QueryCounters* counters) const;
 
   [[nodiscard]] const BvhStats& stats() const { return stats_; }
   [[nodiscard]] const TriangleMesh& mesh() const { return *mesh_; }

@@ -22,7 +22,8 @@ TriangleClosest closest_point_on_triangle(const Vec3& p, const Vec3& a, const Ve
     return {b, bp.squaredNorm(), TriangleFeature::kVertexB};
   }
   const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+  // d1 - d3 = |ab|²: a zero-length edge must not divide 0/0 (NaN); other regions cover it.
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0) {
     const double v = d1 / (d1 - d3);
     const Vec3 q = a + v * ab;
     return {q, (p - q).squaredNorm(), TriangleFeature::kEdgeAB};
@@ -34,13 +35,13 @@ TriangleClosest closest_point_on_triangle(const Vec3& p, const Vec3& a, const Ve
     return {c, cp.squaredNorm(), TriangleFeature::kVertexC};
   }
   const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0) {  // d2 - d6 = |ac|²
     const double w = d2 / (d2 - d6);
     const Vec3 q = a + w * ac;
     return {q, (p - q).squaredNorm(), TriangleFeature::kEdgeCA};
   }
   const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 && (d4 - d3) + (d5 - d6) > 0.0) {
     const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
     const Vec3 q = b + w * (c - b);
     return {q, (p - q).squaredNorm(), TriangleFeature::kEdgeBC};
