@@ -1,0 +1,21 @@
+// How a segment (a bone, a muscle, the sheet) answers a press: Hooke stiffness with the knee
+// paper's per-segment maximum penetration and maximum force, plus damping and Coulomb friction.
+#pragma once
+
+namespace hapsim {
+
+struct ContactMaterial {
+  /// Hooke's law F = k·x along the contact normal (N/m).
+  double stiffness_n_per_m = 500.0;
+  /// Penetration beyond which the spring stops growing (m). Soft tissue: large; bone: small.
+  double max_penetration_m = 0.01;
+  /// Force cap of the segment (N). Soft tissue: small; bone: large.
+  double max_force_n = 5.0;
+  /// Viscous damping along the normal, opposing the approach speed (N·s/m).
+  double damping_n_s_per_m = 0.0;
+  /// Coulomb friction on the proxy: static (stick) and dynamic (slip) coefficients.
+  double static_friction = 0.0;
+  double dynamic_friction = 0.0;
+};
+
+}  // namespace hapsim

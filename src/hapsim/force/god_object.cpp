@@ -1,0 +1,205 @@
+#include "hapsim/force/god_object.h"
+
+#include "hapsim/force/penalty_force.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hapsim {
+
+GodObject::GodObject(GodObjectParams params) : params_(params) {}
+
+void GodObject::reset(const Vec3& p_world) {
+  proxy_world_ = p_world;
+  contact_count_ = 0;
+  iterations_used_ = 0;
+  side_.fill(0);
+}
+
+// haptic path
+GodObject::Probe GodObject::probe(const ProxySurface& surface, int index, const Vec3& p_world,
+                                  double margin_m) {
+  Probe out{margin_m, Vec3::Zero(), Vec3::Zero(), kNoTriangle};
+  if (surface.query == nullptr) {
+    return out;
+  }
+  const Vec3 p_body = surface.X_world_body.inverse() * p_world;
+  SurfacePoint sp;
+  if (!surface.query->contact_within(p_body, params_.radius_m + margin_m, &sp, surface.hint)) {
+    return out;  // nothing within the margin: the clearance is at least margin_m
+  }
+  const Mat3 R = surface.X_world_body.linear();
+  double distance = sp.signed_distance;
+  Vec3 normal_body = sp.normal;
+  if (surface.two_sided && index < kMaxSurfaces) {
+    std::int8_t& side = side_[static_cast<std::size_t>(index)];
+    // The side is learnt only while clearly away from the surface, so it never flips by a
+    // crossing; going round an open edge at a distance updates it.
+    if (side == 0 || std::abs(distance) > params_.radius_m + 2.0 * params_.max_substep_m) {
+      side = distance >= 0.0 ? 1 : -1;
+    }
+    distance *= side;
+    normal_body *= side;
+  }
+  out.clearance_m = distance - params_.radius_m;
+  out.normal_world = R * normal_body;
+  out.point_world = surface.X_world_body * sp.point;
+  out.triangle = sp.triangle;
+  return out;
+}
+
+// haptic path
+double GodObject::scan(std::span<const ProxySurface> surfaces, double margin_m) {
+  contact_count_ = 0;
+  double least = margin_m;
+  const int n = static_cast<int>(std::min<std::size_t>(surfaces.size(), kMaxSurfaces));
+  for (int i = 0; i < n; ++i) {
+    const Probe pr = probe(surfaces[static_cast<std::size_t>(i)], i, proxy_world_, margin_m);
+    least = std::min(least, pr.clearance_m);
+    if (!(pr.clearance_m < params_.contact_tolerance_m)) {
+      continue;
+    }
+    const ProxyContact c{i, pr.point_world, pr.normal_world, pr.triangle, pr.clearance_m};
+    if (contact_count_ < kMaxContacts) {
+      contacts_[static_cast<std::size_t>(contact_count_++)] = c;
+    } else {  // keep the deepest ones
+      auto worst = std::max_element(contacts_.begin(), contacts_.end(),
+                                    [](const ProxyContact& a, const ProxyContact& b) {
+                                      return a.clearance_m < b.clearance_m;
+                                    });
+      if (c.clearance_m < worst->clearance_m) {
+        *worst = c;
+      }
+    }
+  }
+  return least;
+}
+
+// haptic path
+double GodObject::resolve_penetration(std::span<const ProxySurface> surfaces, double margin_m) {
+  double least = margin_m;
+  for (int pass = 0; pass < 4; ++pass) {
+    least = scan(surfaces, margin_m);
+    bool pushed = false;
+    for (int k = 0; k < contact_count_; ++k) {
+      const ProxyContact& c = contacts_[static_cast<std::size_t>(k)];
+      if (c.clearance_m < 0.0) {
+        proxy_world_ += c.normal_world * (-c.clearance_m);
+        pushed = true;
+      }
+    }
+    if (!pushed) {
+      break;
+    }
+  }
+  return least;
+}
+
+namespace {
+
+// Removes from `motion` every component that would push into an active contact plane.
+// Gauss-Seidel projection; three passes settle two planes, three planes block all motion.
+Vec3 project_onto_contacts(Vec3 motion, std::span<const ProxyContact> contacts) {
+  for (int pass = 0; pass < 3; ++pass) {
+    bool changed = false;
+    for (const ProxyContact& c : contacts) {
+      const double into = motion.dot(c.normal_world);
+      if (into < 0.0) {
+        motion -= into * c.normal_world;
+        changed = true;
+      }
+    }
+    if (!changed) {
+      return motion;
+    }
+  }
+  for (const ProxyContact& c : contacts) {
+    if (motion.dot(c.normal_world) < -1e-12) {
+      return Vec3::Zero();  // wedged in a corner
+    }
+  }
+  return motion;
+}
+
+}  // namespace
+
+// haptic path
+void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface> surfaces) {
+  if (!device_p_world.allFinite()) {
+    return;  // never follow a NaN: hold the proxy where it is
+  }
+  const Vec3 previous = proxy_world_;
+  // Look only as far as this cycle's motion can reach (queries exit early beyond it).
+  const double margin =
+      std::max((device_p_world - proxy_world_).norm(), params_.max_substep_m) +
+      params_.contact_tolerance_m;
+  double least = resolve_penetration(surfaces, margin);
+  iterations_used_ = 0;
+  while (iterations_used_ < params_.max_iterations) {
+    ++iterations_used_;
+    const Vec3 motion = project_onto_contacts(device_p_world - proxy_world_, contacts());
+    const double length = motion.norm();
+    if (length < 1e-9) {
+      break;
+    }
+    // Free space up to the least clearance; in contact, short steps then push back out.
+    const double step = std::min(length, std::max(least, params_.max_substep_m));
+    proxy_world_ += motion * (step / length);
+    least = resolve_penetration(surfaces, margin);
+  }
+  apply_friction(previous, device_p_world, surfaces, margin);
+}
+
+// haptic path
+void GodObject::apply_friction(const Vec3& previous_proxy_world, const Vec3& device_p_world,
+                               std::span<const ProxySurface> surfaces, double margin_m) {
+  if (contact_count_ == 0) {
+    return;
+  }
+  const ProxyContact& c = contacts_[0];
+  const ContactMaterial* material = surfaces[static_cast<std::size_t>(c.surface)].material;
+  if (material == nullptr || material->static_friction <= 0.0) {
+    return;
+  }
+  const Vec3& n = c.normal_world;
+  const double depth = (proxy_world_ - device_p_world).dot(n);
+  if (depth <= 0.0) {
+    return;
+  }
+  const Vec3 offset = device_p_world - previous_proxy_world;
+  const Vec3 tangential = offset - offset.dot(n) * n;
+  const double t_len = tangential.norm();
+  const Vec3 moved = proxy_world_ - previous_proxy_world;
+  const Vec3 moved_t = moved - moved.dot(n) * n;
+  if (t_len <= material->static_friction * depth) {
+    proxy_world_ -= moved_t;  // stick: inside the friction cone the proxy keeps its place
+  } else {
+    // Slip: the proxy trails the device by the dynamic friction cone's radius.
+    const Vec3 goal_t = tangential - tangential * (material->dynamic_friction * depth / t_len);
+    proxy_world_ += goal_t - moved_t;
+  }
+  resolve_penetration(surfaces, margin_m);
+}
+
+// haptic path
+Vec3 proxy_force(const GodObject& proxy, std::span<const ProxySurface> surfaces,
+                 const Vec3& device_p_world, const Vec3& device_v_world) {
+  if (!proxy.in_contact() || !device_p_world.allFinite()) {
+    return Vec3::Zero();
+  }
+  const ProxyContact& c = proxy.contacts().front();
+  const ContactMaterial* material = surfaces[static_cast<std::size_t>(c.surface)].material;
+  if (material == nullptr) {
+    return Vec3::Zero();
+  }
+  const Vec3 stretch = proxy.proxy_world() - device_p_world;
+  const double depth = stretch.norm();
+  if (!(depth > 0.0)) {
+    return Vec3::Zero();
+  }
+  const Vec3 direction = stretch / depth;
+  const double approach = device_v_world.allFinite() ? -device_v_world.dot(direction) : 0.0;
+  return direction * penalty_force_magnitude(*material, depth, approach);
+}
+
+}  // namespace hapsim

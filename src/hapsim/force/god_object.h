@@ -1,0 +1,101 @@
+// The proxy / god-object method (Zilles & Salisbury 1995; Ruspini et al. 1997): a proxy sphere
+// follows the device but never enters a surface, so a fast probe cannot pop through a thin sheet
+// or ligament; the force is a spring from the device to the proxy.
+//
+// Motion: each cycle the proxy moves towards the device position in steps no longer than its
+// clearance (sphere tracing: nothing can be crossed) or, in contact, than `max_substep_m` (less
+// than half the thinnest closed feature), after which any penetration is resolved along the
+// surface normal. Remaining motion is projected onto the active contact planes (sliding).
+// Open surfaces (a sheet) are two-sided: the proxy remembers which side it is on.
+// Coulomb friction keeps the proxy stuck while the device stays inside the friction cone.
+#pragma once
+
+#include "hapsim/collision/proximity_query.h"
+#include "hapsim/core/types.h"
+#include "hapsim/force/contact_material.h"
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+namespace hapsim {
+
+/// One surface the proxy must stay outside of (owned by the world; the proxy only reads it).
+struct ProxySurface {
+  const ProximityQuery* query = nullptr;    // answers in the body frame
+  Iso3 X_world_body = Iso3::Identity();     // where the body is
+  const ContactMaterial* material = nullptr;
+  bool two_sided = false;                   // open mesh: both sides are outside
+  QueryHint* hint = nullptr;                // temporal coherence, one per tool-surface pair
+};
+
+struct ProxyContact {
+  int surface = -1;                         // index into the span given to update()
+  Vec3 point_world = Vec3::Zero();          // closest surface point
+  Vec3 normal_world = Vec3::Zero();         // unit, pointing from the surface to the proxy
+  std::uint32_t triangle = kNoTriangle;
+  double clearance_m = 0.0;                 // proxy-to-surface gap (< 0 while penetrating)
+};
+
+struct GodObjectParams {
+  double radius_m = 0.0;                    // tool sphere radius (0: a point probe)
+  double contact_tolerance_m = 1e-5;        // within this of a surface counts as touching
+  double max_substep_m = 2.5e-4;            // step length while in contact
+  int max_iterations = 16;                  // work bound per cycle (motion carries over)
+};
+
+class GodObject {
+ public:
+  static constexpr int kMaxSurfaces = 64;
+  static constexpr int kMaxContacts = 4;
+
+  explicit GodObject(GodObjectParams params = {});
+
+  /// Places the proxy (e.g. at the device's first position, which must be outside surfaces).
+  void reset(const Vec3& p_world);
+
+  /// Moves the proxy towards `device_p_world`. haptic path: no allocation.
+  void update(const Vec3& device_p_world, std::span<const ProxySurface> surfaces);
+
+  [[nodiscard]] const Vec3& proxy_world() const { return proxy_world_; }
+  [[nodiscard]] std::span<const ProxyContact> contacts() const {
+    return {contacts_.data(), static_cast<std::size_t>(contact_count_)};
+  }
+  [[nodiscard]] bool in_contact() const { return contact_count_ > 0; }
+  /// Iterations the last update used (bounded by params.max_iterations).
+  [[nodiscard]] int iterations_used() const { return iterations_used_; }
+  [[nodiscard]] const GodObjectParams& params() const { return params_; }
+
+ private:
+  struct Probe {
+    double clearance_m;  // distance from the proxy sphere to the surface (< 0: penetrating)
+    Vec3 normal_world;   // from the surface towards the proxy side
+    Vec3 point_world;
+    std::uint32_t triangle;
+  };
+  /// Clearance of the proxy sphere at `p_world` to one surface, looking no farther than
+  /// `margin_m` (beyond it the query exits early and the clearance is reported as margin_m).
+  Probe probe(const ProxySurface& surface, int index, const Vec3& p_world, double margin_m);
+  /// Fills contacts_ (clearance < tolerance) at the current proxy; returns the least clearance.
+  double scan(std::span<const ProxySurface> surfaces, double margin_m);
+  /// Pushes the proxy out of any surface it penetrates, along that surface's normal.
+  double resolve_penetration(std::span<const ProxySurface> surfaces, double margin_m);
+  void apply_friction(const Vec3& previous_proxy_world, const Vec3& device_p_world,
+                      std::span<const ProxySurface> surfaces, double margin_m);
+
+  GodObjectParams params_;
+  Vec3 proxy_world_ = Vec3::Zero();
+  std::array<ProxyContact, kMaxContacts> contacts_{};
+  int contact_count_ = 0;
+  int iterations_used_ = 0;
+  /// Side of each two-sided surface the proxy is on (+1 front, −1 back, 0 unknown yet).
+  std::array<std::int8_t, kMaxSurfaces> side_{};
+};
+
+/// Spring force from the device to the proxy with the touched material's stiffness, maximum
+/// penetration and maximum force, and normal damping from the device velocity. Zero when not in
+/// contact. haptic path.
+Vec3 proxy_force(const GodObject& proxy, std::span<const ProxySurface> surfaces,
+                 const Vec3& device_p_world, const Vec3& device_v_world);
+
+}  // namespace hapsim

@@ -1,0 +1,194 @@
+#include "hapsim/force/god_object.h"
+
+#include "analytic_surfaces.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace hapsim {
+namespace {
+
+ContactMaterial wall_material(double stiffness, double damping) {
+  ContactMaterial m;
+  m.stiffness_n_per_m = stiffness;
+  m.max_penetration_m = 1.0;
+  m.max_force_n = 1000.0;
+  m.damping_n_s_per_m = damping;
+  return m;
+}
+
+TEST(GodObject, FreeSpaceFollowsTheDeviceExactly) {
+  test::HalfSpace floor;
+  const ContactMaterial m = wall_material(700.0, 0.0);
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&floor, Iso3::Identity(), &m, false, &hint}}};
+  GodObject proxy;
+  proxy.reset(Vec3(0, 0, 0.05));
+  proxy.update(Vec3(0.01, -0.02, 0.03), surfaces);
+  EXPECT_TRUE(proxy.proxy_world().isApprox(Vec3(0.01, -0.02, 0.03), 1e-12));
+  EXPECT_FALSE(proxy.in_contact());
+  EXPECT_EQ(proxy_force(proxy, surfaces, Vec3(0.01, -0.02, 0.03), Vec3::Zero()), Vec3::Zero());
+}
+
+TEST(GodObject, PressingIntoAPlaneGivesHookeForceAlongTheNormal) {
+  test::HalfSpace floor;
+  const ContactMaterial m = wall_material(700.0, 0.0);
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&floor, Iso3::Identity(), &m, false, &hint}}};
+  GodObject proxy;
+  proxy.reset(Vec3(0.001, 0.002, 0.01));
+  const Vec3 device(0.001, 0.002, -0.002);  // 2 mm below the surface
+  proxy.update(device, surfaces);
+  EXPECT_NEAR(proxy.proxy_world().z(), 0.0, 2e-5);
+  EXPECT_NEAR(proxy.proxy_world().x(), 0.001, 1e-12);
+  ASSERT_TRUE(proxy.in_contact());
+  const Vec3 f = proxy_force(proxy, surfaces, device, Vec3::Zero());
+  EXPECT_NEAR(f.z(), 700.0 * 0.002, 700.0 * 2e-5);
+  EXPECT_NEAR(f.x(), 0.0, 1e-9);
+}
+
+TEST(GodObject, SphereToolRestsOnTheSurfaceAtItsRadius) {
+  test::SolidSphere ball(0.05);
+  const ContactMaterial m = wall_material(500.0, 0.0);
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&ball, Iso3::Identity(), &m, false, &hint}}};
+  GodObjectParams params;
+  params.radius_m = 0.005;
+  GodObject proxy(params);
+  proxy.reset(Vec3(0, 0, 0.1));
+  const Vec3 device(0, 0, 0.05);  // the tool centre on the surface: 5 mm too deep
+  proxy.update(device, surfaces);
+  EXPECT_NEAR(proxy.proxy_world().z(), 0.055, 2e-5);
+  const Vec3 f = proxy_force(proxy, surfaces, device, Vec3::Zero());
+  EXPECT_NEAR(f.norm(), 500.0 * 0.005, 500.0 * 2e-5);
+}
+
+TEST(GodObject, SlidesAlongTheSurfaceWithoutFriction) {
+  test::SolidSphere ball(0.05);
+  const ContactMaterial m = wall_material(500.0, 0.0);
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&ball, Iso3::Identity(), &m, false, &hint}}};
+  GodObject proxy;
+  proxy.reset(Vec3(0, 0, 0.06));
+  // The device moves inside the ball along a circle of radius 45 mm; the proxy must stay on the
+  // sphere of radius 50 mm, on the device's ray (frictionless: force along the normal).
+  for (int k = 0; k <= 300; ++k) {
+    const double angle = 0.5 * k / 300.0;
+    const Vec3 device = 0.045 * Vec3(std::sin(angle), 0, std::cos(angle));
+    proxy.update(device, surfaces);
+    EXPECT_NEAR(proxy.proxy_world().norm(), 0.05, 3e-5) << k;
+  }
+  const Vec3 final_dir = Vec3(std::sin(0.5), 0, std::cos(0.5));
+  EXPECT_LT((proxy.proxy_world().normalized() - final_dir).norm(), 1e-3);
+}
+
+TEST(GodObject, StaticFrictionHoldsAndDynamicFrictionTrails) {
+  test::HalfSpace floor;
+  ContactMaterial m = wall_material(1000.0, 0.0);
+  m.static_friction = 0.5;
+  m.dynamic_friction = 0.3;
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&floor, Iso3::Identity(), &m, false, &hint}}};
+  GodObject proxy;
+  proxy.reset(Vec3(0, 0, 0.001));
+  proxy.update(Vec3(0, 0, -0.002), surfaces);  // press 2 mm in: cone radius 1 mm (static)
+  ASSERT_TRUE(proxy.in_contact());
+  proxy.update(Vec3(0.0008, 0, -0.002), surfaces);  // inside the cone: stick
+  EXPECT_NEAR(proxy.proxy_world().x(), 0.0, 1e-9);
+  const Vec3 fx = proxy_force(proxy, surfaces, Vec3(0.0008, 0, -0.002), Vec3::Zero());
+  EXPECT_LT(fx.x(), -0.5);  // friction force resists the sideways push
+  proxy.update(Vec3(0.005, 0, -0.002), surfaces);  // outside: slip, trail by 0.3 * 2 mm
+  EXPECT_NEAR(proxy.proxy_world().x(), 0.005 - 0.3 * 0.002, 2e-5);
+}
+
+TEST(GodObject, NaNDeviceInputHoldsTheProxy) {
+  test::HalfSpace floor;
+  const ContactMaterial m = wall_material(700.0, 0.0);
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&floor, Iso3::Identity(), &m, false, &hint}}};
+  GodObject proxy;
+  proxy.reset(Vec3(0, 0, 0.01));
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  proxy.update(Vec3(nan, 0, 0), surfaces);
+  EXPECT_TRUE(proxy.proxy_world().allFinite());
+  EXPECT_EQ(proxy_force(proxy, surfaces, Vec3(nan, 0, 0), Vec3::Zero()), Vec3::Zero());
+}
+
+// A device of mass m is pressed onto a stiff virtual wall by a steady hand force and bounces.
+// The force is computed at 1 kHz from the sampled position and a backward-difference velocity
+// and held between samples (zero-order hold); the device itself moves continuously (exactly). Sampling
+// makes a pure spring active (Colgate & Schenkel 1997: it needs damping b > K·T/2). With the
+// damping hapsim ships (K·T) the excess energy above the resting state must never grow over
+// 10 s; without it, it must (the control case, so the test can fail).
+struct WallRun {
+  double initial_excess_j;
+  double max_excess_j;
+  double final_excess_j;
+  std::array<double, 10> max_excess_per_second_j;  // envelope, one entry per simulated second
+};
+
+WallRun press_on_wall(double damping_n_s_per_m) {
+  constexpr double kMassKg = 0.05;
+  constexpr double kStiffness = 700.0;  // a desktop stylus's rated stiffness
+  constexpr double kPeriodS = 1e-3;
+  constexpr double kHandForceN = 0.5;  // pushes the device down into the wall
+  test::HalfSpace wall;
+  const ContactMaterial m = wall_material(kStiffness, damping_n_s_per_m);
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&wall, Iso3::Identity(), &m, false, &hint}}};
+  GodObject proxy;
+  double z = 0.002;
+  double v = -0.1;
+  proxy.reset(Vec3(0, 0, z));
+  // Energy relative to the resting state z = -F/k (kinetic + wall spring + hand potential).
+  const double z_rest = -kHandForceN / kStiffness;
+  const auto excess = [&](double zz, double vv) {
+    const auto potential = [&](double q) {
+      const double pen = std::min(q, 0.0);
+      return 0.5 * kStiffness * pen * pen + kHandForceN * q;
+    };
+    return 0.5 * kMassKg * vv * vv + potential(zz) - potential(z_rest);
+  };
+  WallRun run{excess(z, v), 0.0, 0.0, {}};
+  run.max_excess_j = run.initial_excess_j;
+  double z_previous = z - v * kPeriodS;  // as if it had been moving before
+  for (int k = 0; k < 10000; ++k) {
+    const Vec3 device(0, 0, z);
+    const Vec3 velocity(0, 0, (z - z_previous) / kPeriodS);
+    z_previous = z;
+    proxy.update(device, surfaces);
+    const double force = proxy_force(proxy, surfaces, device, velocity).z() - kHandForceN;
+    // The force is held over the period, so the device's motion is an exact parabola: no
+    // integration error can add or remove energy and blur the check.
+    const double a = force / kMassKg;
+    z += v * kPeriodS + 0.5 * a * kPeriodS * kPeriodS;
+    v += a * kPeriodS;
+    run.max_excess_j = std::max(run.max_excess_j, excess(z, v));
+    double& window = run.max_excess_per_second_j[static_cast<std::size_t>(k / 1000)];
+    window = std::max(window, excess(z, v));
+  }
+  run.final_excess_j = excess(z, v);
+  return run;
+}
+
+TEST(GodObject, PassiveOnAStiffWallWithShippedDamping) {
+  const WallRun run = press_on_wall(700.0 * 1e-3);  // K·T, see ContactMaterial docs
+  // The only rise allowed is the entry transient of the zero-order hold: the sample before first
+  // contact pushes nothing while the device enters, a fraction of a percent of the energy.
+  EXPECT_LE(run.max_excess_j, run.initial_excess_j * 1.01);
+  for (std::size_t s = 1; s < run.max_excess_per_second_j.size(); ++s) {
+    EXPECT_LE(run.max_excess_per_second_j[s], run.max_excess_per_second_j[s - 1]) << "second " << s;
+  }
+  EXPECT_LT(run.final_excess_j, 0.01 * run.initial_excess_j);  // it settles
+}
+
+TEST(GodObject, UndampedWallGainsEnergyUnderSampling) {
+  const WallRun run = press_on_wall(0.0);
+  EXPECT_GT(run.final_excess_j, 1.5 * run.initial_excess_j);
+}
+
+}  // namespace
+}  // namespace hapsim
