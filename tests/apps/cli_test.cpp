@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -161,3 +162,54 @@ TEST(Cli, InfoWritesJson) {
 }
 
 }  // namespace
+
+// A cube of side 20 mm written as an OBJ in millimetres: loading with --scale 0.001 gives its
+// exact volume and the query its exact distances.
+constexpr const char* kCubeObjMm =
+    "v -10 -10 -10\nv 10 -10 -10\nv 10 10 -10\nv -10 10 -10\n"
+    "v -10 -10 10\nv 10 -10 10\nv 10 10 10\nv -10 10 10\n"
+    "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n"
+    "f 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+
+TEST(Cli, InfoAndQueryReadMeshFilesInMillimetres) {
+  const auto obj = temp_file("cube_mm.obj", kCubeObjMm);
+  const auto json = temp_file("cube_info.json", "");
+  const RunResult info =
+      run_hapsim("info " + obj.string() + " --scale 0.001 --json " + json.string());
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  EXPECT_NE(info.output.find("closed"), std::string::npos) << info.output;
+  std::ifstream in(json);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"validation\""), std::string::npos) << text;
+
+  const auto points = temp_file("cube_points.csv", "x,y,z\n0,0,0\n0,0,25\n");
+  const auto out = std::filesystem::temp_directory_path() / "hapsim_cli_test" / "cube_out.csv";
+  const RunResult q = run_hapsim("query " + obj.string() + " --scale 0.001 --points " +
+                                 points.string() + " --method exact --out " + out.string());
+  ASSERT_EQ(q.exit_code, 0) << q.output;
+  const auto rows = read_csv_numbers(out);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_NEAR(rows[0][3], -10.0, 1e-9);  // centre: 10 mm inside, answered in the input's units
+  EXPECT_NEAR(rows[1][3], 15.0, 1e-9);   // 15 mm above the top face
+}
+
+TEST(Cli, MeshWithNanCoordinatesIsRefusedAndNamed) {
+  std::string bad = kCubeObjMm;
+  bad.replace(0, 13, "v nan -10 -10");
+  const auto obj = temp_file("cube_nan.obj", bad);
+  const RunResult r = run_hapsim("info " + obj.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("cube_nan.obj"), std::string::npos) << r.output;
+}
+
+TEST(Cli, InfoOnTheRealKnee) {
+  const std::filesystem::path stl = std::filesystem::path(HAPSIM_TEST_DATA_DIR) /
+                                    "knee_vhf_left/stl/VHF_Left_Bone_Patella_smooth.stl";
+  if (!std::filesystem::exists(stl)) {
+    GTEST_SKIP() << "real knee data not found at " << stl << " (../shared/data absent)";
+  }
+  const RunResult r = run_hapsim("info " + stl.string() + " --scale 0.001");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("closed"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no defects"), std::string::npos) << r.output;
+}
