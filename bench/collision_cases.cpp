@@ -613,7 +613,25 @@ void compute_ratios(std::vector<CollisionRow>& rows) {
   }
 }
 
-std::string format_table(const std::vector<CollisionRow>& rows) {
+std::string format_table(const std::vector<CollisionRow>& rows_in_run_order) {
+  // Rows arrive method by method; a table compares methods, so group by mesh and workload
+  // (each in order of first appearance) and keep the run order of methods inside a group.
+  std::vector<std::string> keys;
+  for (const CollisionRow& row : rows_in_run_order) {
+    const std::string key = row.mesh + "/" + row.workload;
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
+      keys.push_back(key);
+    }
+  }
+  std::vector<CollisionRow> rows;
+  rows.reserve(rows_in_run_order.size());
+  for (const std::string& key : keys) {
+    for (const CollisionRow& row : rows_in_run_order) {
+      if (row.mesh + "/" + row.workload == key) {
+        rows.push_back(row);
+      }
+    }
+  }
   std::ostringstream out;
   char line[256];
   const std::size_t n = rows.empty() ? 0 : rows.front().query_count;

@@ -69,9 +69,13 @@ class FclOracle final : public ClosestPointOracle {
   [[nodiscard]] double build_ms() const override { return build_ms_; }
 
   [[nodiscard]] std::size_t memory_bytes() const override {
-    // BVHModel::memUsage counts its BV nodes, its own copy of the vertices (double) and
-    // triangles, and the primitive index permutation.
-    return static_cast<std::size_t>(model_->memUsage(0)) + sizeof(*model_);
+    // Its BV nodes, its own copy of the vertices (double) and triangles, and the primitive
+    // index permutation. (BVHModel::memUsage() computes this but returns BVH_OK, i.e. 0.)
+    const auto bvs = static_cast<std::size_t>(model_->getNumBVs());
+    const auto tris = static_cast<std::size_t>(model_->num_tris);
+    const auto verts = static_cast<std::size_t>(model_->num_vertices);
+    return bvs * sizeof(fcl::BVNode<fcl::OBBRSSd>) + tris * sizeof(fcl::Triangle) +
+           verts * sizeof(fcl::Vector3d) + tris * sizeof(unsigned int) + sizeof(*model_);
   }
 
  private:
