@@ -1,0 +1,345 @@
+#include "hapsim/deform/vertex_deflection.h"
+
+#include "hapsim/core/error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <utility>
+
+namespace hapsim {
+
+namespace {
+
+void check_params(const DeflectionParams& p, std::size_t s) {
+  const std::string where = "VertexDeflectionOptions.segments[" + std::to_string(s) + "]";
+  if (!std::isfinite(p.elasticity_factor) || p.elasticity_factor <= 0.0) {
+    throw Error(where + ".elasticity_factor",
+                "expected a finite factor > 0, got " + std::to_string(p.elasticity_factor));
+  }
+  if (std::isnan(p.recovery_time_constant_s) || p.recovery_time_constant_s < 0.0) {
+    throw Error(where + ".recovery_time_constant_s",
+                "expected a time >= 0 s, got " + std::to_string(p.recovery_time_constant_s));
+  }
+  if (std::isnan(p.max_recovery_speed_m_per_s) || p.max_recovery_speed_m_per_s <= 0.0) {
+    throw Error(where + ".max_recovery_speed_m_per_s",
+                "expected a speed > 0 m/s, got " + std::to_string(p.max_recovery_speed_m_per_s));
+  }
+  if (std::isnan(p.max_deflection_m) || p.max_deflection_m <= 0.0) {
+    throw Error(where + ".max_deflection_m",
+                "expected a depth > 0 m, got " + std::to_string(p.max_deflection_m));
+  }
+  if (!std::isfinite(p.rest_tolerance_m) || p.rest_tolerance_m < 0.0) {
+    throw Error(where + ".rest_tolerance_m",
+                "expected a finite length >= 0 m, got " + std::to_string(p.rest_tolerance_m));
+  }
+}
+
+/// Angle-weighted normal of vertex v from its incident triangles (as TriangleMesh does).
+Vec3 vertex_normal(const TriangleMesh& mesh, std::span<const std::uint32_t> tris, std::uint32_t v) {
+  Vec3 sum = Vec3::Zero();
+  for (const std::uint32_t t : tris) {
+    const TriangleIndices& tri = mesh.triangles[t];
+    const int k = tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
+    const Vec3 n = mesh.face_normal(t);
+    const Vec3& p = mesh.vertices[v];
+    const Vec3 e1 = (mesh.vertices[tri[(k + 1) % 3]] - p).normalized();
+    const Vec3 e2 = (mesh.vertices[tri[(k + 2) % 3]] - p).normalized();
+    sum += std::acos(std::clamp(e1.dot(e2), -1.0, 1.0)) * n;
+  }
+  const double len = sum.norm();
+  return len > 0.0 && std::isfinite(len) ? Vec3(sum / len) : Vec3::Zero();
+}
+
+}  // namespace
+
+VertexDeflection::VertexDeflection(TriangleMesh rest_mesh, VertexDeflectionOptions options)
+    : mesh_(std::make_unique<TriangleMesh>(std::move(rest_mesh))),
+      segment_of_vertex_(std::move(options.segment_of_vertex)),
+      segments_(std::move(options.segments)) {
+  TriangleMesh& mesh = *mesh_;
+  const std::size_t n = mesh.vertex_count();
+  if (n >= std::numeric_limits<std::uint32_t>::max()) {
+    throw Error("VertexDeflection", "too many vertices for 32-bit indices");
+  }
+  for (std::size_t v = 0; v < n; ++v) {
+    if (!mesh.vertices[v].allFinite()) {
+      throw Error("VertexDeflection", "rest vertex " + std::to_string(v) + " is not finite");
+    }
+  }
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    for (const std::uint32_t v : mesh.triangles[t]) {
+      if (v >= n) {
+        throw Error("VertexDeflection", "triangle " + std::to_string(t) +
+                                            " references missing vertex " + std::to_string(v));
+      }
+    }
+  }
+  if (segments_.empty()) {
+    segments_.emplace_back();
+  }
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    check_params(segments_[s], s);
+  }
+  if (segment_of_vertex_.empty()) {
+    segment_of_vertex_.assign(n, 0);
+  } else if (segment_of_vertex_.size() != n) {
+    throw Error("VertexDeflectionOptions.segment_of_vertex",
+                "expected one segment per vertex (" + std::to_string(n) + "), got " +
+                    std::to_string(segment_of_vertex_.size()));
+  }
+  for (std::size_t v = 0; v < n; ++v) {
+    if (segment_of_vertex_[v] >= segments_.size()) {
+      throw Error("VertexDeflectionOptions.segment_of_vertex[" + std::to_string(v) + "]",
+                  "expected a segment < " + std::to_string(segments_.size()) + ", got " +
+                      std::to_string(segment_of_vertex_[v]));
+    }
+  }
+
+  if (mesh.vertex_normals.size() != n) {
+    mesh.compute_vertex_normals();
+  }
+  rest_ = mesh.vertices;
+  if (options.directions.empty()) {
+    // A vertex without a normal (unused or only in degenerate triangles) simply stays put.
+    direction_.resize(n);
+    for (std::size_t v = 0; v < n; ++v) {
+      direction_[v] = -mesh.vertex_normals[v];
+    }
+  } else {
+    if (options.directions.size() != n) {
+      throw Error("VertexDeflectionOptions.directions",
+                  "expected one direction per vertex (" + std::to_string(n) + "), got " +
+                      std::to_string(options.directions.size()));
+    }
+    direction_ = std::move(options.directions);
+    for (std::size_t v = 0; v < n; ++v) {
+      const double len = direction_[v].norm();
+      if (!std::isfinite(len) || len < 1e-12) {
+        throw Error("VertexDeflectionOptions.directions[" + std::to_string(v) + "]",
+                    "expected a finite, non-zero direction");
+      }
+      direction_[v] /= len;
+    }
+  }
+
+  // Vertex → triangle adjacency.
+  vertex_tri_start_.assign(n + 1, 0);
+  for (const TriangleIndices& tri : mesh.triangles) {
+    for (const std::uint32_t v : tri) {
+      ++vertex_tri_start_[v + 1];
+    }
+  }
+  for (std::size_t v = 0; v < n; ++v) {
+    vertex_tri_start_[v + 1] += vertex_tri_start_[v];
+  }
+  vertex_tris_.resize(vertex_tri_start_[n]);
+  {
+    std::vector<std::uint32_t> fill(vertex_tri_start_.begin(), vertex_tri_start_.end() - 1);
+    for (std::uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+      for (const std::uint32_t v : mesh.triangles[t]) {
+        vertex_tris_[fill[v]++] = t;
+      }
+    }
+  }
+
+  double cell_m = options.grid_cell_m;
+  if (std::isnan(cell_m) || cell_m < 0.0) {
+    throw Error("VertexDeflectionOptions.grid_cell_m",
+                "expected a length >= 0 m (0: automatic), got " + std::to_string(cell_m));
+  }
+  if (cell_m == 0.0) {
+    double edge_sum_m = 0.0;
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+      const auto c = mesh.corners(t);
+      edge_sum_m += (c[1] - c[0]).norm() + (c[2] - c[1]).norm() + (c[0] - c[2]).norm();
+    }
+    cell_m = mesh.triangle_count() > 0 ? 2.0 * edge_sum_m / (3.0 * mesh.triangle_count()) : 0.0;
+    if (!(cell_m > 0.0)) {
+      const double diag_m = n > 0 ? mesh.bounds().diagonal().norm() : 0.0;
+      cell_m = diag_m > 0.0 ? diag_m / std::cbrt(static_cast<double>(n)) : 1.0;
+    }
+  }
+  grid_ = std::make_unique<PointHashGrid>(rest_, cell_m);
+
+  // Everything the haptic path touches, sized once.
+  offset_m_.assign(n, 0.0);
+  target_m_.assign(n, 0.0);
+  target_stamp_.assign(n, 0);
+  normal_pending_flag_.assign(n, 0);
+  normals_pending_.reserve(n);
+  decay_per_segment_.assign(segments_.size(), 0.0);
+  triangle_stamp_.assign(mesh.triangle_count(), 0);
+  in_active_.assign(n, 0);
+  active_.reserve(n);
+  touched_.reserve(n);
+  moved_vertices_.reserve(n);
+  moved_triangles_.reserve(mesh.triangle_count());
+}
+
+double VertexDeflection::deflection_profile_m(double distance_m, double penetration_m,
+                                              double zero_distance_m) {
+  if (!(distance_m >= 0.0) || !(distance_m < zero_distance_m) || !(penetration_m > 0.0)) {
+    return 0.0;
+  }
+  return 0.5 * penetration_m * (std::cos(std::numbers::pi * distance_m / zero_distance_m) + 1.0);
+}
+
+// haptic path
+void VertexDeflection::next_stamp() {
+  if (++stamp_ == 0) {
+    // Wrapped after 2^32 cycles (~50 days at 1 kHz): clear the marks once.
+    std::fill(target_stamp_.begin(), target_stamp_.end(), 0);
+    std::fill(triangle_stamp_.begin(), triangle_stamp_.end(), 0);
+    stamp_ = 1;
+  }
+  touched_.clear();
+  moved_vertices_.clear();
+  moved_triangles_.clear();
+}
+
+// haptic path
+double VertexDeflection::recovered_gap_m(std::uint32_t segment, double gap_m, double dt_s) const {
+  const DeflectionParams& p = segments_[segment];
+  double next_m = gap_m * decay_per_segment_[segment];
+  // The speed cap slows recovery down, never speeds it past the target.
+  next_m = std::max(next_m, gap_m - p.max_recovery_speed_m_per_s * dt_s);
+  next_m = std::clamp(next_m, 0.0, gap_m);
+  return next_m <= p.rest_tolerance_m ? 0.0 : next_m;
+}
+
+// haptic path
+void VertexDeflection::set_offset(std::uint32_t v, double offset_m) {
+  if (offset_m == offset_m_[v]) {
+    return;
+  }
+  offset_m_[v] = offset_m;
+  // Exactly the rest position at zero, so a released surface is bit-identical to rest.
+  mesh_->vertices[v] = offset_m > 0.0 ? Vec3(rest_[v] + offset_m * direction_[v]) : rest_[v];
+  moved_vertices_.push_back(v);
+}
+
+// haptic path
+void VertexDeflection::step(std::span<const DeflectionContact> contacts, double dt_s) {
+  next_stamp();
+  if (!std::isfinite(dt_s) || dt_s < 0.0) {
+    dt_s = 0.0;
+  }
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    const double tau_s = segments_[s].recovery_time_constant_s;
+    decay_per_segment_[s] = tau_s > 0.0 ? std::exp(-dt_s / tau_s) : 0.0;
+  }
+
+  // 1. Target deflection of every vertex near a contact (deepest wins).
+  for (const DeflectionContact& c : contacts) {
+    if (!c.p_mesh.allFinite() || !std::isfinite(c.penetration_m) ||
+        std::isnan(c.contact_radius_m) || c.segment >= segments_.size()) {
+      ++rejected_;
+      continue;
+    }
+    const DeflectionParams& p = segments_[c.segment];
+    const double x_m = std::min(c.penetration_m, p.max_deflection_m);
+    if (!(x_m > 0.0)) {
+      continue;
+    }
+    const double r_m = std::max(c.contact_radius_m, 0.0);
+    const double d0_m = zero_deflection_distance_m(x_m, r_m, p.elasticity_factor);
+    if (!std::isfinite(d0_m)) {
+      ++rejected_;
+      continue;
+    }
+    grid_->for_each_within(c.p_mesh, d0_m, [&](std::uint32_t v, double d2) {
+      if (segment_of_vertex_[v] != c.segment) {
+        return;
+      }
+      const double delta_m = deflection_profile_m(std::sqrt(d2), x_m, d0_m);
+      if (target_stamp_[v] != stamp_) {
+        target_stamp_[v] = stamp_;
+        target_m_[v] = delta_m;
+        touched_.push_back(v);
+      } else {
+        target_m_[v] = std::max(target_m_[v], delta_m);
+      }
+    });
+  }
+
+  // 2. Touched vertices: press at once, or recover towards a shallower target.
+  for (const std::uint32_t v : touched_) {
+    const double target_m = target_m_[v];
+    const double current_m = offset_m_[v];
+    const double next_m =
+        target_m >= current_m
+            ? target_m
+            : target_m + recovered_gap_m(segment_of_vertex_[v], current_m - target_m, dt_s);
+    set_offset(v, next_m);
+    if (next_m > 0.0 && in_active_[v] == 0) {
+      in_active_[v] = 1;
+      active_.push_back(v);
+    }
+  }
+
+  // 3. Deformed vertices no contact reaches any more: recover towards rest.
+  max_deflection_m_ = 0.0;
+  for (std::size_t k = 0; k < active_.size();) {
+    const std::uint32_t v = active_[k];
+    if (target_stamp_[v] != stamp_) {
+      set_offset(v, recovered_gap_m(segment_of_vertex_[v], offset_m_[v], dt_s));
+    }
+    if (offset_m_[v] == 0.0) {
+      in_active_[v] = 0;
+      active_[k] = active_.back();
+      active_.pop_back();
+      continue;
+    }
+    max_deflection_m_ = std::max(max_deflection_m_, offset_m_[v]);
+    ++k;
+  }
+
+  finish_cycle();
+}
+
+// haptic path: moved triangles for local refit; their corners' normals become stale.
+void VertexDeflection::finish_cycle() {
+  for (const std::uint32_t v : moved_vertices_) {
+    for (std::uint32_t e = vertex_tri_start_[v]; e < vertex_tri_start_[v + 1]; ++e) {
+      const std::uint32_t t = vertex_tris_[e];
+      if (triangle_stamp_[t] != stamp_) {
+        triangle_stamp_[t] = stamp_;
+        moved_triangles_.push_back(t);
+      }
+    }
+  }
+  for (const std::uint32_t t : moved_triangles_) {
+    for (const std::uint32_t v : mesh_->triangles[t]) {
+      if (normal_pending_flag_[v] == 0) {
+        normal_pending_flag_[v] = 1;
+        normals_pending_.push_back(v);
+      }
+    }
+  }
+}
+
+void VertexDeflection::update_normals() {
+  TriangleMesh& mesh = *mesh_;
+  for (const std::uint32_t v : normals_pending_) {
+    const std::span<const std::uint32_t> tris(vertex_tris_.data() + vertex_tri_start_[v],
+                                              vertex_tri_start_[v + 1] - vertex_tri_start_[v]);
+    mesh.vertex_normals[v] = vertex_normal(mesh, tris, v);
+    normal_pending_flag_[v] = 0;
+  }
+  normals_pending_.clear();
+}
+
+void VertexDeflection::reset() {
+  next_stamp();
+  for (const std::uint32_t v : active_) {
+    set_offset(v, 0.0);
+    in_active_[v] = 0;
+  }
+  active_.clear();
+  max_deflection_m_ = 0.0;
+  finish_cycle();
+}
+
+}  // namespace hapsim

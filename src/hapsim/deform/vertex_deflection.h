@@ -1,0 +1,161 @@
+// Local vertex deflection (seed 001 §3.1.1, eq. 1): a contact of penetration depth x pushes every
+// vertex within d0 of the contact point inward by δ(d) = (x/2)·(cos(π·d/d0) + 1), so δ(0) = x and
+// δ(d0) = 0, with d0 = (x + effective contact radius) × the segment's elasticity factor. Released
+// vertices recover (reformation) towards their rest positions at a per-segment rate.
+//
+// Rules chosen here (the paper leaves them open):
+//  * Deformation is recomputed from the rest positions every cycle, so it cannot drift.
+//  * Several contacts: the deepest deflection per vertex wins (max, not sum) — two fingertips
+//    side by side must not push the surface deeper than either fingertip.
+//  * A contact deflects only the vertices of its own segment (pressing a muscle does not dent the
+//    bone under it); d0 uses that segment's elasticity factor.
+//  * Pressing is immediate (the surface follows the probe); releasing follows the recovery law:
+//    the gap to the target shrinks as exp(−dt/τ) and by at most v_max·dt per step, and snaps to the
+//    target below `rest_tolerance_m`, so it never overshoots and reaches rest in bounded time.
+//  * The paper's eq. 1 prints d_p/2 as the amplitude; SPEC §4 reads x/2 (δ(0) = x), used here.
+#pragma once
+
+#include "hapsim/core/types.h"
+#include "hapsim/deform/point_hash_grid.h"
+#include "hapsim/geometry/triangle_mesh.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace hapsim {
+
+/// Per-segment deformation parameters, SI.
+struct DeflectionParams {
+  /// d0 = (x + r_eff) · elasticity_factor; finite, > 0. Soft tissue large, bone small.
+  double elasticity_factor = 1.5;
+  /// Reformation time constant τ, seconds; ≥ 0 (0: no exponential lag, only the speed cap).
+  double recovery_time_constant_s = 0.1;
+  /// Largest reformation speed, m/s; > 0 (infinity: no cap).
+  double max_recovery_speed_m_per_s = kInf;
+  /// Penetration depths are clamped to this before use, metres; > 0 (infinity: no clamp).
+  double max_deflection_m = kInf;
+  /// A recovering gap below this snaps to the target, metres; ≥ 0.
+  double rest_tolerance_m = 1e-7;
+};
+
+struct VertexDeflectionOptions {
+  /// Unit direction in which each vertex moves inward (knee method: towards its group centroid).
+  /// Empty → the negated rest vertex normal. Non-zero, finite; normalised on construction.
+  std::vector<Vec3> directions;
+  /// Segment index of each vertex into `segments`. Empty → every vertex in segment 0.
+  std::vector<std::uint32_t> segment_of_vertex;
+  /// Parameters per segment. Empty → one segment with default parameters.
+  std::vector<DeflectionParams> segments;
+  /// Edge of the rest-position hash grid cells, metres. 0 → twice the mean edge length.
+  double grid_cell_m = 0.0;
+};
+
+struct DeflectionContact {
+  /// Contact point on the *rest* surface (mesh frame): the probe's projection onto the undeformed
+  /// surface, so δ(0) = x brings the surface to the probe tip.
+  Vec3 p_mesh = Vec3::Zero();
+  /// Penetration depth x, metres (≤ 0: no deflection).
+  double penetration_m = 0.0;
+  /// Effective radius of the contacting object (fingertip), metres; negative is clamped to 0.
+  double contact_radius_m = 0.0;
+  /// Segment touched; only its vertices deflect.
+  std::uint32_t segment = 0;
+};
+
+class VertexDeflection {
+ public:
+  /// Takes the mesh at rest. Throws hapsim::Error on non-finite vertices, bad parameters, a
+  /// zero/non-finite direction, or option arrays whose size does not match the vertex count.
+  explicit VertexDeflection(TriangleMesh rest_mesh, VertexDeflectionOptions options = {});
+
+  VertexDeflection(VertexDeflection&&) noexcept = default;
+  VertexDeflection& operator=(VertexDeflection&&) noexcept = default;
+  VertexDeflection(const VertexDeflection&) = delete;
+  VertexDeflection& operator=(const VertexDeflection&) = delete;
+  ~VertexDeflection() = default;
+
+  /// One cycle: deflect from `contacts`, let everything else recover for `dt_s` seconds
+  /// (non-finite or negative dt counts as 0). Cost O(vertices within d0 + vertices still
+  /// recovering). Invalid contacts are skipped and counted. haptic path
+  void step(std::span<const DeflectionContact> contacts, double dt_s);
+
+  /// Every vertex back to rest at once (reported as moved).
+  void reset();
+
+  /// Recomputes the vertex normals of every vertex whose neighbourhood moved since the last call
+  /// (angle-weighted, like TriangleMesh::compute_vertex_normals). Normals are for display only,
+  /// so step() does not pay for them: call this at display rate, from the thread that owns the
+  /// mesh. Allocation-free; cost O(vertices moved since the last call).
+  void update_normals();
+
+  /// Eq. 1: δ(d) = (x/2)·(cos(π·d/d0) + 1) for 0 ≤ d < d0, else 0.
+  [[nodiscard]] static double deflection_profile_m(double distance_m, double penetration_m,
+                                                   double zero_distance_m);
+  /// d0 = (x + r_eff) · elasticity_factor.
+  [[nodiscard]] static double zero_deflection_distance_m(double penetration_m,
+                                                         double contact_radius_m,
+                                                         double elasticity_factor) {
+    return (penetration_m + contact_radius_m) * elasticity_factor;
+  }
+
+  /// The deformed mesh; vertices are updated in place by step(), vertex normals by
+  /// update_normals(); the addresses of the mesh and its arrays never change (safe to hold in a
+  /// collision structure).
+  [[nodiscard]] const TriangleMesh& mesh() const { return *mesh_; }
+  [[nodiscard]] std::span<const Vec3> rest_positions() const { return rest_; }
+  [[nodiscard]] std::span<const Vec3> directions() const { return direction_; }
+  /// Current inward displacement of vertex v along its direction, metres (≥ 0).
+  [[nodiscard]] double deflection_m(std::uint32_t v) const { return offset_m_[v]; }
+  /// Vertices whose position changed in the last step()/reset(), each once.
+  [[nodiscard]] std::span<const std::uint32_t> moved_vertices() const { return moved_vertices_; }
+  /// Triangles with a moved corner in the last step()/reset(), each once (refit these).
+  [[nodiscard]] std::span<const std::uint32_t> moved_triangles() const { return moved_triangles_; }
+  /// Largest current deflection after the last step, metres.
+  [[nodiscard]] double max_deflection_m() const { return max_deflection_m_; }
+  /// Vertices currently away from rest.
+  [[nodiscard]] std::size_t deformed_vertex_count() const { return active_.size(); }
+  [[nodiscard]] std::size_t rejected_contacts() const { return rejected_; }
+  [[nodiscard]] const PointHashGrid& grid() const { return *grid_; }
+  [[nodiscard]] std::size_t segment_count() const { return segments_.size(); }
+
+ private:
+  void set_offset(std::uint32_t v, double offset_m);
+  void next_stamp();
+  void finish_cycle();
+  [[nodiscard]] double recovered_gap_m(std::uint32_t segment, double gap_m, double dt_s) const;
+
+  std::unique_ptr<TriangleMesh> mesh_;
+  std::vector<Vec3> rest_;
+  std::vector<Vec3> direction_;
+  std::vector<std::uint32_t> segment_of_vertex_;
+  std::vector<DeflectionParams> segments_;
+  std::unique_ptr<PointHashGrid> grid_;
+  /// Vertex → incident triangles (CSR), for local refit lists and normals.
+  std::vector<std::uint32_t> vertex_tri_start_;
+  std::vector<std::uint32_t> vertex_tris_;
+
+  std::vector<double> offset_m_;
+  std::vector<double> target_m_;
+  /// Per-vertex/triangle "seen in this cycle" marks, so nothing is cleared per cycle.
+  std::vector<std::uint32_t> target_stamp_;
+  std::vector<std::uint32_t> triangle_stamp_;
+  std::uint32_t stamp_ = 0;
+  std::vector<std::uint8_t> in_active_;
+  /// Vertices away from rest (recovering or held), pre-sized to the vertex count.
+  std::vector<std::uint32_t> active_;
+  std::vector<std::uint32_t> touched_;
+  std::vector<std::uint32_t> moved_vertices_;
+  std::vector<std::uint32_t> moved_triangles_;
+  /// Vertices whose normal is stale (pending update_normals()), each once.
+  std::vector<std::uint32_t> normals_pending_;
+  std::vector<std::uint8_t> normal_pending_flag_;
+  /// Per segment, exp(−dt/τ) for this step's dt: one exp per segment instead of per vertex.
+  std::vector<double> decay_per_segment_;
+  double max_deflection_m_ = 0.0;
+  std::size_t rejected_ = 0;
+};
+
+}  // namespace hapsim
