@@ -1,0 +1,61 @@
+// A parsed scene file (docs/scene-format.md): the world it builds plus the device that drives it
+// and how a run goes. Plain data; scene_file.h reads it from JSON.
+#pragma once
+
+#include "hapsim/core/types.h"
+#include "hapsim/world/world_description.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace hapsim {
+
+/// One press of a scripted palpation: the probe comes at the named segment from direction
+/// `from_world` (a unit vector pointing from the segment towards where the probe starts), touches
+/// the first surface on that line (skin, if the segment is under it) and presses `depth_m` past it.
+struct PalpationTargetDescription {
+  std::string body;     // body name
+  std::string segment;  // segment name within the body
+  Vec3 from_world = Vec3::UnitY();
+  double depth_m = 0.006;
+  double hold_s = 0.5;
+};
+
+struct PalpationScriptDescription {
+  std::vector<PalpationTargetDescription> targets;
+  double standoff_m = 0.02;
+  double move_s = 1.0;
+  double approach_s = 0.5;
+  double press_s = 0.5;
+  double release_s = 0.5;
+};
+
+struct DeviceDescription {
+  /// Only "simulated" for now (a trajectory file or a palpation script).
+  std::string type = "simulated";
+  /// Built-in device profile (device_profile.h), e.g. "touch", "omega3".
+  std::string profile = "touch";
+  /// Trajectory CSV (docs/trajectory-format.md), resolved against the scene file's folder.
+  /// Empty when a palpation script drives the device.
+  std::filesystem::path trajectory_file;
+  bool has_palpation = false;
+  PalpationScriptDescription palpation;
+};
+
+struct RunDescription {
+  /// Simulated seconds; 0: until the device's trajectory or script ends.
+  double duration_s = 0.0;
+  /// Haptic step, seconds.
+  double dt_s = 0.001;
+};
+
+struct SceneDescription {
+  std::filesystem::path file;  // where it was read from (empty when built in code)
+  std::string description;
+  WorldDescription world;
+  DeviceDescription device;
+  RunDescription run;
+};
+
+}  // namespace hapsim

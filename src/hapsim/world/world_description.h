@@ -1,0 +1,94 @@
+// What a world is made of, as plain read-only data: materials, bodies split into segments (each
+// with its own mesh and material), and tools. A scene file is parsed into this (scene/), tests
+// and programs may fill it in code; World (world.h) builds its query structures from it once and
+// never changes it, so a step only touches per-step state.
+#pragma once
+
+#include "hapsim/core/types.h"
+#include "hapsim/deform/vertex_deflection.h"
+#include "hapsim/force/contact_material.h"
+#include "hapsim/geometry/triangle_mesh.h"
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace hapsim {
+
+/// How a tool's contact with a segment turns into force.
+enum class ContactResponse : std::uint8_t {
+  /// God-object proxy: the tool's proxy never enters the segment (bone, ligament, tendon, thin
+  /// sheets): no pop-through at any speed the device can reach.
+  kProxy,
+  /// Penalty spring on the tool's own position: the tool sinks in (soft tissue: skin, muscle),
+  /// the force grows with depth up to the segment's maximum penetration and maximum force.
+  kPenalty,
+};
+
+/// Which proximity query answers contacts with a segment.
+enum class ContactMethod : std::uint8_t {
+  kExact,       ///< MeshBvh: exact closest point (the reference).
+  kSphereTree,  ///< SphereTree: sphere hierarchy, refined exactly.
+  kKnee,        ///< KneeIndex: the knee paper's groups and plane test (approximate).
+};
+
+enum class BodyKind : std::uint8_t {
+  kStatic,      ///< never moves, never deforms
+  kDynamic,     ///< rigid with mass (later issue: grasping)
+  kDeformable,  ///< vertices deflect under contact and recover (SPEC §4)
+};
+
+[[nodiscard]] std::string_view to_string(ContactResponse response);
+[[nodiscard]] std::string_view to_string(ContactMethod method);
+[[nodiscard]] std::string_view to_string(BodyKind kind);
+
+struct MaterialDescription {
+  std::string name;
+  ContactMaterial contact;
+  ContactResponse response = ContactResponse::kProxy;
+  /// Used when the body is deformable.
+  DeflectionParams deflection;
+};
+
+struct SegmentDescription {
+  std::string name;
+  /// Index into WorldDescription::materials.
+  std::uint32_t material = 0;
+  /// In the body frame, metres. Closed and outward-oriented unless two_sided.
+  TriangleMesh mesh;
+  /// Open surface (a sheet): both sides are outside.
+  bool two_sided = false;
+};
+
+struct BodyDescription {
+  std::string name;
+  BodyKind kind = BodyKind::kStatic;
+  Iso3 X_world_body = Iso3::Identity();
+  ContactMethod method = ContactMethod::kExact;
+  std::vector<SegmentDescription> segments;
+};
+
+/// A contact sphere driven by the device: a stylus tip or a fingertip.
+struct ToolDescription {
+  std::string name;
+  /// Sphere radius; 0 is a point probe.
+  double radius_m = 0.005;
+  /// Where the tool sits in the device's frame (rotated by the device orientation).
+  Vec3 offset_device = Vec3::Zero();
+  /// Device finger actuator that renders this tool's force magnitude; -1: the tool's force goes
+  /// to the device tip force (summed over such tools).
+  int finger = -1;
+};
+
+struct WorldDescription {
+  std::string name;
+  std::vector<MaterialDescription> materials;
+  std::vector<BodyDescription> bodies;
+  std::vector<ToolDescription> tools;
+  /// Floor on the normal damping of every contact: b ≥ factor · k · dt. Sampling a spring at
+  /// period T makes it active (Colgate & Schenkel); b > k·T/2 restores passivity, 1 gives margin.
+  double passivity_damping_factor = 1.0;
+};
+
+}  // namespace hapsim

@@ -1,0 +1,285 @@
+// World::step against analytic answers: flat faces give exact depths, so the penalty force must be
+// k·x exactly; a fast probe must never pass a 1 mm plate or an open sheet; forces stay within
+// every limit and finite; deformation follows eq. 1 and recovers; the step allocates nothing and
+// replays to the same bits.
+#include "hapsim/world/world.h"
+#include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/geometry/procedural.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <new>
+
+// Allocation counter for the "no allocation on the haptic path" test: counts only while armed.
+namespace {
+std::atomic<bool> g_count_allocations{false};
+std::atomic<long> g_allocations{0};
+}  // namespace
+
+void* operator new(std::size_t size) {
+  if (g_count_allocations.load(std::memory_order_relaxed)) {
+    g_allocations.fetch_add(1, std::memory_order_relaxed);
+  }
+  if (void* p = std::malloc(size == 0 ? 1 : size)) {
+    return p;
+  }
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept {
+  std::free(p);
+}
+void operator delete(void* p, std::size_t /*size*/) noexcept {
+  std::free(p);
+}
+
+namespace hapsim {
+namespace {
+
+MaterialDescription material(const char* name, ContactResponse response, double k,
+                             double max_penetration_m, double max_force_n) {
+  MaterialDescription m;
+  m.name = name;
+  m.response = response;
+  m.contact.stiffness_n_per_m = k;
+  m.contact.max_penetration_m = max_penetration_m;
+  m.contact.max_force_n = max_force_n;
+  return m;
+}
+
+// A box body whose top face is the plane z = 0 (box centred at z = -half_z).
+WorldDescription box_world(ContactResponse response, double half_z, BodyKind kind,
+                           double tool_radius_m) {
+  WorldDescription w;
+  w.name = "box";
+  w.materials.push_back(material("tissue", response, 500.0, 0.01, 4.0));
+  w.passivity_damping_factor = 0.0;  // the analytic checks below are static (no velocity)
+  BodyDescription body;
+  body.name = "block";
+  body.kind = kind;
+  body.X_world_body = Iso3(Eigen::Translation3d(0, 0, -half_z));
+  SegmentDescription seg;
+  seg.name = "block";
+  seg.mesh = make_box(Vec3(0.05, 0.05, half_z));
+  body.segments.push_back(std::move(seg));
+  w.bodies.push_back(std::move(body));
+  ToolDescription tool;
+  tool.name = "tip";
+  tool.radius_m = tool_radius_m;
+  w.tools.push_back(tool);
+  return w;
+}
+
+DeviceInput at(const Vec3& p, double t = 0.0) {
+  DeviceInput in;
+  in.time_s = t;
+  in.p_world = p;
+  return in;
+}
+
+TEST(World, PenaltyForceIsHookeOnAFlatFace) {
+  World world(box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0));
+  world.step(at(Vec3(0.001, 0.002, 0.01)), 1e-3);  // above: free
+  EXPECT_EQ(world.last_result().tools[0].force_world_n, Vec3::Zero());
+  for (double depth : {0.001, 0.004, 0.0075}) {
+    World w(box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0));
+    const StepResult& r = w.step(at(Vec3(0.001, 0.002, -depth)), 1e-3);
+    EXPECT_NEAR(r.tools[0].force_world_n.z(), 500.0 * depth, 1e-9) << depth;
+    EXPECT_NEAR(r.tools[0].force_world_n.head<2>().norm(), 0.0, 1e-12);
+    ASSERT_EQ(r.contacts.size(), 1u);
+    EXPECT_NEAR(r.contacts[0].depth_m, depth, 1e-12);
+    EXPECT_FALSE(r.contacts[0].proxy);
+  }
+}
+
+TEST(World, SphereToolDepthIncludesItsRadius) {
+  World world(box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.005));
+  const StepResult& r = world.step(at(Vec3(0, 0, 0.003)), 1e-3);  // 2 mm into the face
+  EXPECT_NEAR(r.tools[0].force_world_n.z(), 500.0 * 0.002, 1e-9);
+}
+
+TEST(World, PenaltyForceSaturatesAtTheSegmentLimits) {
+  // max penetration 10 mm → at most 5 N by the spring, capped at 4 N by the segment.
+  for (double depth : {0.009, 0.012, 0.03}) {  // 0.03: deeper than the reach, inside the box
+    World world(box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0));
+    const StepResult& r = world.step(at(Vec3(0, 0, -depth)), 1e-3);
+    EXPECT_NEAR(r.tools[0].force_world_n.norm(), 4.0, 1e-9) << depth;
+  }
+}
+
+TEST(World, ProxyForceOnAFlatFaceAndSliding) {
+  World world(box_world(ContactResponse::kProxy, 0.02, BodyKind::kStatic, 0.0));
+  world.step(at(Vec3(0, 0, 0.002)), 1e-3);
+  // Press 3 mm in, in small steps so the proxy settles, then hold.
+  for (int i = 1; i <= 30; ++i) {
+    world.step(at(Vec3(0, 0, 0.002 - 0.005 * i / 30.0)), 1e-3);
+  }
+  const StepResult& r = world.step(at(Vec3(0, 0, -0.003)), 1e-3);
+  EXPECT_NEAR(r.tools[0].proxy_world.z(), 0.0, 2e-5);
+  EXPECT_NEAR(r.tools[0].force_world_n.z(), 500.0 * 0.003, 500.0 * 2e-5);
+  ASSERT_GE(r.contacts.size(), 1u);
+  EXPECT_TRUE(r.contacts[0].proxy);
+}
+
+// The tool crosses a plate at 1 m/s (1 mm per 1 kHz step): the proxy must stay above it at
+// every step and the force must push up, for a 1 mm plate and for an open two-sided sheet.
+void expect_no_pop_through(WorldDescription w, double top_z) {
+  World world(std::move(w));
+  for (int i = 0; i <= 60; ++i) {
+    const double z = 0.02 - 0.001 * i;  // from 20 mm above to 40 mm below the plate
+    const StepResult& r = world.step(at(Vec3(0.003, -0.002, z)), 1e-3);
+    ASSERT_GE(r.tools[0].proxy_world.z(), top_z - 1e-6) << "step " << i << " z " << z;
+    if (z < top_z - 0.001) {
+      EXPECT_GT(r.tools[0].force_world_n.z(), 0.0) << "step " << i;
+    }
+    EXPECT_LE(r.tools[0].force_world_n.norm(), 4.0 + 1e-9);
+  }
+}
+
+TEST(World, NoPopThroughAThinPlateAtOneMetrePerSecond) {
+  expect_no_pop_through(box_world(ContactResponse::kProxy, 0.0005, BodyKind::kStatic, 0.0), 0.0);
+  expect_no_pop_through(box_world(ContactResponse::kProxy, 0.0005, BodyKind::kStatic, 0.004), 0.0);
+}
+
+TEST(World, NoPopThroughAnOpenSheetAtOneMetrePerSecond) {
+  WorldDescription w = box_world(ContactResponse::kProxy, 0.0005, BodyKind::kStatic, 0.0);
+  w.bodies[0].X_world_body = Iso3::Identity();
+  w.bodies[0].segments[0].mesh = make_sheet(16, 0.2);  // z = 0, open
+  w.bodies[0].segments[0].two_sided = true;
+  expect_no_pop_through(std::move(w), 0.0);
+}
+
+TEST(World, NaNAndUnhealthyInputGiveZeroForce) {
+  World world(box_world(ContactResponse::kProxy, 0.02, BodyKind::kDeformable, 0.0));
+  world.step(at(Vec3(0, 0, 0.001)), 1e-3);
+  world.step(at(Vec3(0, 0, -0.002)), 1e-3);
+  EXPECT_GT(world.last_result().tools[0].force_world_n.norm(), 0.0);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const StepResult& r = world.step(at(Vec3(nan, 0, 0)), 1e-3);
+  EXPECT_EQ(r.tools[0].force_world_n, Vec3::Zero());
+  EXPECT_EQ(r.command.force_world_n, Vec3::Zero());
+  DeviceInput sick = at(Vec3(0, 0, -0.002));
+  sick.healthy = false;
+  EXPECT_EQ(world.step(sick, 1e-3).command.force_world_n, Vec3::Zero());
+  DeviceInput bad_q = at(Vec3(0, 0, -0.002));
+  bad_q.q_world = Quat(0, 0, 0, 0);
+  EXPECT_EQ(world.step(bad_q, 1e-3).command.force_world_n, Vec3::Zero());
+  EXPECT_TRUE(world.step(at(Vec3(0, 0, -0.002)), nan).command.force_world_n.allFinite());
+}
+
+// A deformable open sheet at z = 0 with a node at the origin (65 nodes over 10 cm).
+WorldDescription sheet_world(double tool_radius_m) {
+  WorldDescription w =
+      box_world(ContactResponse::kProxy, 0.02, BodyKind::kDeformable, tool_radius_m);
+  w.bodies[0].segments[0].mesh = make_sheet(65, 0.1);
+  w.bodies[0].segments[0].two_sided = true;
+  w.bodies[0].X_world_body = Iso3::Identity();
+  w.materials[0].deflection.recovery_time_constant_s = 0.02;
+  return w;
+}
+
+TEST(World, DeformationFollowsThePressAndRecovers) {
+  World world(sheet_world(0.0));
+  world.step(at(Vec3(0, 0, 0.002)), 1e-3);
+  for (int i = 1; i <= 40; ++i) {
+    world.step(at(Vec3(0, 0, 0.002 - 0.006 * i / 40.0)), 1e-3);
+  }
+  // Pressed 4 mm: the deepest vertex moved by about the depth (eq. 1: δ(0) = x).
+  EXPECT_NEAR(world.current_deflection_m(0, 0), 0.004, 2e-5);
+  // The deformed surface's exact query (refitted) equals one built from scratch on it.
+  const ProximityQuery& refitted = world.deformed_query(0, 0);
+  const MeshBvh fresh(world.surface(0, 0));
+  for (const Vec3& p : {Vec3(0, 0, 0.001), Vec3(0.003, 0.001, -0.002), Vec3(-0.01, 0.004, 0.0)}) {
+    const SurfacePoint a = refitted.closest_point(p);
+    const SurfacePoint b = fresh.closest_point(p);
+    EXPECT_NEAR(std::abs(a.signed_distance), std::abs(b.signed_distance), 1e-12);
+    EXPECT_NEAR((a.point - b.point).norm(), 0.0, 1e-12);
+  }
+  // Release: it recovers to rest.
+  for (int i = 0; i < 1000; ++i) {
+    world.step(at(Vec3(0, 0, 0.02)), 1e-3);
+  }
+  EXPECT_EQ(world.current_deflection_m(0, 0), 0.0);
+}
+
+TEST(World, DampingNeverBelowThePassivityFloor) {
+  WorldDescription w = box_world(ContactResponse::kProxy, 0.02, BodyKind::kStatic, 0.0);
+  w.passivity_damping_factor = 1.0;
+  w.materials[0].contact.damping_n_s_per_m = 0.1;
+  World world(std::move(w), WorldOptions{.max_stiffness_n_per_m = 400.0});
+  const ContactMaterial m = world.effective_material(0, 1e-3);
+  EXPECT_EQ(m.stiffness_n_per_m, 400.0);         // clamped to the device
+  EXPECT_NEAR(m.damping_n_s_per_m, 0.4, 1e-15);  // k·T, above the material's 0.1
+  EXPECT_EQ(world.effective_material(0, 1e-5).damping_n_s_per_m, 0.1);  // material's own wins
+}
+
+TEST(World, FingerToolsDriveFingerChannels) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0);
+  w.tools[0].finger = 1;
+  ToolDescription second = w.tools[0];
+  second.name = "other";
+  second.finger = -1;
+  second.offset_device = Vec3(0.0, 0.0, 0.01);  // 1 cm higher: free while the first presses
+  w.tools.push_back(second);
+  World world(std::move(w));
+  const StepResult& r = world.step(at(Vec3(0, 0, -0.002)), 1e-3);
+  EXPECT_EQ(r.command.finger_count, 2);
+  EXPECT_NEAR(r.command.finger_force_n[1], 1.0, 1e-9);
+  EXPECT_EQ(r.command.force_world_n, Vec3::Zero());
+}
+
+std::vector<DeviceInput> press_path() {
+  std::vector<DeviceInput> path;
+  for (int i = 0; i < 300; ++i) {
+    const double t = i * 1e-3;
+    path.push_back(at(Vec3(0.01 * std::sin(20 * t), 0.003 * t, 0.004 - 0.03 * t), t));
+  }
+  return path;
+}
+
+TEST(World, StepAllocatesNothing) {
+  World world(sheet_world(0.004));
+  const auto path = press_path();
+  world.step(path[0], 1e-3);
+  g_allocations = 0;
+  g_count_allocations = true;
+  for (const DeviceInput& in : path) {
+    world.step(in, 1e-3);
+  }
+  g_count_allocations = false;
+  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_GT(world.current_deflection_m(0, 0), 0.0);  // the path did press in
+}
+
+TEST(World, ReplaysBitForBit) {
+  const auto path = press_path();
+  World a(box_world(ContactResponse::kPenalty, 0.02, BodyKind::kDeformable, 0.004));
+  World b(box_world(ContactResponse::kPenalty, 0.02, BodyKind::kDeformable, 0.004));
+  EXPECT_EQ(a.content_hash(), b.content_hash());
+  for (const DeviceInput& in : path) {
+    const Vec3 fa = a.step(in, 1e-3).command.force_world_n;
+    const Vec3 fb = b.step(in, 1e-3).command.force_world_n;
+    ASSERT_EQ(std::memcmp(fa.data(), fb.data(), sizeof(double) * 3), 0);
+  }
+}
+
+TEST(World, BadDescriptionsAreNamed) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0);
+  w.bodies[0].segments[0].material = 7;
+  try {
+    World world(std::move(w));
+    FAIL() << "accepted a bad material index";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("segment 'block'"), std::string::npos) << e.what();
+  }
+  WorldDescription empty = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0);
+  empty.bodies[0].segments[0].mesh = TriangleMesh{};
+  EXPECT_THROW(World{std::move(empty)}, std::exception);
+}
+
+}  // namespace
+}  // namespace hapsim
