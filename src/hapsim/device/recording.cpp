@@ -1,0 +1,558 @@
+#include "hapsim/device/recording.h"
+
+#include "hapsim/core/error.h"
+
+#include <algorithm>
+#include <bit>
+#include <charconv>
+#include <cstring>
+#include <type_traits>
+#include <utility>
+
+namespace hapsim {
+namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "recordings are little-endian and written with memcpy; add byte swapping to port");
+
+constexpr std::array<char, 8> kMagic = {'H', 'A', 'P', 'S', 'I', 'M', 'R', 'C'};
+constexpr std::uint32_t kFrameMarker = 0x31524648u;  // "HFR1" in file byte order
+// magic + version + frame size + max contacts + max fingers + max joints + hash length
+constexpr std::size_t kHeaderFixedBytes = 8 + 6 * 4;
+
+// Names one field for comparison messages: group[group_index].name[index].
+struct FieldId {
+  const char* group;  // nullptr for top-level fields
+  int group_index;    // -1 when the group is not an array
+  const char* name;
+  int index;  // -1 for a scalar
+};
+
+std::string field_name(const FieldId& id) {
+  std::string s;
+  if (id.group != nullptr) {
+    s += id.group;
+    if (id.group_index >= 0) {
+      s += "[" + std::to_string(id.group_index) + "]";
+    }
+    s += ".";
+  }
+  s += id.name;
+  if (id.index >= 0) {
+    s += "[" + std::to_string(id.index) + "]";
+  }
+  return s;
+}
+
+// The one list of a frame's fields, in file order. Encoding, decoding, sizing and comparison all
+// walk it, so they cannot disagree about the layout.
+template <class Frame, class Visitor>
+void visit_frame(Frame& f, Visitor& v) {
+  v(FieldId{nullptr, -1, "cycle_index", -1}, f.cycle_index);
+  auto& in = f.input;
+  v(FieldId{"input", -1, "time_s", -1}, in.time_s);
+  for (int k = 0; k < 3; ++k) {
+    v(FieldId{"input", -1, "p_world", k}, in.p_world[k]);
+  }
+  // Eigen stores (x, y, z, w); written in that order.
+  for (int k = 0; k < 4; ++k) {
+    v(FieldId{"input", -1, "q_world.coeffs(xyzw)", k}, in.q_world.coeffs()[k]);
+  }
+  for (int k = 0; k < kMaxDeviceJoints; ++k) {
+    v(FieldId{"input", -1, "joint_rad", k}, in.joint_rad[static_cast<std::size_t>(k)]);
+  }
+  v(FieldId{"input", -1, "joint_count", -1}, in.joint_count);
+  for (int k = 0; k < kMaxFingers; ++k) {
+    v(FieldId{"input", -1, "finger_rad", k}, in.finger_rad[static_cast<std::size_t>(k)]);
+  }
+  v(FieldId{"input", -1, "finger_count", -1}, in.finger_count);
+  v(FieldId{"input", -1, "buttons", -1}, in.buttons);
+  v(FieldId{"input", -1, "healthy", -1}, in.healthy);
+
+  auto& cmd = f.command;
+  for (int k = 0; k < 3; ++k) {
+    v(FieldId{"command", -1, "force_world_n", k}, cmd.force_world_n[k]);
+  }
+  for (int k = 0; k < kMaxFingers; ++k) {
+    v(FieldId{"command", -1, "finger_force_n", k}, cmd.finger_force_n[static_cast<std::size_t>(k)]);
+  }
+  v(FieldId{"command", -1, "finger_count", -1}, cmd.finger_count);
+  for (int k = 0; k < kMaxDeviceJoints; ++k) {
+    v(FieldId{"command", -1, "joint_torque_nm", k},
+      cmd.joint_torque_nm[static_cast<std::size_t>(k)]);
+  }
+  v(FieldId{"command", -1, "joint_count", -1}, cmd.joint_count);
+
+  v(FieldId{nullptr, -1, "contact_count", -1}, f.contact_count);
+  for (int c = 0; c < kMaxRecordedContacts; ++c) {
+    auto& contact = f.contacts[static_cast<std::size_t>(c)];
+    v(FieldId{"contacts", c, "tool_index", -1}, contact.tool_index);
+    v(FieldId{"contacts", c, "body_index", -1}, contact.body_index);
+    v(FieldId{"contacts", c, "segment_index", -1}, contact.segment_index);
+    for (int k = 0; k < 3; ++k) {
+      v(FieldId{"contacts", c, "point_world", k}, contact.point_world[k]);
+    }
+    for (int k = 0; k < 3; ++k) {
+      v(FieldId{"contacts", c, "normal_world", k}, contact.normal_world[k]);
+    }
+    v(FieldId{"contacts", c, "depth_m", -1}, contact.depth_m);
+    v(FieldId{"contacts", c, "force_n", -1}, contact.force_n);
+  }
+}
+
+template <class T>
+constexpr std::size_t encoded_size() {
+  return std::is_same_v<T, bool> ? 1 : sizeof(T);
+}
+
+struct Sizer {
+  std::size_t bytes = 0;
+  template <class T>
+  void operator()(const FieldId&, const T&) {
+    bytes += encoded_size<std::remove_cvref_t<T>>();
+  }
+};
+
+struct Encoder {
+  unsigned char* p;
+  template <class T>
+  void operator()(const FieldId&, const T& value) {
+    if constexpr (std::is_same_v<T, bool>) {
+      *p++ = value ? 1 : 0;
+    } else {
+      std::memcpy(p, &value, sizeof(T));  // bit-exact, doubles included
+      p += sizeof(T);
+    }
+  }
+};
+
+struct Decoder {
+  const unsigned char* p;
+  bool bad_bool = false;
+  template <class T>
+  void operator()(const FieldId&, T& value) {
+    if constexpr (std::is_same_v<T, bool>) {
+      bad_bool = bad_bool || *p > 1;
+      value = *p++ != 0;
+    } else {
+      std::memcpy(&value, p, sizeof(T));
+      p += sizeof(T);
+    }
+  }
+};
+
+// FNV-1a, 64 bit: detects corrupted frames; not cryptographic (nobody forges recordings).
+std::uint64_t fnv1a(const unsigned char* data, std::size_t size) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= data[i];
+    h *= 0x100000001b3ull;
+  }
+  return h;
+}
+
+std::size_t payload_size() {
+  static const std::size_t size = [] {
+    Sizer sizer;
+    const RecordedFrame frame;
+    visit_frame(frame, sizer);
+    return sizer.bytes;
+  }();
+  return size;
+}
+
+// Encodes marker + payload + checksum into `out` (recorded_frame_size_bytes() long).
+void encode_frame(const RecordedFrame& frame, unsigned char* out) {
+  std::memcpy(out, &kFrameMarker, 4);
+  Encoder encoder{out + 4};
+  visit_frame(frame, encoder);
+  const std::uint64_t sum = fnv1a(out + 4, payload_size());
+  std::memcpy(out + 4 + payload_size(), &sum, 8);
+}
+
+template <class T>
+void put(std::vector<unsigned char>& out, const T& value) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
+  out.insert(out.end(), bytes, bytes + sizeof(T));
+}
+
+template <class T>
+T get(const unsigned char* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  return value;
+}
+
+std::string format_value(double v) {
+  std::array<char, 32> buf{};
+  const auto [ptr, ec] = std::to_chars(buf.data(), buf.data() + buf.size(), v);
+  (void)ec;
+  return std::string(buf.data(), ptr);
+}
+
+template <class T>
+std::string format_value(const T& v) {
+  if constexpr (std::is_same_v<T, bool>) {
+    return v ? "true" : "false";
+  } else {
+    return std::to_string(v);
+  }
+}
+
+// Collects (field, bytes, text) of a frame for a field-by-field comparison (offline only).
+struct Flattener {
+  struct Entry {
+    FieldId id;
+    std::array<unsigned char, 8> bytes{};
+    std::string text;
+  };
+  std::vector<Entry> entries;
+  template <class T>
+  void operator()(const FieldId& id, const T& value) {
+    Entry e{id, {}, format_value(value)};
+    if constexpr (std::is_same_v<T, bool>) {
+      e.bytes[0] = value ? 1 : 0;
+    } else {
+      std::memcpy(e.bytes.data(), &value, sizeof(T));
+    }
+    entries.push_back(std::move(e));
+  }
+};
+
+const char* check_counts(const RecordedFrame& f) {
+  if (f.input.finger_count < 0 || f.input.finger_count > kMaxFingers) {
+    return "input.finger_count out of range";
+  }
+  if (f.input.joint_count < 0 || f.input.joint_count > kMaxDeviceJoints) {
+    return "input.joint_count out of range";
+  }
+  if (f.command.finger_count < 0 || f.command.finger_count > kMaxFingers) {
+    return "command.finger_count out of range";
+  }
+  if (f.command.joint_count < 0 || f.command.joint_count > kMaxDeviceJoints) {
+    return "command.joint_count out of range";
+  }
+  if (f.contact_count < 0 || f.contact_count > kMaxRecordedContacts) {
+    return "contact_count out of range";
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+std::size_t recorded_frame_size_bytes() {
+  return 4 + payload_size() + 8;
+}
+
+// ---------------------------------------------------------------------------------------------
+// SessionRecorder
+
+SessionRecorder::SessionRecorder(std::filesystem::path path, std::string scene_hash,
+                                 std::size_t capacity_frames, Overflow overflow)
+    : path_(std::move(path)), capacity_frames_(capacity_frames), overflow_(overflow) {
+  const std::string where = path_.string();
+  if (capacity_frames_ == 0) {
+    throw Error(where, "recorder buffer capacity must be at least one frame");
+  }
+  if (scene_hash.size() > kMaxSceneHashLength) {
+    throw Error(where, "scene hash is " + std::to_string(scene_hash.size()) +
+                           " characters, at most " + std::to_string(kMaxSceneHashLength) +
+                           " allowed");
+  }
+  out_.open(path_, std::ios::binary | std::ios::trunc);
+  if (!out_) {
+    throw Error(where, "cannot create recording file");
+  }
+  std::vector<unsigned char> header(kMagic.begin(), kMagic.end());
+  put(header, kRecordingVersion);
+  put(header, static_cast<std::uint32_t>(recorded_frame_size_bytes()));
+  put(header, static_cast<std::uint32_t>(kMaxRecordedContacts));
+  put(header, static_cast<std::uint32_t>(kMaxFingers));
+  put(header, static_cast<std::uint32_t>(kMaxDeviceJoints));
+  put(header, static_cast<std::uint32_t>(scene_hash.size()));
+  header.insert(header.end(), scene_hash.begin(), scene_hash.end());
+  put(header, fnv1a(header.data(), header.size()));
+  out_.write(reinterpret_cast<const char*>(header.data()),
+             static_cast<std::streamsize>(header.size()));
+  if (!out_) {
+    throw Error(where, "cannot write recording header");
+  }
+  buffer_.reserve(capacity_frames_);
+  bytes_.resize(recorded_frame_size_bytes());
+}
+
+SessionRecorder::~SessionRecorder() {
+  try {
+    close();
+  } catch (...) {  // NOLINT(bugprone-empty-catch): documented, close() reports errors
+  }
+}
+
+bool SessionRecorder::record(const RecordedFrame& frame) noexcept {
+  if (closed_ || check_counts(frame) != nullptr) {
+    ++frames_dropped_;
+    return false;
+  }
+  if (buffer_.size() == capacity_frames_) {
+    if (overflow_ == Overflow::kDrop) {
+      ++frames_dropped_;
+      return false;
+    }
+    try {
+      write_buffer();
+    } catch (const std::exception& e) {
+      try {
+        last_error_ = e.what();
+      } catch (...) {  // out of memory for the message: the drop count still tells
+      }
+      ++frames_dropped_;
+      return false;
+    }
+  }
+  buffer_.push_back(frame);  // within the reserved capacity: no allocation
+  return true;
+}
+
+void SessionRecorder::write_buffer() {
+  for (const RecordedFrame& frame : buffer_) {
+    encode_frame(frame, bytes_.data());
+    out_.write(reinterpret_cast<const char*>(bytes_.data()),
+               static_cast<std::streamsize>(bytes_.size()));
+  }
+  out_.flush();
+  if (!out_) {
+    throw Error(path_.string(),
+                "write failed after frame " + std::to_string(frames_written_) + " (disk full?)");
+  }
+  frames_written_ += buffer_.size();
+  buffer_.clear();  // keeps the capacity
+}
+
+void SessionRecorder::flush() {
+  if (!last_error_.empty()) {
+    throw Error(path_.string(), last_error_);
+  }
+  if (!closed_) {
+    write_buffer();
+  }
+}
+
+void SessionRecorder::close() {
+  if (closed_) {
+    return;
+  }
+  flush();
+  closed_ = true;
+  out_.close();
+  if (out_.fail()) {
+    throw Error(path_.string(), "closing the recording failed");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// RecordingReader
+
+RecordingReader::RecordingReader(std::filesystem::path path) : path_(std::move(path)) {
+  const std::string where = path_.string();
+  std::error_code ec;
+  file_size_ = std::filesystem::file_size(path_, ec);
+  in_.open(path_, std::ios::binary);
+  if (ec || !in_) {
+    throw Error(where, "cannot open recording file");
+  }
+  std::vector<unsigned char> head(kHeaderFixedBytes);
+  in_.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  if (static_cast<std::size_t>(in_.gcount()) != head.size()) {
+    throw Error(where, "not a hapsim recording: " + std::to_string(file_size_) +
+                           " bytes, too short for the header");
+  }
+  if (!std::equal(kMagic.begin(), kMagic.end(), head.begin())) {
+    throw Error(where, "not a hapsim recording: bad magic (expected 'HAPSIMRC')");
+  }
+  header_.version = get<std::uint32_t>(&head[8]);
+  header_.frame_size_bytes = get<std::uint32_t>(&head[12]);
+  const auto max_contacts = get<std::uint32_t>(&head[16]);
+  const auto max_fingers = get<std::uint32_t>(&head[20]);
+  const auto max_joints = get<std::uint32_t>(&head[24]);
+  const auto hash_length = get<std::uint32_t>(&head[28]);
+  if (header_.version != kRecordingVersion) {
+    throw Error(where, "recording version " + std::to_string(header_.version) +
+                           ", this build reads version " + std::to_string(kRecordingVersion));
+  }
+  if (header_.frame_size_bytes != recorded_frame_size_bytes() ||
+      max_contacts != static_cast<std::uint32_t>(kMaxRecordedContacts) ||
+      max_fingers != static_cast<std::uint32_t>(kMaxFingers) ||
+      max_joints != static_cast<std::uint32_t>(kMaxDeviceJoints)) {
+    throw Error(where, "corrupt header: frame size " + std::to_string(header_.frame_size_bytes) +
+                           " bytes, " + std::to_string(max_contacts) + " contacts, " +
+                           std::to_string(max_fingers) + " fingers, " + std::to_string(max_joints) +
+                           " joints; version 1 expects " +
+                           std::to_string(recorded_frame_size_bytes()) + ", " +
+                           std::to_string(kMaxRecordedContacts) + ", " +
+                           std::to_string(kMaxFingers) + ", " + std::to_string(kMaxDeviceJoints));
+  }
+  if (hash_length > kMaxSceneHashLength || kHeaderFixedBytes + hash_length + 8 > file_size_) {
+    throw Error(where, "corrupt header: scene hash length " + std::to_string(hash_length) +
+                           " (at most " + std::to_string(kMaxSceneHashLength) +
+                           " and within the file expected)");
+  }
+  head.resize(kHeaderFixedBytes + hash_length + 8);
+  in_.read(reinterpret_cast<char*>(head.data() + kHeaderFixedBytes),
+           static_cast<std::streamsize>(hash_length + 8));
+  if (static_cast<std::size_t>(in_.gcount()) != hash_length + 8) {
+    throw Error(where, "truncated header");
+  }
+  const std::size_t checked = kHeaderFixedBytes + hash_length;
+  if (get<std::uint64_t>(&head[checked]) != fnv1a(head.data(), checked)) {
+    throw Error(where, "corrupt header: checksum mismatch");
+  }
+  header_.scene_hash.assign(reinterpret_cast<const char*>(&head[kHeaderFixedBytes]), hash_length);
+  offset_ = head.size();
+  frame_count_hint_ = static_cast<std::size_t>((file_size_ - offset_) / header_.frame_size_bytes);
+  bytes_.resize(header_.frame_size_bytes);
+}
+
+bool RecordingReader::next(RecordedFrame& frame) {
+  if (offset_ == file_size_) {
+    return false;
+  }
+  const std::string where = path_.string();
+  const std::string which =
+      "frame " + std::to_string(frame_index_) + " (byte offset " + std::to_string(offset_) + ")";
+  in_.read(reinterpret_cast<char*>(bytes_.data()), static_cast<std::streamsize>(bytes_.size()));
+  const auto got = static_cast<std::size_t>(in_.gcount());
+  if (got != bytes_.size()) {
+    throw Error(where, which + " is truncated: " + std::to_string(got) + " of " +
+                           std::to_string(bytes_.size()) + " bytes; the file ends early");
+  }
+  if (get<std::uint32_t>(bytes_.data()) != kFrameMarker) {
+    throw Error(where, which + " is corrupt: bad frame marker");
+  }
+  const std::size_t payload = payload_size();
+  if (get<std::uint64_t>(bytes_.data() + 4 + payload) != fnv1a(bytes_.data() + 4, payload)) {
+    throw Error(where, which + " is corrupt: checksum mismatch");
+  }
+  RecordedFrame decoded;
+  Decoder decoder{bytes_.data() + 4};
+  visit_frame(decoded, decoder);
+  if (decoder.bad_bool) {
+    throw Error(where, which + " is corrupt: input.healthy is neither 0 nor 1");
+  }
+  if (const char* problem = check_counts(decoded)) {
+    throw Error(where, which + " is corrupt: " + problem);
+  }
+  frame = decoded;
+  offset_ += got;
+  ++frame_index_;
+  return true;
+}
+
+Recording read_recording(const std::filesystem::path& path) {
+  RecordingReader reader(path);
+  Recording recording;
+  recording.header = reader.header();
+  recording.frames.reserve(reader.frame_count_hint());
+  RecordedFrame frame;
+  while (reader.next(frame)) {
+    recording.frames.push_back(frame);
+  }
+  return recording;
+}
+
+// ---------------------------------------------------------------------------------------------
+// ReplayDevice
+
+ReplayDevice::ReplayDevice(DeviceProfile profile, std::vector<RecordedFrame> frames)
+    : profile_(std::move(profile)), frames_(std::move(frames)) {
+  if (frames_.empty()) {
+    throw Error("replay device '" + profile_.name + "'", "recording has no frames");
+  }
+  commands_.reserve(frames_.size());
+}
+
+DeviceInput ReplayDevice::read(double /*time_s*/) noexcept {
+  const std::size_t i = std::min(next_frame_, frames_.size() - 1);
+  if (next_frame_ < frames_.size()) {
+    ++next_frame_;
+  }
+  last_healthy_ = frames_[i].input.healthy;
+  return frames_[i].input;
+}
+
+void ReplayDevice::write(const DeviceCommand& command) noexcept {
+  if (commands_.size() < commands_.capacity()) {
+    commands_.push_back(command);  // within the reserved capacity: no allocation
+  }
+}
+
+DeviceStatus ReplayDevice::status() const noexcept {
+  if (!last_healthy_) {
+    return {DeviceHealth::kFailed, "the recorded input was marked unhealthy"};
+  }
+  return {DeviceHealth::kConnected, {}};
+}
+
+void ReplayDevice::rewind() noexcept {
+  next_frame_ = 0;
+  last_healthy_ = true;
+  commands_.clear();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Comparison
+
+RecordingDifference compare_frames(std::span<const RecordedFrame> expected,
+                                   std::span<const RecordedFrame> actual) {
+  RecordingDifference diff;
+  std::vector<unsigned char> a(recorded_frame_size_bytes());
+  std::vector<unsigned char> b(recorded_frame_size_bytes());
+  const std::size_t common = std::min(expected.size(), actual.size());
+  for (std::size_t i = 0; i < common; ++i) {
+    encode_frame(expected[i], a.data());
+    encode_frame(actual[i], b.data());
+    if (a == b) {
+      continue;
+    }
+    Flattener fa;
+    Flattener fb;
+    visit_frame(expected[i], fa);
+    visit_frame(actual[i], fb);
+    for (std::size_t k = 0; k < fa.entries.size(); ++k) {
+      if (fa.entries[k].bytes != fb.entries[k].bytes) {
+        diff.identical = false;
+        diff.frame_index = i;
+        diff.field = field_name(fa.entries[k].id);
+        diff.expected_value = fa.entries[k].text;
+        diff.actual_value = fb.entries[k].text;
+        diff.message = "frame " + std::to_string(i) + ", " + diff.field + ": expected " +
+                       diff.expected_value + ", got " + diff.actual_value;
+        return diff;
+      }
+    }
+  }
+  if (expected.size() != actual.size()) {
+    diff.identical = false;
+    diff.field = "frame count";
+    diff.expected_value = std::to_string(expected.size());
+    diff.actual_value = std::to_string(actual.size());
+    diff.message = "frame count: expected " + diff.expected_value + ", got " + diff.actual_value +
+                   " (the first " + std::to_string(common) + " frames are identical)";
+  }
+  return diff;
+}
+
+RecordingDifference compare_recordings(const Recording& expected, const Recording& actual) {
+  if (expected.header.scene_hash != actual.header.scene_hash) {
+    RecordingDifference diff;
+    diff.identical = false;
+    diff.field = "header.scene_hash";
+    diff.expected_value = expected.header.scene_hash;
+    diff.actual_value = actual.header.scene_hash;
+    diff.message = "header.scene_hash: expected '" + diff.expected_value + "', got '" +
+                   diff.actual_value + "'";
+    return diff;
+  }
+  return compare_frames(expected.frames, actual.frames);
+}
+
+}  // namespace hapsim

@@ -1,0 +1,386 @@
+#include "hapsim/device/recording.h"
+
+#include "device_test_util.h"
+#include "hapsim/core/error.h"
+#include "hapsim/device/force_safety.h"
+#include "hapsim/device/simulated_device.h"
+
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+namespace hapsim {
+namespace {
+
+// Frames with awkward values: -0.0, a denormal, a NaN with a payload, large and tiny numbers.
+RecordedFrame make_frame(std::uint64_t i) {
+  RecordedFrame f;
+  const double x = static_cast<double>(i);
+  f.cycle_index = i;
+  f.input.time_s = 0.001 * x;
+  f.input.p_world = Vec3(std::sin(x) / 3.0, -0.0, 1e-310 * x);
+  f.input.q_world = Quat(Eigen::AngleAxisd(0.01 * x, Vec3(1, 1, 0).normalized()));
+  f.input.finger_count = 2;
+  f.input.finger_rad = {std::numbers::pi / (x + 1), 1.0 / 3.0, 0, 0, 0};
+  f.input.joint_count = 1;
+  f.input.joint_rad[0] = -x * 1e10;
+  f.input.buttons = static_cast<std::uint32_t>(i % 4);
+  f.input.healthy = i % 5 != 4;
+  f.command.force_world_n = Vec3(0.1 * x, -0.2, std::sqrt(x));
+  f.command.finger_count = 2;
+  f.command.finger_force_n = {0.5, 1.0 / 7.0, 0, 0, 0};
+  f.command.joint_count = 1;
+  f.command.joint_torque_nm[0] = 1e-3 * x;
+  f.contact_count = static_cast<std::int32_t>(i % 3);
+  for (int c = 0; c < f.contact_count; ++c) {
+    RecordedContact& k = f.contacts[static_cast<std::size_t>(c)];
+    k.tool_index = c;
+    k.body_index = 7;
+    k.segment_index = c - 1;
+    k.point_world = Vec3(x, 2.0 / 3.0, -1.0);
+    k.normal_world = Vec3::UnitZ();
+    k.depth_m = 1e-4 * x;
+    k.force_n = std::bit_cast<double>(0x7ff8'0000'0000'1234ull);  // NaN with a payload
+  }
+  return f;
+}
+
+std::vector<RecordedFrame> make_frames(std::size_t n) {
+  std::vector<RecordedFrame> frames;
+  for (std::size_t i = 0; i < n; ++i) {
+    frames.push_back(make_frame(i));
+  }
+  return frames;
+}
+
+// Every double of the frame, in a fixed order, for memcmp.
+std::vector<double> doubles_of(const RecordedFrame& f) {
+  std::vector<double> d = {f.input.time_s};
+  d.insert(d.end(), f.input.p_world.data(), f.input.p_world.data() + 3);
+  d.insert(d.end(), f.input.q_world.coeffs().data(), f.input.q_world.coeffs().data() + 4);
+  d.insert(d.end(), f.input.joint_rad.begin(), f.input.joint_rad.end());
+  d.insert(d.end(), f.input.finger_rad.begin(), f.input.finger_rad.end());
+  d.insert(d.end(), f.command.force_world_n.data(), f.command.force_world_n.data() + 3);
+  d.insert(d.end(), f.command.finger_force_n.begin(), f.command.finger_force_n.end());
+  d.insert(d.end(), f.command.joint_torque_nm.begin(), f.command.joint_torque_nm.end());
+  for (const RecordedContact& c : f.contacts) {
+    d.insert(d.end(), c.point_world.data(), c.point_world.data() + 3);
+    d.insert(d.end(), c.normal_world.data(), c.normal_world.data() + 3);
+    d.push_back(c.depth_m);
+    d.push_back(c.force_n);
+  }
+  return d;
+}
+
+void expect_bit_identical(const RecordedFrame& a, const RecordedFrame& b) {
+  const std::vector<double> da = doubles_of(a);
+  const std::vector<double> db = doubles_of(b);
+  ASSERT_EQ(da.size(), db.size());
+  EXPECT_EQ(std::memcmp(da.data(), db.data(), da.size() * sizeof(double)), 0);
+  EXPECT_EQ(a.cycle_index, b.cycle_index);
+  EXPECT_EQ(a.input.buttons, b.input.buttons);
+  EXPECT_EQ(a.input.healthy, b.input.healthy);
+  EXPECT_EQ(a.input.finger_count, b.input.finger_count);
+  EXPECT_EQ(a.command.joint_count, b.command.joint_count);
+  EXPECT_EQ(a.contact_count, b.contact_count);
+  for (std::size_t c = 0; c < a.contacts.size(); ++c) {
+    EXPECT_EQ(a.contacts[c].segment_index, b.contacts[c].segment_index);
+  }
+}
+
+std::filesystem::path write_recording(const std::vector<RecordedFrame>& frames,
+                                      const std::string& hash = "scene-abc123") {
+  const auto path = test::temp_path(".hrec");
+  SessionRecorder recorder(path, hash, 7, SessionRecorder::Overflow::kFlushInline);
+  for (const RecordedFrame& f : frames) {
+    EXPECT_TRUE(recorder.record(f));
+  }
+  recorder.close();
+  EXPECT_EQ(recorder.frames_written(), frames.size());
+  EXPECT_EQ(recorder.frames_dropped(), 0u);
+  return path;
+}
+
+std::vector<char> file_bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_bytes(const std::filesystem::path& path, const std::vector<char>& bytes) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+// The message of the hapsim::Error that reading `path` throws ("" if it does not throw).
+std::string read_error(const std::filesystem::path& path) {
+  try {
+    (void)read_recording(path);
+  } catch (const Error& e) {
+    EXPECT_EQ(e.where(), path.string());
+    return e.what();
+  }
+  return "";
+}
+
+std::size_t header_size(const std::string& hash) {
+  return 8 + 6 * 4 + hash.size() + 8;
+}
+
+TEST(Recording, RoundTripIsBitExact) {
+  const auto frames = make_frames(23);  // 3 full buffers of 7 and a partial one
+  const auto path = write_recording(frames);
+  EXPECT_EQ(std::filesystem::file_size(path),
+            header_size("scene-abc123") + frames.size() * recorded_frame_size_bytes());
+  const Recording rec = read_recording(path);
+  std::filesystem::remove(path);
+  EXPECT_EQ(rec.header.version, kRecordingVersion);
+  EXPECT_EQ(rec.header.scene_hash, "scene-abc123");
+  EXPECT_EQ(rec.header.frame_size_bytes, recorded_frame_size_bytes());
+  ASSERT_EQ(rec.frames.size(), frames.size());
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    SCOPED_TRACE(i);
+    expect_bit_identical(rec.frames[i], frames[i]);
+  }
+  EXPECT_TRUE(compare_frames(frames, rec.frames).identical);
+}
+
+TEST(Recording, RealTimeBufferDropsInsteadOfBlockingAndCounts) {
+  const auto path = test::temp_path(".hrec");
+  {
+    SessionRecorder recorder(path, "h", 4);  // Overflow::kDrop
+    for (std::uint64_t i = 0; i < 6; ++i) {
+      EXPECT_EQ(recorder.record(make_frame(i)), i < 4) << i;
+    }
+    EXPECT_EQ(recorder.frames_buffered(), 4u);
+    EXPECT_EQ(recorder.frames_dropped(), 2u);
+    recorder.flush();
+    EXPECT_EQ(recorder.frames_written(), 4u);
+    EXPECT_TRUE(recorder.record(make_frame(9)));
+    RecordedFrame bad = make_frame(10);
+    bad.contact_count = kMaxRecordedContacts + 1;  // would make an unreadable file
+    EXPECT_FALSE(recorder.record(bad));
+    EXPECT_EQ(recorder.frames_dropped(), 3u);
+  }  // the destructor flushes
+  const Recording rec = read_recording(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(rec.frames.size(), 5u);
+  EXPECT_EQ(rec.frames[4].cycle_index, 9u);
+}
+
+TEST(Recording, TruncatedFileNamesTheFrame) {
+  const auto path = write_recording(make_frames(5));
+  auto bytes = file_bytes(path);
+  const std::size_t frame = recorded_frame_size_bytes();
+  bytes.resize(header_size("scene-abc123") + 3 * frame + frame / 2);
+  write_bytes(path, bytes);
+  const std::string message = read_error(path);
+  EXPECT_NE(message.find("frame 3"), std::string::npos) << message;
+  EXPECT_NE(message.find("truncated"), std::string::npos) << message;
+
+  bytes.resize(20);  // inside the header
+  write_bytes(path, bytes);
+  EXPECT_NE(read_error(path).find("too short for the header"), std::string::npos);
+  bytes.clear();
+  write_bytes(path, bytes);
+  EXPECT_NE(read_error(path).find("too short"), std::string::npos);
+  std::filesystem::remove(path);
+  EXPECT_NE(read_error(path).find("cannot open"), std::string::npos);
+}
+
+TEST(Recording, CorruptFrameNamesTheFrame) {
+  const auto frames = make_frames(6);
+  const auto path = write_recording(frames);
+  const auto original = file_bytes(path);
+  const std::size_t frame = recorded_frame_size_bytes();
+  const std::size_t frame2 = header_size("scene-abc123") + 2 * frame;
+  // Every single-byte flip anywhere in frame 2 is caught (marker, payload or checksum).
+  for (std::size_t offset = 0; offset < frame; offset += 37) {
+    auto bytes = original;
+    bytes[frame2 + offset] = static_cast<char>(bytes[frame2 + offset] ^ 0x10);
+    write_bytes(path, bytes);
+    const std::string message = read_error(path);
+    EXPECT_NE(message.find("frame 2 "), std::string::npos) << offset << ": " << message;
+    EXPECT_NE(message.find("corrupt"), std::string::npos) << message;
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(Recording, CorruptHeaderIsRejected) {
+  const auto path = write_recording(make_frames(2));
+  const auto original = file_bytes(path);
+  const auto with = [&](std::size_t offset, char value) {
+    auto bytes = original;
+    bytes[offset] = value;
+    write_bytes(path, bytes);
+    return read_error(path);
+  };
+  EXPECT_NE(with(0, 'X').find("bad magic"), std::string::npos);
+  EXPECT_NE(with(8, 9).find("version 9"), std::string::npos);                    // version
+  EXPECT_NE(with(12, 1).find("corrupt header: frame size"), std::string::npos);  // frame size
+  EXPECT_NE(with(29, 0x7f).find("scene hash length"), std::string::npos);        // hash length
+  EXPECT_NE(with(28, 100).find("checksum"), std::string::npos);                  // plausible length
+  EXPECT_NE(with(33, 'Z').find("checksum"), std::string::npos);                  // hash text
+  std::filesystem::remove(path);
+}
+
+TEST(Recording, CompareReportsTheFirstDifferingFrameAndField) {
+  const auto expected = make_frames(10);
+  auto actual = expected;
+  EXPECT_TRUE(compare_frames(expected, actual).identical);
+
+  actual[7].input.p_world.x() += 1.0;
+  actual[5].command.finger_force_n[1] = std::nextafter(actual[5].command.finger_force_n[1], 1.0);
+  RecordingDifference d = compare_frames(expected, actual);
+  EXPECT_FALSE(d.identical);
+  EXPECT_EQ(d.frame_index, 5u);
+  EXPECT_EQ(d.field, "command.finger_force_n[1]");
+  EXPECT_NE(d.message.find("frame 5, command.finger_force_n[1]: expected 0.14285714285714285"),
+            std::string::npos)
+      << d.message;
+
+  actual = expected;
+  actual[3].contacts[1].point_world.z() = -actual[3].contacts[1].point_world.z();
+  d = compare_frames(expected, actual);
+  EXPECT_EQ(d.frame_index, 3u);
+  EXPECT_EQ(d.field, "contacts[1].point_world[2]");
+
+  actual = expected;
+  actual[0].input.p_world.y() = 0.0;  // was -0.0: equal as numbers, not as bits
+  d = compare_frames(expected, actual);
+  EXPECT_EQ(d.frame_index, 0u);
+  EXPECT_EQ(d.field, "input.p_world[1]");
+
+  actual = expected;
+  actual.pop_back();
+  d = compare_frames(expected, actual);
+  EXPECT_FALSE(d.identical);
+  EXPECT_EQ(d.frame_index, RecordingDifference::kNoFrame);
+  EXPECT_EQ(d.field, "frame count");
+
+  Recording a;
+  a.header.scene_hash = "one";
+  a.frames = expected;
+  Recording b = a;
+  b.header.scene_hash = "two";
+  EXPECT_EQ(compare_recordings(a, b).field, "header.scene_hash");
+}
+
+// A toy deterministic step standing in for World::step: a spring towards the origin, clamped
+// and safety-filtered like the real loop, with a contact when below z = 0.
+RecordedFrame step(Device& device, std::uint64_t cycle, ForceWatchdog& watchdog) {
+  constexpr double kDt = 0.001;
+  RecordedFrame frame;
+  frame.cycle_index = cycle;
+  frame.input = device.read(static_cast<double>(cycle) * kDt);
+  DeviceCommand wanted;
+  wanted.force_world_n = -800.0 * frame.input.p_world;
+  wanted.finger_count = frame.input.finger_count;
+  for (int i = 0; i < frame.input.finger_count; ++i) {
+    wanted.finger_force_n[static_cast<std::size_t>(i)] =
+        std::sin(frame.input.finger_rad[static_cast<std::size_t>(i)]) * 10.0;
+  }
+  frame.command = watchdog.update(frame.input.time_s, &wanted, frame.input.healthy);
+  if (frame.input.p_world.z() < 0.0) {
+    frame.contact_count = 1;
+    frame.contacts[0] = {0,
+                         1,
+                         2,
+                         frame.input.p_world,
+                         Vec3::UnitZ(),
+                         -frame.input.p_world.z(),
+                         frame.command.force_world_n.norm()};
+  }
+  device.write(frame.command);
+  return frame;
+}
+
+TEST(Recording, ReplayReproducesTheSessionBitForBit) {
+  const DeviceProfile& profile = device_profile("touch");
+  SimulatedDevice live(
+      profile,
+      [](double t) {
+        DeviceInput in;
+        in.p_world = Vec3(0.01 * std::sin(7.0 * t), 0.003 * t, -0.004 * std::sin(3.0 * t));
+        in.q_world = Quat(Eigen::AngleAxisd(t, Vec3::UnitY()));
+        in.finger_count = 1;
+        in.finger_rad[0] = t * t;
+        in.healthy = !(t > 0.2 && t < 0.21);  // a short link drop
+        return in;
+      },
+      0.5);
+  const auto path = test::temp_path(".hrec");
+  {
+    ForceWatchdog watchdog(profile);
+    SessionRecorder recorder(path, "toy-scene", 64, SessionRecorder::Overflow::kFlushInline);
+    for (std::uint64_t c = 0; c < 500; ++c) {
+      ASSERT_TRUE(recorder.record(step(live, c, watchdog)));
+    }
+    recorder.close();
+  }
+  const Recording original = read_recording(path);
+  ASSERT_EQ(original.frames.size(), 500u);
+
+  ReplayDevice replay(profile, original.frames);
+  const auto path2 = test::temp_path("_replay.hrec");
+  {
+    ForceWatchdog watchdog(profile);
+    SessionRecorder recorder(path2, "toy-scene", 64, SessionRecorder::Overflow::kFlushInline);
+    for (std::uint64_t c = 0; c < 500; ++c) {
+      ASSERT_TRUE(recorder.record(step(replay, c, watchdog)));
+    }
+    recorder.close();
+  }
+  EXPECT_TRUE(replay.finished());
+  const Recording replayed = read_recording(path2);
+  std::filesystem::remove(path);
+  std::filesystem::remove(path2);
+
+  const RecordingDifference d = compare_recordings(original, replayed);
+  EXPECT_TRUE(d.identical) << d.message;
+  // The commands the replayed step wrote are the recorded ones.
+  ASSERT_EQ(replay.commands_written().size(), 500u);
+  for (std::size_t i = 0; i < 500; ++i) {
+    EXPECT_EQ(std::memcmp(replay.commands_written()[i].force_world_n.data(),
+                          original.frames[i].command.force_world_n.data(), 3 * sizeof(double)),
+              0)
+        << i;
+  }
+  // The comparison is not vacuous: a one-ulp change in the replayed input is found.
+  auto tampered = original.frames;
+  tampered[321].input.p_world.x() = std::nextafter(tampered[321].input.p_world.x(), 1.0);
+  ReplayDevice replay2(profile, tampered);
+  ForceWatchdog watchdog(profile);
+  std::vector<RecordedFrame> frames;
+  for (std::uint64_t c = 0; c < 500; ++c) {
+    frames.push_back(step(replay2, c, watchdog));
+  }
+  const RecordingDifference d2 = compare_frames(original.frames, frames);
+  EXPECT_EQ(d2.frame_index, 321u);
+  EXPECT_EQ(d2.field, "input.p_world[0]");
+}
+
+TEST(ReplayDevice, HoldsTheLastFrameAndReportsRecordedHealth) {
+  auto frames = make_frames(3);
+  frames[1].input.healthy = false;
+  ReplayDevice device(device_profile("simulated"), frames);
+  EXPECT_EQ(device.read(123.0).time_s, frames[0].input.time_s);  // the argument is ignored
+  EXPECT_EQ(device.status().health, DeviceHealth::kConnected);
+  EXPECT_FALSE(device.read(0.0).healthy);
+  EXPECT_EQ(device.status().health, DeviceHealth::kFailed);
+  EXPECT_FALSE(device.finished());
+  EXPECT_EQ(device.read(0.0).time_s, frames[2].input.time_s);
+  EXPECT_TRUE(device.finished());
+  EXPECT_EQ(device.read(0.0).time_s, frames[2].input.time_s);
+  device.rewind();
+  EXPECT_EQ(device.next_frame(), 0u);
+  EXPECT_EQ(device.read(0.0).time_s, frames[0].input.time_s);
+  EXPECT_THROW(ReplayDevice(device_profile("simulated"), {}), Error);
+}
+
+}  // namespace
+}  // namespace hapsim
