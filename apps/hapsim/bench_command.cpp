@@ -5,6 +5,7 @@
 #ifdef HAPSIM_WITH_BENCH
 
 #include "commands.h"
+#include "progress_printer.h"
 
 #include "bench/collision_cases.h"
 #include "hapsim/core/data_dir.h"
@@ -33,34 +34,6 @@ struct BenchArgs {
   std::string data_dir;
 };
 
-/// Progress on stderr: one rewritten line on a terminal, one line per step otherwise.
-class ProgressPrinter {
- public:
-  ProgressPrinter() : tty_(isatty(STDERR_FILENO) != 0) {}
-  void operator()(std::string_view label, double fraction) {
-    if (label == last_label_) {
-      return;
-    }
-    last_label_ = std::string(label);
-    char prefix[64];
-    std::snprintf(prefix, sizeof prefix, "[%3.0f%% %6.1fs] ", 100.0 * fraction, watch_.elapsed_s());
-    if (tty_) {
-      std::string line = prefix + last_label_;
-      line.resize(std::max<std::size_t>(line.size(), width_), ' ');
-      width_ = std::max(width_, line.size());
-      std::cerr << '\r' << line << (fraction >= 1.0 ? "\n" : "") << std::flush;
-    } else {
-      std::cerr << prefix << last_label_ << '\n';
-    }
-  }
-
- private:
-  bool tty_;
-  std::string last_label_;
-  std::size_t width_ = 0;
-  Stopwatch watch_;
-};
-
 std::string join(const std::vector<std::string>& names) {
   std::string out;
   for (const auto& n : names) {
@@ -75,8 +48,8 @@ void run_collision(const BenchArgs& args) {
   options.meshes = args.meshes;
   options.methods = args.methods;
   options.queries = args.queries;
-  options.data_dir = args.data_dir.empty() ? bench::default_data_dir()
-                                           : find_data_dir(args.data_dir);
+  options.data_dir =
+      args.data_dir.empty() ? bench::default_data_dir() : find_data_dir(args.data_dir);
   if (!args.data_dir.empty() && !options.data_dir) {
     throw CommandError("--data " + args.data_dir + ": not a folder");
   }
@@ -84,12 +57,12 @@ void run_collision(const BenchArgs& args) {
   const auto built_methods = bench::available_methods();
   for (const auto& m : options.methods) {
     if (std::find(built_methods.begin(), built_methods.end(), m) == built_methods.end()) {
-      throw CommandError("--methods " + m + ": " +
-                         (std::find(known_methods.begin(), known_methods.end(), m) !=
-                                  known_methods.end()
-                              ? "not built in this binary"
-                              : "unknown method") +
-                         "; available: " + join(built_methods));
+      throw CommandError(
+          "--methods " + m + ": " +
+          (std::find(known_methods.begin(), known_methods.end(), m) != known_methods.end()
+               ? "not built in this binary"
+               : "unknown method") +
+          "; available: " + join(built_methods));
     }
   }
   const auto known_meshes = bench::all_collision_mesh_names();
@@ -171,9 +144,9 @@ void add_bench_command(CLI::App& app) {
                       "Fewer queries, no 1M-triangle mesh (about a minute)");
   collision->add_option("--json", args->json_path, "Write the rows as a JSON array to FILE");
   collision
-      ->add_option("--meshes", args->meshes,
-                   "Meshes to run (default: all for the mode): " +
-                       join(bench::all_collision_mesh_names()))
+      ->add_option(
+          "--meshes", args->meshes,
+          "Meshes to run (default: all for the mode): " + join(bench::all_collision_mesh_names()))
       ->delimiter(',');
   collision
       ->add_option("--methods", args->methods,
@@ -182,8 +155,9 @@ void add_bench_command(CLI::App& app) {
   collision->add_option("--workloads", args->workloads, "trajectory, uniform (default: both)")
       ->delimiter(',')
       ->check(CLI::IsMember({"trajectory", "uniform"}));
-  collision->add_option("--queries", args->queries,
-                        "Timed queries per row (default 20000, --quick 4000)")
+  collision
+      ->add_option("--queries", args->queries,
+                   "Timed queries per row (default 20000, --quick 4000)")
       ->check(CLI::PositiveNumber);
   collision->add_option("--data", args->data_dir,
                         "Real-data folder for the knee meshes (default: $HAPSIM_DATA or "

@@ -94,6 +94,7 @@ class SessionRecorder {
   [[nodiscard]] const std::filesystem::path& path() const { return path_; }
   [[nodiscard]] std::size_t frames_written() const { return frames_written_; }
   [[nodiscard]] std::size_t frames_buffered() const { return buffer_.size(); }
+  [[nodiscard]] std::size_t capacity_frames() const { return capacity_frames_; }
   [[nodiscard]] std::size_t frames_dropped() const { return frames_dropped_; }
   [[nodiscard]] const std::string& last_error() const { return last_error_; }
 

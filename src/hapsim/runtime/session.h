@@ -1,0 +1,94 @@
+// One unattended run of a world driven by a device (SPEC §7, §10): the deterministic step at a
+// fixed dt, as fast as it goes (offline) or on an absolute 1 kHz deadline (--realtime), with the
+// device safety layer between the world and the device, an optional recorder, and the figures a
+// user wants at the end: contacts and deflection per segment, forces per tool, pop-throughs,
+// force-limit violations and the cost of a step.
+#pragma once
+
+#include "hapsim/core/progress.h"
+#include "hapsim/device/device.h"
+#include "hapsim/device/recording.h"
+#include "hapsim/world/world.h"
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace hapsim {
+
+struct SessionOptions {
+  /// Simulated seconds to run (> 0).
+  double duration_s = 10.0;
+  double dt_s = 0.001;
+  /// Sleep to an absolute deadline every dt (clock_nanosleep, TIMER_ABSTIME).
+  bool realtime = false;
+  /// Check every step, outside the timed step, that no tool's proxy centre entered a closed
+  /// proxy segment, against an exact query built independently of the world's method.
+  bool check_pop_through = true;
+  /// Receives every cycle (input, command after safety, contacts). Not owned; may be null.
+  SessionRecorder* recorder = nullptr;
+  ProgressFn progress;
+};
+
+struct StepTimingUs {
+  double p50 = 0.0;
+  double p99 = 0.0;
+  double max = 0.0;
+  double mean = 0.0;
+};
+
+/// Forces as the device renders them (after the safety layer's clamp): a finger tool's actuator
+/// force, or the tool's share of the tip force.
+struct ToolSummary {
+  std::string name;
+  double peak_force_n = 0.0;
+  /// Mean force magnitude over the steps in which the tool touched something.
+  double mean_force_n = 0.0;
+  std::size_t contact_steps = 0;
+};
+
+struct SegmentSummary {
+  std::string body;
+  std::string name;
+  /// Tool-steps in contact with this segment.
+  std::size_t contacts = 0;
+  /// Largest contact force the world computed on this segment (before the device clamp).
+  double peak_force_n = 0.0;
+  double max_deflection_m = 0.0;
+};
+
+struct SessionSummary {
+  std::size_t steps = 0;
+  double simulated_s = 0.0;
+  double wall_s = 0.0;
+  StepTimingUs step_us;
+  /// Steps at which a tool's proxy centre was inside a closed proxy segment (must be 0).
+  std::size_t pop_throughs = 0;
+  /// Deepest the proxy sphere ever reached into a proxy segment, metres (tolerance-sized).
+  double max_proxy_penetration_m = 0.0;
+  std::vector<ToolSummary> tools;
+  std::vector<SegmentSummary> segments;
+  /// Commands sent above the device's rated force (after the safety layer: must be 0).
+  std::size_t max_force_limit_violations = 0;
+  /// Cycles where the safety layer had to clamp the world's command to the device.
+  std::size_t clamped_cycles = 0;
+  std::size_t nonfinite_commands = 0;
+  double peak_command_force_n = 0.0;
+  std::size_t dropped_contacts = 0;
+  std::size_t recorded_frames = 0;
+  std::size_t recording_dropped_frames = 0;
+  /// Realtime only: deadlines missed by more than one period.
+  std::size_t missed_deadlines = 0;
+};
+
+/// Runs `world` with `device` for options.duration_s. Throws hapsim::Error on bad options.
+[[nodiscard]] SessionSummary run_session(World& world, Device& device,
+                                         const SessionOptions& options);
+
+/// Short human summary (a dozen lines).
+[[nodiscard]] std::string format_session_summary(const SessionSummary& summary);
+
+/// Percentiles of step costs (microseconds); sorts `samples_us`.
+[[nodiscard]] StepTimingUs step_timing(std::vector<double>& samples_us);
+
+}  // namespace hapsim

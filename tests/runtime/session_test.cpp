@@ -1,0 +1,235 @@
+// run_session: the runner around World::step. Checked against what the scripted device did (steps,
+// contact counts against the trajectory's geometry), the device's rated limits, an exact replay of
+// the session's own recording, and nearest-rank percentiles on known samples.
+#include "hapsim/runtime/session.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/device/device_profile.h"
+#include "hapsim/device/recording.h"
+#include "hapsim/device/simulated_device.h"
+#include "hapsim/geometry/procedural.h"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <numeric>
+#include <string>
+
+namespace hapsim {
+namespace {
+
+MaterialDescription material(const char* name, ContactResponse response, double k,
+                             double max_force_n) {
+  MaterialDescription m;
+  m.name = name;
+  m.response = response;
+  m.contact.stiffness_n_per_m = k;
+  m.contact.max_penetration_m = 0.02;
+  m.contact.max_force_n = max_force_n;
+  return m;
+}
+
+// A stiff "bone" block (proxy) with its top face at z = 0, and a soft deformable "muscle" sphere
+// beside it at x = 0.2, resting on nothing.
+WorldDescription two_body_world() {
+  WorldDescription w;
+  w.name = "session-test";
+  w.materials.push_back(material("bone", ContactResponse::kProxy, 3000.0, 40.0));
+  w.materials.push_back(material("muscle", ContactResponse::kPenalty, 300.0, 2.0));
+  BodyDescription bone;
+  bone.name = "bone";
+  bone.X_world_body = Iso3(Eigen::Translation3d(0, 0, -0.02));
+  SegmentDescription block;
+  block.name = "block";
+  block.material = 0;
+  block.mesh = make_box(Vec3(0.05, 0.05, 0.02));
+  bone.segments.push_back(std::move(block));
+  w.bodies.push_back(std::move(bone));
+  BodyDescription soft;
+  soft.name = "soft";
+  soft.kind = BodyKind::kDeformable;
+  soft.X_world_body = Iso3(Eigen::Translation3d(0.2, 0, -0.03));
+  SegmentDescription ball;
+  ball.name = "ball";
+  ball.material = 1;
+  ball.mesh = make_uv_sphere(0.03, 48, 24);
+  soft.segments.push_back(std::move(ball));
+  w.bodies.push_back(std::move(soft));
+  ToolDescription tip;
+  tip.name = "tip";
+  tip.radius_m = 0.004;
+  w.tools.push_back(tip);
+  return w;
+}
+
+// 0-1 s: press the bone 10 mm deep at 1 m/s-ish speeds (fast enough to tunnel without a proxy);
+// 1-2 s: press the soft ball 5 mm; then hover.
+DeviceInput script(double t) {
+  DeviceInput in;
+  in.time_s = t;
+  const double r = 0.004;
+  if (t < 1.0) {
+    // Triangle wave between 20 mm above and 10 mm into the bone, 4 round trips: 0.24 m/s.
+    const double phase = std::fmod(t * 4.0, 1.0);
+    const double z = phase < 0.5 ? 0.02 - 0.06 * phase : -0.01 + 0.06 * (phase - 0.5);
+    in.p_world = Vec3(0.0, 0.0, z + r);
+  } else if (t < 2.0) {
+    const double depth = 0.005 * std::sin(3.141592653589793 * (t - 1.0));
+    in.p_world = Vec3(0.2, 0.0, r - depth);
+  } else {
+    in.p_world = Vec3(0.1, 0.0, 0.05);
+  }
+  return in;
+}
+
+std::filesystem::path temp_path(const std::string& name) {
+  return std::filesystem::temp_directory_path() /
+         ("hapsim_session_" + std::to_string(::getpid()) + "_" + name);
+}
+
+TEST(StepTiming, NearestRankPercentiles) {
+  std::vector<double> samples(100);
+  std::iota(samples.begin(), samples.end(), 1.0);
+  std::reverse(samples.begin(), samples.end());
+  const StepTimingUs t = step_timing(samples);
+  EXPECT_EQ(t.p50, 50.0);
+  EXPECT_EQ(t.p99, 99.0);
+  EXPECT_EQ(t.max, 100.0);
+  EXPECT_DOUBLE_EQ(t.mean, 50.5);
+  std::vector<double> one{7.0};
+  EXPECT_EQ(step_timing(one).p99, 7.0);
+  std::vector<double> none;
+  EXPECT_EQ(step_timing(none).max, 0.0);
+}
+
+TEST(Session, CountsContactsWithinLimitsWithoutPopThrough) {
+  const DeviceProfile& omega = device_profile("omega3");
+  WorldOptions wo;
+  wo.max_stiffness_n_per_m = omega.max_stiffness_n_per_m;
+  World world(two_body_world(), wo);
+  SimulatedDevice device(omega, script, 3.0);
+  SessionOptions options;
+  options.duration_s = 3.0;
+  int progress_calls = 0;
+  double last_fraction = 0.0;
+  options.progress = [&](std::string_view, double f) {
+    ++progress_calls;
+    EXPECT_GE(f, last_fraction);
+    last_fraction = f;
+  };
+  const SessionSummary s = run_session(world, device, options);
+  EXPECT_EQ(s.steps, 3000u);
+  EXPECT_DOUBLE_EQ(s.simulated_s, 3.0);
+  EXPECT_EQ(last_fraction, 1.0);
+  EXPECT_GT(progress_calls, 10);
+  EXPECT_EQ(s.pop_throughs, 0u);
+  // The proxy sphere may rest within the god-object's contact tolerance, not deeper.
+  EXPECT_LT(s.max_proxy_penetration_m, 1e-4);
+  EXPECT_EQ(s.max_force_limit_violations, 0u);
+  EXPECT_EQ(s.nonfinite_commands, 0u);
+  ASSERT_EQ(s.segments.size(), 2u);
+  ASSERT_EQ(s.tools.size(), 1u);
+  // The script is below the bone's top face (tool sphere touching: z < r) for 1/3 of each
+  // 250 ms period of the first second: 250 ms of contact in all, to within a step per crossing.
+  EXPECT_NEAR(static_cast<double>(s.segments[0].contacts), 333.0, 12.0);
+  // The soft ball is pressed for the whole second (depth > 0 strictly inside (1, 2) s).
+  EXPECT_NEAR(static_cast<double>(s.segments[1].contacts), 999.0, 3.0);
+  // Deflection of the penalty ball: its surface follows the tool, at most the 5 mm pressed.
+  EXPECT_GT(s.segments[1].max_deflection_m, 0.003);
+  EXPECT_LE(s.segments[1].max_deflection_m, 0.005 + 1e-9);
+  EXPECT_EQ(s.segments[0].max_deflection_m, 0.0);  // static body
+  // The bone is pressed 10 mm with k clamped to the omega.3's 5000 N/m... by the material's
+  // 3000 N/m: 30 N, above the device's 12 N: the device gets its rated maximum.
+  EXPECT_GT(s.segments[0].peak_force_n, 12.0);
+  EXPECT_LE(s.tools[0].peak_force_n, omega.max_force_n);
+  EXPECT_NEAR(s.tools[0].peak_force_n, omega.max_force_n, 1e-6);
+  EXPECT_GT(s.clamped_cycles, 0u);
+  // The soft ball peaks at k·5 mm = 1.5 N (below its 2 N cap).
+  EXPECT_NEAR(s.segments[1].peak_force_n, 1.5, 0.1);
+  EXPECT_GT(s.tools[0].mean_force_n, 0.0);
+  EXPECT_LT(s.tools[0].mean_force_n, s.tools[0].peak_force_n);
+  EXPECT_GT(s.step_us.p50, 0.0);
+  EXPECT_LE(s.step_us.p50, s.step_us.p99);
+  EXPECT_LE(s.step_us.p99, s.step_us.max);
+  const std::string text = format_session_summary(s);
+  EXPECT_NE(text.find("pop-throughs: 0"), std::string::npos) << text;
+  EXPECT_NE(text.find("soft/ball"), std::string::npos) << text;
+}
+
+TEST(Session, RecordingReplaysBitForBit) {
+  const DeviceProfile& omega = device_profile("omega3");
+  const auto path = temp_path("a.rec");
+  {
+    World world(two_body_world());
+    SimulatedDevice device(omega, script, 2.5);
+    SessionRecorder recorder(path, world.content_hash(), 512);
+    SessionOptions options;
+    options.duration_s = 2.5;
+    options.recorder = &recorder;
+    const SessionSummary s = run_session(world, device, options);
+    recorder.close();
+    EXPECT_EQ(s.recorded_frames, 2500u);
+    EXPECT_EQ(s.recording_dropped_frames, 0u);
+  }
+  const Recording original = read_recording(path);
+  ASSERT_EQ(original.frames.size(), 2500u);
+  World world(two_body_world());
+  ReplayDevice replay(omega, original.frames);
+  const auto again_path = temp_path("b.rec");
+  SessionRecorder recorder(again_path, world.content_hash(), 512);
+  SessionOptions options;
+  options.duration_s = 2.5;
+  options.recorder = &recorder;
+  (void)run_session(world, replay, options);
+  recorder.close();
+  const RecordingDifference d = compare_recordings(original, read_recording(again_path));
+  EXPECT_TRUE(d.identical) << d.message;
+  // And a changed world is noticed: a softer bone changes the forces.
+  WorldDescription softer = two_body_world();
+  softer.materials[0].contact.stiffness_n_per_m = 2000.0;
+  World other(softer);
+  ReplayDevice replay2(omega, original.frames);
+  const auto other_path = temp_path("c.rec");
+  SessionRecorder recorder2(other_path, world.content_hash(), 512);
+  options.recorder = &recorder2;
+  (void)run_session(other, replay2, options);
+  recorder2.close();
+  const RecordingDifference d2 = compare_recordings(original, read_recording(other_path));
+  EXPECT_FALSE(d2.identical);
+  EXPECT_NE(d2.field.find("command"), std::string::npos) << d2.message;
+  std::filesystem::remove(path);
+  std::filesystem::remove(again_path);
+  std::filesystem::remove(other_path);
+}
+
+TEST(Session, UnhealthyDeviceGetsNoForce) {
+  const DeviceProfile& omega = device_profile("omega3");
+  World world(two_body_world());
+  SimulatedDevice device(omega, script, 1.0);
+  device.set_health(DeviceHealth::kFailed, "cable pulled");
+  SessionOptions options;
+  options.duration_s = 1.0;
+  const SessionSummary s = run_session(world, device, options);
+  EXPECT_EQ(s.peak_command_force_n, 0.0);
+  EXPECT_EQ(device.peak_force_n(), 0.0);
+  EXPECT_EQ(s.max_force_limit_violations, 0u);
+}
+
+TEST(Session, BadOptionsAreErrors) {
+  World world(two_body_world());
+  SimulatedDevice device(device_profile("touch"), script, 1.0);
+  SessionOptions options;
+  options.duration_s = 0.0;
+  EXPECT_THROW((void)run_session(world, device, options), Error);
+  options.duration_s = std::nan("");
+  EXPECT_THROW((void)run_session(world, device, options), Error);
+  options.duration_s = 1.0;
+  options.dt_s = -0.001;
+  EXPECT_THROW((void)run_session(world, device, options), Error);
+}
+
+}  // namespace
+}  // namespace hapsim
