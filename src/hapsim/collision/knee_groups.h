@@ -47,7 +47,9 @@ struct KneeGroup {
   std::vector<std::uint32_t> halo;
   /// Triangles with at least one owned corner.
   std::vector<std::uint32_t> triangles;
-  /// Every triangle faces away from the centroid: ((tri centroid − c)·n > 0).
+  /// Every triangle faces away from the centroid ((tri centroid − c)·n > 0, see
+  /// is_star_shaped_about) and every owned and halo vertex is seen from the centroid through the
+  /// body's interior, with the centroid inside the body.
   bool star_shaped = false;
 };
 
@@ -88,7 +90,8 @@ struct KneeGrouping {
   KneeGroupStats stats;
 };
 
-/// Builds segments and groups for a closed, outward-oriented mesh. Precondition: non-empty mesh.
+/// Builds segments and groups for a closed, outward-oriented mesh. An empty mesh gives no
+/// segments and no groups.
 /// Cost: O(iterations · vertices · groups per segment) for k-means plus a few exact
 /// inside/outside queries per group.
 [[nodiscard]] KneeGrouping build_knee_groups(const TriangleMesh& mesh,

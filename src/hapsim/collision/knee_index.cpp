@@ -101,6 +101,12 @@ KneeIndex::KneeIndex(const TriangleMesh& mesh, KneeIndexOptions options)
       g.cone_cos = std::min(g.cone_cos, g.cone_axis.dot(Vec3(ux_[e], uy_[e], uz_[e])));
     }
     g.cone_cos = g.cone_cos - 1e-6;  // float directions
+    // The spherical cap through the farthest direction bounds the patch's directions only while
+    // it is convex, i.e. smaller than a hemisphere: a wider patch (a whole small closed body,
+    // whose mean direction is ~0) can have triangles reaching outside the cap, so no culling.
+    if (g.cone_cos <= 0.0) {
+      g.cone_cos = -2.0;
+    }
     // Error-bound inputs: longest edge, and the largest normal turn between triangles sharing a
     // vertex of the group (how far a plane through nearby vertices can tilt from the surface).
     for (std::uint32_t t : kg.triangles) {
@@ -238,13 +244,13 @@ std::size_t KneeIndex::memory_bytes() const {
 
 // haptic path
 bool KneeIndex::plane_for_group(const Vec3& p, std::uint32_t gi, KneeCounters* counters,
-                                SurfacePoint* answer, bool* covers) const {
+                                SurfacePoint* answer, bool* covers, bool use_cone) const {
   const Group& g = groups_[gi];
   Vec3 d = p - g.centroid_m;
   const double dn = d.norm();
   d = dn > 0.0 ? Vec3(d / dn) : Vec3::UnitZ();
   *covers = false;
-  if (d.dot(g.cone_axis) < g.cone_cos) {
+  if (use_cone && d.dot(g.cone_axis) < g.cone_cos) {
     return false;  // the ray from the centroid through p misses this group's patch
   }
   const float dx = static_cast<float>(d.x());
@@ -382,6 +388,12 @@ bool KneeIndex::plane_for_group(const Vec3& p, std::uint32_t gi, KneeCounters* c
 SurfacePoint KneeIndex::query(const Vec3& p, double margin_m, KneeCounters* counters) const {
   SurfacePoint outside;   // best answer from a covering group that says "no contact"
   SurfacePoint fallback;  // first answer from a non-covering group
+  // The candidate whose cone the point's direction missed by the least: near a group border the ray
+  // from each nearby centroid can pass beside that group's patch (the centroids differ, so the
+  // cones leave gaps between them); rather than report "nothing here" for a point right at the
+  // surface, its plane is used as a last resort.
+  std::uint32_t uncovered = kNoTriangle;
+  double uncovered_slack = -kInf;
   for (const Segment& s : segments_) {
     if (counters != nullptr) {
       ++counters->segments_tested;
@@ -421,6 +433,13 @@ SurfacePoint KneeIndex::query(const Vec3& p, double margin_m, KneeCounters* coun
       SurfacePoint ans;
       bool covers = false;
       if (!plane_for_group(p, cand[i].group, counters, &ans, &covers)) {
+        // Keep the group whose cone the direction misses by the least.
+        const Group& g = groups_[cand[i].group];
+        const double slack = (p - g.centroid_m).normalized().dot(g.cone_axis) - g.cone_cos;
+        if (slack > uncovered_slack) {
+          uncovered_slack = slack;
+          uncovered = cand[i].group;
+        }
         continue;
       }
       if (covers) {
@@ -435,7 +454,14 @@ SurfacePoint KneeIndex::query(const Vec3& p, double margin_m, KneeCounters* coun
       }
     }
   }
-  return outside.found() ? outside : fallback;
+  if (outside.found()) {
+    return outside;
+  }
+  if (!fallback.found() && uncovered != kNoTriangle) {
+    bool covers = false;
+    (void)plane_for_group(p, uncovered, counters, &fallback, &covers, /*use_cone=*/false);
+  }
+  return fallback;
 }
 
 SurfacePoint KneeIndex::closest_point(const Vec3& p, QueryHint* hint) const {

@@ -7,7 +7,9 @@
 // It is approximate (the plane through three nearby vertices stands in for the surface) and it
 // answers only near the body: a point outside every sphere of influence (grown by
 // `influence_margin_m`) gets found() == false and signed_distance == +inf. Its error against the
-// exact query is measured by knee_error.h.
+// exact query is measured by knee_error.h. A point near the surface whose direction falls in no
+// candidate group's cone (a gap between the cones of neighbouring centroids) gets the plane of
+// the group whose cone it misses by the least. An index of an empty mesh never answers.
 //
 // Deformation model (the paper's): vertices move along their group's radial direction, so the
 // stored directions stay those of the rest shape and refit() only updates radii and bounds.
@@ -127,9 +129,9 @@ class KneeIndex final : public ProximityQuery {
   /// Plane test of one group. Returns false when the point's direction from the centroid is
   /// outside the group's cone (nothing computed); otherwise fills `answer`, and `covers` tells
   /// whether the direction falls in the group's own patch (owned nearest vertex, enclosing
-  /// triple).
+  /// triple). `use_cone` false skips the cone test (the last resort of query()).
   bool plane_for_group(const Vec3& p, std::uint32_t g, KneeCounters* counters, SurfacePoint* answer,
-                       bool* covers) const;
+                       bool* covers, bool use_cone = true) const;
   void refit_bounds_tight();
 
   const TriangleMesh* mesh_;
