@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The main job: install what is missing, build, then run hapsim's reference scene on the
-# simulated device and report what happened. Extra arguments go to the final command.
+# The main job: install what is missing, build, then run the knee palpation scene on the simulated
+# device (scenes/knee.json: a procedural knee, one fingertip, a scripted palpation) and report what
+# happened. Extra arguments go to `hapsim run` (e.g. --method knee, --realtime, --record FILE).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 hapsim_install_packages
@@ -9,9 +10,5 @@ hapsim_build
 HAPSIM="${HAPSIM_BUILD_DIR}/apps/hapsim"
 OUT="${HAPSIM_ROOT}/build/main-job"
 mkdir -p "$OUT"
-# Until the knee scene lands (issue 3): describe the built-in bumpy sphere and query it along a
-# probe path that passes through its surface.
-"$HAPSIM" info builtin:bumpy-sphere --json "$OUT/info.json"
-"$HAPSIM" query builtin:bumpy-sphere --points builtin:probe-path --method spheretree \
-  --out "$OUT/query.csv" --json "$OUT/query.json" "$@"
-echo "hapsim: results in $OUT"
+"$HAPSIM" run "${HAPSIM_ROOT}/scenes/knee.json" --json "$OUT/knee-run.json" "$@"
+echo "hapsim: summary as JSON in $OUT/knee-run.json"

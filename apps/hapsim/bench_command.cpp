@@ -8,6 +8,7 @@
 #include "progress_printer.h"
 
 #include "bench/collision_cases.h"
+#include "bench/step_cases.h"
 #include "hapsim/core/data_dir.h"
 #include "hapsim/core/stopwatch.h"
 
@@ -15,9 +16,11 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -130,6 +133,56 @@ void run_collision(const BenchArgs& args) {
   }
 }
 
+struct StepArgs {
+  std::vector<std::string> methods;
+  std::vector<std::string> scenes;
+  std::string data_dir;
+  double duration_s = 0.0;
+  std::string json_path;
+};
+
+void run_step(const StepArgs& args) {
+  std::unique_ptr<std::ofstream> json_out;
+  if (!args.json_path.empty()) {
+    json_out = std::make_unique<std::ofstream>(args.json_path);
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": cannot open for writing");
+    }
+  }
+  bench::StepBenchOptions options;
+  options.methods = args.methods;
+  options.duration_s = args.duration_s;
+  const std::optional<std::filesystem::path> data_dir =
+      args.data_dir.empty() ? bench::default_data_dir()
+                            : std::optional<std::filesystem::path>(args.data_dir);
+  if (args.scenes.empty()) {
+    options.cases = bench::default_step_cases(bench::default_scenes_dir(), data_dir);
+    if (options.cases.size() < 2) {
+      std::cerr << "hapsim bench step: no knee_vhf_left in the data folder: the 5-finger VHF "
+                   "case is skipped (give --data)\n";
+    }
+  } else {
+    for (const std::string& scene : args.scenes) {
+      options.cases.push_back({std::filesystem::path(scene).stem().string(), scene, std::nullopt});
+    }
+  }
+  ProgressPrinter printer;
+  options.progress = [&printer](std::string_view label, double fraction) {
+    printer(label, fraction);
+  };
+  const std::vector<bench::StepRow> rows = bench::run_step_bench(options);
+  std::cout << bench::format_step_table(rows);
+  std::cout << "step = device read + collision + force + deformation + safety + write, timed per "
+               "cycle; ratios < 1: faster than the exact-query baseline\n";
+  if (json_out) {
+    *json_out << bench::step_rows_to_json(rows).dump(2) << '\n';
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": write failed");
+    }
+    std::cout << "wrote " << args.json_path << '\n';
+  }
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
@@ -163,6 +216,26 @@ void add_bench_command(CLI::App& app) {
                         "Real-data folder for the knee meshes (default: $HAPSIM_DATA or "
                         "../shared/data)");
   collision->callback([args] { run_collision(*args); });
+
+  auto step_args = std::make_shared<StepArgs>();
+  CLI::App* step = bench->add_subcommand(
+      "step",
+      "Haptic step cost on the knee scenes (one fingertip; five on the real knee) per contact "
+      "method, beside the exact-query baseline");
+  step->add_option("--methods", step_args->methods, "exact, spheretree, knee (default: all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"exact", "spheretree", "knee"}));
+  step->add_option("--scenes", step_args->scenes,
+                   "Scene files to run instead of the shipped knee scenes")
+      ->delimiter(',');
+  step->add_option("--data", step_args->data_dir,
+                   "Real-data folder holding knee_vhf_left (default: $HAPSIM_DATA or "
+                   "../shared/data)");
+  step->add_option("--duration", step_args->duration_s,
+                   "Simulated seconds per run (default: the whole palpation)")
+      ->check(CLI::PositiveNumber);
+  step->add_option("--json", step_args->json_path, "Write the rows as a JSON array to FILE");
+  step->callback([step_args] { run_step(*step_args); });
 }
 
 }  // namespace hapsim::app

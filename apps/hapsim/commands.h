@@ -21,5 +21,6 @@ int& exit_status();
 void add_info_command(CLI::App& app);
 void add_query_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
+void add_run_command(CLI::App& app);
 
 }  // namespace hapsim::app

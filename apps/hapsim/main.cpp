@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
       "-v,--verbose", [] { spdlog::set_level(spdlog::level::debug); }, "More log output");
   add_info_command(app);
   add_query_command(app);
+  add_run_command(app);
 #ifdef HAPSIM_WITH_BENCH
   add_bench_command(app);
 #endif

@@ -1,0 +1,301 @@
+// `hapsim run SCENE`: loads a scene, drives its world with the simulated device (the scene's
+// trajectory or palpation script, another trajectory file, or a recording to replay) at 1 kHz
+// simulated time, and reports contacts, forces, deflection, pop-throughs and the step cost.
+#include "commands.h"
+#include "progress_printer.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/core/stopwatch.h"
+#include "hapsim/device/recording.h"
+#include "hapsim/runtime/session.h"
+#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/scene_file.h"
+
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace hapsim::app {
+namespace {
+
+struct RunArgs {
+  std::string scene;
+  std::string device;  // "sim" or "sim:FILE"
+  double duration_s = std::numeric_limits<double>::quiet_NaN();  // NaN: not given
+  std::string record_path;
+  std::string replay_path;
+  std::string json_path;
+  std::string method;
+  std::string data_dir;
+  bool realtime = false;
+  bool quiet = false;
+};
+
+ContactMethod parse_method(const std::string& name) {
+  if (name == "exact") {
+    return ContactMethod::kExact;
+  }
+  if (name == "spheretree") {
+    return ContactMethod::kSphereTree;
+  }
+  return ContactMethod::kKnee;  // CLI11 has checked the name
+}
+
+nlohmann::json summary_json(const SceneDescription& scene, const World& world,
+                            const SessionSummary& s, const std::string& device_name) {
+  nlohmann::json j;
+  j["scene"] = scene.file.string();
+  j["world"] = world.description().name;
+  j["device"] = device_name;
+  j["steps"] = s.steps;
+  j["dt_s"] = s.steps > 0 ? s.simulated_s / static_cast<double>(s.steps) : 0.0;
+  j["simulated_s"] = s.simulated_s;
+  j["wall_s"] = s.wall_s;
+  j["step_us"] = {{"p50", s.step_us.p50},
+                  {"p99", s.step_us.p99},
+                  {"max", s.step_us.max},
+                  {"mean", s.step_us.mean}};
+  j["pop_throughs"] = s.pop_throughs;
+  j["max_proxy_penetration_m"] = s.max_proxy_penetration_m;
+  j["max_force_limit_violations"] = s.max_force_limit_violations;
+  j["clamped_cycles"] = s.clamped_cycles;
+  j["nonfinite_commands"] = s.nonfinite_commands;
+  j["peak_command_force_n"] = s.peak_command_force_n;
+  j["dropped_contacts"] = s.dropped_contacts;
+  j["missed_deadlines"] = s.missed_deadlines;
+  j["recorded_frames"] = s.recorded_frames;
+  j["tools"] = nlohmann::json::array();
+  for (const ToolSummary& t : s.tools) {
+    j["tools"].push_back({{"name", t.name},
+                          {"peak_force_n", t.peak_force_n},
+                          {"mean_force_n", t.mean_force_n},
+                          {"contact_steps", t.contact_steps}});
+  }
+  j["segments"] = nlohmann::json::array();
+  for (const SegmentSummary& g : s.segments) {
+    j["segments"].push_back({{"body", g.body},
+                             {"name", g.name},
+                             {"contacts", g.contacts},
+                             {"peak_force_n", g.peak_force_n},
+                             {"max_deflection_m", g.max_deflection_m}});
+  }
+  std::vector<std::string> methods;
+  for (const BodyDescription& b : world.description().bodies) {
+    methods.emplace_back(to_string(b.method));
+  }
+  j["methods"] = methods;
+  j["world_build_ms"] = world.build_ms();
+  j["query_memory_bytes"] = world.query_memory_bytes();
+  return j;
+}
+
+void run(const RunArgs& args) {
+  ProgressPrinter printer;
+  const ProgressFn progress = [&printer, &args](std::string_view label, double fraction) {
+    if (!args.quiet) {
+      printer(label, fraction);
+    }
+  };
+  // Open outputs first, so a bad path fails before the run.
+  std::unique_ptr<std::ofstream> json_out;
+  if (!args.json_path.empty()) {
+    json_out = std::make_unique<std::ofstream>(args.json_path);
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": cannot open for writing");
+    }
+  }
+  std::optional<std::filesystem::path> trajectory;
+  if (!args.device.empty() && args.device != "sim") {
+    if (args.device.rfind("sim:", 0) != 0 || args.device.size() <= 4) {
+      throw CommandError("--device " + args.device +
+                         ": expected 'sim' or 'sim:FILE' (a trajectory CSV for the simulated "
+                         "device)");
+    }
+    trajectory = args.device.substr(4);
+  }
+  if (trajectory && !args.replay_path.empty()) {
+    throw CommandError("--device and --replay both choose the input: give one");
+  }
+
+  SceneLoadOptions load_options;
+  if (!args.data_dir.empty()) {
+    load_options.data_dir = args.data_dir;
+  }
+  load_options.progress = progress;
+  const Stopwatch load_watch;
+  SceneDescription scene = load_scene(args.scene, load_options);
+  if (!args.method.empty()) {
+    for (BodyDescription& b : scene.world.bodies) {
+      b.method = parse_method(args.method);
+    }
+  }
+  const DeviceProfile& profile = device_profile(scene.device.profile);
+  WorldOptions world_options;
+  // Render no stiffer than the device stays stable at (CHAI3D's published maxima).
+  world_options.max_stiffness_n_per_m = profile.max_stiffness_n_per_m;
+  report_progress(progress, "building contact structures", 0.0);
+  World world(scene.world, world_options);
+  std::size_t vertices = 0;
+  std::size_t segments = 0;
+  for (const BodyDescription& b : scene.world.bodies) {
+    for (const SegmentDescription& s : b.segments) {
+      vertices += s.mesh.vertex_count();
+      ++segments;
+    }
+  }
+  std::printf(
+      "scene        %s: %zu bodies, %zu segments, %zu vertices, %zu tool(s); loaded and "
+      "built in %.2f s (world %.0f ms, %.1f MB of query structures)\n",
+      args.scene.c_str(), scene.world.bodies.size(), segments, vertices, scene.world.tools.size(),
+      load_watch.elapsed_s(), world.build_ms(),
+      static_cast<double>(world.query_memory_bytes()) / 1e6);
+
+  std::unique_ptr<Device> device;
+  std::string device_name;
+  double duration_s = scene.run.duration_s;
+  std::optional<Recording> replayed;
+  if (!args.replay_path.empty()) {
+    replayed = read_recording(args.replay_path);
+    if (replayed->header.scene_hash != world.content_hash()) {
+      throw CommandError("--replay " + args.replay_path +
+                         ": recorded on a different scene (content hash differs)");
+    }
+    if (replayed->frames.empty()) {
+      throw CommandError("--replay " + args.replay_path + ": the recording has no frames");
+    }
+    duration_s = static_cast<double>(replayed->frames.size()) * scene.run.dt_s;
+    device = std::make_unique<ReplayDevice>(profile, replayed->frames);
+    device_name = "replay of " + args.replay_path;
+  } else {
+    auto sim = make_scene_device(scene, world, trajectory);
+    if (!(duration_s > 0.0)) {
+      duration_s = sim->duration_end_s();
+    }
+    device_name = "simulated " + profile.name +
+                  (trajectory                   ? " playing " + trajectory->string()
+                   : scene.device.has_palpation ? " (palpation script)"
+                                                : " (scene trajectory)");
+    device = std::move(sim);
+  }
+  if (!std::isnan(args.duration_s)) {
+    if (!(args.duration_s > 0.0) || !std::isfinite(args.duration_s)) {
+      throw CommandError("--duration: expected seconds > 0");
+    }
+    duration_s = args.duration_s;
+  }
+  if (!(duration_s > 0.0) || !std::isfinite(duration_s)) {
+    throw CommandError(args.scene + ": the run has no length (give --duration S)");
+  }
+  std::printf("device       %s; %.3f s at %.0f Hz%s\n", device_name.c_str(), duration_s,
+              1.0 / scene.run.dt_s, args.realtime ? " in real time" : " as fast as possible");
+
+  // A replay without --record still records, to a temporary file, to compare bit for bit.
+  std::filesystem::path record_path = args.record_path;
+  bool temporary_record = false;
+  if (record_path.empty() && replayed) {
+    record_path = std::filesystem::temp_directory_path() /
+                  ("hapsim_replay_" + std::to_string(::getpid()) + ".rec");
+    temporary_record = true;
+  }
+  std::unique_ptr<SessionRecorder> recorder;
+  if (!record_path.empty()) {
+    recorder = std::make_unique<SessionRecorder>(record_path, world.content_hash(), 8192);
+  }
+
+  SessionOptions options;
+  options.duration_s = duration_s;
+  options.dt_s = scene.run.dt_s;
+  options.realtime = args.realtime;
+  options.recorder = recorder.get();
+  options.progress = progress;
+  const SessionSummary summary = run_session(world, *device, options);
+  if (recorder) {
+    recorder->close();
+  }
+  std::cout << format_session_summary(summary);
+
+  bool failed = false;
+  nlohmann::json j = summary_json(scene, world, summary, device_name);
+  if (replayed) {
+    const Recording again = read_recording(record_path);
+    const RecordingDifference d = compare_recordings(*replayed, again);
+    j["replay_identical"] = d.identical;
+    if (d.identical) {
+      std::printf("replay       identical to %s, bit for bit (%zu frames)\n",
+                  args.replay_path.c_str(), again.frames.size());
+    } else {
+      std::printf("replay       DIFFERS from %s: %s\n", args.replay_path.c_str(),
+                  d.message.c_str());
+      j["replay_difference"] = d.message;
+      failed = true;
+    }
+    if (temporary_record) {
+      std::error_code ec;
+      std::filesystem::remove(record_path, ec);
+    }
+  } else if (recorder) {
+    std::printf("recorded     %s (%zu frames)\n", record_path.string().c_str(),
+                recorder->frames_written());
+  }
+  if (summary.pop_throughs > 0) {
+    std::printf("FAILED: %zu pop-through(s): a proxy entered a closed segment\n",
+                summary.pop_throughs);
+    failed = true;
+  }
+  if (summary.max_force_limit_violations > 0) {
+    std::printf("FAILED: %zu command(s) above the device's rated force\n",
+                summary.max_force_limit_violations);
+    failed = true;
+  }
+  j["ok"] = !failed;
+  if (json_out) {
+    *json_out << j.dump(2) << '\n';
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": write failed");
+    }
+    std::printf("wrote        %s\n", args.json_path.c_str());
+  }
+  if (failed) {
+    exit_status() = 1;
+  }
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app) {
+  auto args = std::make_shared<RunArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "run", "Run a scene: the haptic step at 1 kHz driven by the simulated device");
+  cmd->add_option("scene", args->scene, "Scene file (JSON, see docs/scene-format.md)")->required();
+  cmd->add_option("--device", args->device,
+                  "sim (the scene's own trajectory or palpation script) or sim:FILE (play a "
+                  "trajectory CSV)");
+  cmd->add_option("--duration", args->duration_s,
+                  "Simulated seconds (default: the scene's run.duration_s, else until the "
+                  "trajectory ends)");
+  cmd->add_option("--record", args->record_path, "Record every cycle to FILE (binary)");
+  cmd->add_option("--replay", args->replay_path,
+                  "Drive the world with a recording's inputs and check the run reproduces it "
+                  "bit for bit");
+  cmd->add_option("--json", args->json_path, "Write the summary as JSON to FILE");
+  cmd->add_option("--method", args->method, "Override every body's contact method")
+      ->check(CLI::IsMember({"exact", "spheretree", "knee"}));
+  cmd->add_option("--data", args->data_dir,
+                  "Real-data folder for scenes that use one (e.g. ../shared/data/knee_vhf_left)");
+  cmd->add_flag("--realtime", args->realtime,
+                "Sleep to an absolute 1 kHz deadline instead of running as fast as possible");
+  cmd->add_flag("-q,--quiet", args->quiet, "No progress lines");
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace hapsim::app

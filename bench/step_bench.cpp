@@ -1,0 +1,74 @@
+// Google Benchmark view of the haptic step (bench/step_cases.h): one benchmark per case and
+// contact method, named "step/<case>/<method>"; each iteration is one World::step on the next
+// sample of the scene's palpation script (looping), so deformation and proxy state evolve as in a
+// session. For the p50/p99 table and JSON, use `hapsim bench step`.
+#include "bench/collision_cases.h"
+#include "bench/step_cases.h"
+
+#include "hapsim/device/device_profile.h"
+#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/scene_file.h"
+#include "hapsim/world/world.h"
+
+#include <benchmark/benchmark.h>
+
+#include <iostream>
+#include <memory>
+#include <string>
+
+namespace {
+
+using namespace hapsim;
+
+void run_case(benchmark::State& state, const bench::StepBenchCase& c, ContactMethod method) {
+  SceneLoadOptions load;
+  if (c.data_dir) {
+    load.data_dir = *c.data_dir;
+  }
+  const SceneDescription scene = load_scene(c.scene, load);
+  WorldDescription description = scene.world;
+  for (BodyDescription& b : description.bodies) {
+    b.method = method;
+  }
+  WorldOptions options;
+  options.max_stiffness_n_per_m = device_profile(scene.device.profile).max_stiffness_n_per_m;
+  World world(std::move(description), options);
+  auto device = make_scene_device(scene, world);
+  const double dt = scene.run.dt_s;
+  const double end_s = device->duration_end_s();
+  double t = 0.0;
+  for (auto _ : state) {
+    const DeviceInput input = device->read(t);
+    const StepResult& r = world.step(input, dt);
+    benchmark::DoNotOptimize(r.command.force_world_n.data());
+    t += dt;
+    if (t > end_s) {
+      t = 0.0;
+    }
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  const auto cases =
+      bench::default_step_cases(bench::default_scenes_dir(), bench::default_data_dir());
+  if (cases.size() < 2) {
+    std::cerr << "hapsim_step_bench: no real-data folder (set HAPSIM_DATA): VHF case skipped\n";
+  }
+  const std::pair<const char*, ContactMethod> methods[] = {
+      {"exact", ContactMethod::kExact},
+      {"spheretree", ContactMethod::kSphereTree},
+      {"knee", ContactMethod::kKnee}};
+  for (const auto& c : cases) {
+    for (const auto& [name, method] : methods) {
+      benchmark::RegisterBenchmark(("step/" + c.name + "/" + name).c_str(),
+                                   [c, m = method](benchmark::State& s) { run_case(s, c, m); })
+          ->Unit(benchmark::kMicrosecond);
+    }
+  }
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,165 @@
+#include "bench/step_cases.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/device/device_profile.h"
+#include "hapsim/runtime/session.h"
+#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/scene_file.h"
+#include "hapsim/world/world.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <sstream>
+
+namespace hapsim::bench {
+namespace {
+
+ContactMethod method_from_name(const std::string& name) {
+  if (name == "exact") {
+    return ContactMethod::kExact;
+  }
+  if (name == "spheretree") {
+    return ContactMethod::kSphereTree;
+  }
+  if (name == "knee") {
+    return ContactMethod::kKnee;
+  }
+  throw Error("--methods", "unknown method '" + name + "', expected exact, spheretree or knee");
+}
+
+}  // namespace
+
+std::filesystem::path default_scenes_dir() {
+  return HAPSIM_BENCH_SCENES_DIR;
+}
+
+std::vector<StepBenchCase> default_step_cases(
+    const std::filesystem::path& scenes_dir, const std::optional<std::filesystem::path>& data_dir) {
+  std::vector<StepBenchCase> cases;
+  cases.push_back({"knee-1-finger", scenes_dir / "knee.json", std::nullopt});
+  if (data_dir && std::filesystem::is_directory(*data_dir / "knee_vhf_left")) {
+    cases.push_back({"vhf-5-fingers", scenes_dir / "knee_vhf.json", *data_dir / "knee_vhf_left"});
+  }
+  return cases;
+}
+
+std::vector<StepRow> run_step_bench(const StepBenchOptions& options) {
+  std::vector<std::string> methods = options.methods;
+  if (methods.empty()) {
+    methods = {"exact", "spheretree", "knee"};
+  }
+  // Exact first: the other rows are compared with it.
+  std::stable_partition(methods.begin(), methods.end(),
+                        [](const std::string& m) { return m == "exact"; });
+  std::vector<StepRow> rows;
+  const double total = static_cast<double>(options.cases.size() * methods.size());
+  std::size_t done = 0;
+  for (const StepBenchCase& c : options.cases) {
+    SceneLoadOptions load;
+    if (c.data_dir) {
+      load.data_dir = *c.data_dir;
+    }
+    const SceneDescription scene = load_scene(c.scene, load);
+    const StepRow* exact_row = nullptr;
+    std::size_t first_row = rows.size();
+    for (const std::string& method : methods) {
+      report_progress(options.progress, c.name + " / " + method, static_cast<double>(done) / total);
+      WorldDescription description = scene.world;
+      for (BodyDescription& b : description.bodies) {
+        b.method = method_from_name(method);
+      }
+      const DeviceProfile& profile = device_profile(scene.device.profile);
+      WorldOptions world_options;
+      world_options.max_stiffness_n_per_m = profile.max_stiffness_n_per_m;
+      World world(std::move(description), world_options);
+      auto device = make_scene_device(scene, world);
+      SessionOptions session;
+      session.dt_s = scene.run.dt_s;
+      session.duration_s = options.duration_s > 0.0     ? options.duration_s
+                           : scene.run.duration_s > 0.0 ? scene.run.duration_s
+                                                        : device->duration_end_s();
+      const SessionSummary s = run_session(world, *device, session);
+
+      StepRow row;
+      row.case_name = c.name;
+      row.method = method;
+      row.tools = world.description().tools.size();
+      row.segments = world.flat_segment_count();
+      for (const BodyDescription& b : world.description().bodies) {
+        for (const SegmentDescription& seg : b.segments) {
+          row.vertices += seg.mesh.vertex_count();
+        }
+      }
+      row.steps = s.steps;
+      row.build_ms = world.build_ms();
+      row.memory_bytes = world.query_memory_bytes();
+      row.p50_us = s.step_us.p50;
+      row.p99_us = s.step_us.p99;
+      row.max_us = s.step_us.max;
+      row.mean_us = s.step_us.mean;
+      for (const ToolSummary& t : s.tools) {
+        row.contact_steps += t.contact_steps;
+        row.peak_force_n = std::max(row.peak_force_n, t.peak_force_n);
+      }
+      row.pop_throughs = s.pop_throughs;
+      rows.push_back(row);
+      ++done;
+    }
+    for (std::size_t i = first_row; i < rows.size(); ++i) {
+      if (rows[i].method == "exact") {
+        exact_row = &rows[i];
+      }
+    }
+    if (exact_row != nullptr) {
+      for (std::size_t i = first_row; i < rows.size(); ++i) {
+        rows[i].p50_ratio_to_exact = rows[i].p50_us / exact_row->p50_us;
+        rows[i].p99_ratio_to_exact = rows[i].p99_us / exact_row->p99_us;
+      }
+    }
+  }
+  report_progress(options.progress, "done", 1.0);
+  return rows;
+}
+
+std::string format_step_table(const std::vector<StepRow>& rows) {
+  std::ostringstream out;
+  char line[320];
+  std::snprintf(line, sizeof line, "%-15s %-11s %5s %8s %7s %9s %8s %8s %8s %8s %9s %9s %8s %5s\n",
+                "case", "method", "tools", "vertices", "steps", "build_ms", "mem_MB", "p50_us",
+                "p99_us", "max_us", "p50/exact", "p99/exact", "contact", "pops");
+  out << line;
+  for (const StepRow& r : rows) {
+    std::snprintf(
+        line, sizeof line,
+        "%-15s %-11s %5zu %8zu %7zu %9.1f %8.2f %8.2f %8.2f %8.1f %9.2f %9.2f %8zu %5zu\n",
+        r.case_name.c_str(), r.method.c_str(), r.tools, r.vertices, r.steps, r.build_ms,
+        static_cast<double>(r.memory_bytes) / 1e6, r.p50_us, r.p99_us, r.max_us,
+        r.p50_ratio_to_exact, r.p99_ratio_to_exact, r.contact_steps, r.pop_throughs);
+    out << line;
+  }
+  return out.str();
+}
+
+nlohmann::json step_rows_to_json(const std::vector<StepRow>& rows) {
+  nlohmann::json j = nlohmann::json::array();
+  for (const StepRow& r : rows) {
+    j.push_back({{"case", r.case_name},
+                 {"method", r.method},
+                 {"tools", r.tools},
+                 {"segments", r.segments},
+                 {"vertices", r.vertices},
+                 {"steps", r.steps},
+                 {"build_ms", r.build_ms},
+                 {"memory_bytes", r.memory_bytes},
+                 {"step_us",
+                  {{"p50", r.p50_us}, {"p99", r.p99_us}, {"max", r.max_us}, {"mean", r.mean_us}}},
+                 {"p50_ratio_to_exact", r.p50_ratio_to_exact},
+                 {"p99_ratio_to_exact", r.p99_ratio_to_exact},
+                 {"contact_steps", r.contact_steps},
+                 {"pop_throughs", r.pop_throughs},
+                 {"peak_force_n", r.peak_force_n}});
+  }
+  return j;
+}
+
+}  // namespace hapsim::bench

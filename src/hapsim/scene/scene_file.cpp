@@ -1,0 +1,855 @@
+#include "hapsim/scene/scene_file.h"
+
+#include "hapsim/core/data_dir.h"
+#include "hapsim/core/error.h"
+#include "hapsim/device/device_profile.h"
+#include "hapsim/geometry/mesh_io.h"
+#include "hapsim/geometry/procedural.h"
+#include "hapsim/geometry/procedural_knee.h"
+#include "hapsim/world/device_io.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+
+namespace hapsim {
+namespace {
+
+using Json = nlohmann::json;
+
+std::string type_name(const Json& j) {
+  switch (j.type()) {
+    case Json::value_t::null:
+      return "null";
+    case Json::value_t::object:
+      return "an object";
+    case Json::value_t::array:
+      return "an array";
+    case Json::value_t::string:
+      return "a string";
+    case Json::value_t::boolean:
+      return "a boolean";
+    case Json::value_t::number_integer:
+    case Json::value_t::number_unsigned:
+    case Json::value_t::number_float:
+      return "a number";
+    default:
+      return "something else";
+  }
+}
+
+std::string shown(const Json& j) {
+  std::string s = j.dump();
+  if (s.size() > 40) {
+    s = s.substr(0, 37) + "...";
+  }
+  return s;
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+// JSON pointer escaping (RFC 6901) for keys that contain '/' or '~'.
+std::string escape_key(const std::string& key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') {
+      out += "~0";
+    } else if (c == '/') {
+      out += "~1";
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+// The parser: carries the file name for messages, the folders paths resolve against, and the
+// materials and bodies read so far for cross-references.
+class Parser {
+ public:
+  Parser(std::filesystem::path file, const SceneLoadOptions& options)
+      : file_(std::move(file)), options_(options) {}
+
+  SceneDescription parse(const Json& root);
+
+ private:
+  [[noreturn]] void fail(const std::string& ptr, const std::string& what) const {
+    throw Error(file_.string() + ":" + (ptr.empty() ? "/" : ptr), what);
+  }
+
+  static std::string at(const std::string& ptr, const std::string& key) {
+    return ptr + "/" + escape_key(key);
+  }
+  static std::string at(const std::string& ptr, std::size_t index) {
+    return ptr + "/" + std::to_string(index);
+  }
+
+  const Json& object(const Json& j, const std::string& ptr, const std::string& what) const {
+    if (!j.is_object()) {
+      fail(ptr, "expected " + what + " (a JSON object), got " + type_name(j));
+    }
+    return j;
+  }
+  const Json& array(const Json& j, const std::string& ptr, const std::string& what) const {
+    if (!j.is_array()) {
+      fail(ptr, "expected " + what + " (a JSON array), got " + type_name(j));
+    }
+    return j;
+  }
+
+  void allow_keys(const Json& obj, const std::string& ptr,
+                  std::initializer_list<const char*> allowed) const {
+    for (const auto& [key, value] : obj.items()) {
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
+        std::string list;
+        for (const char* a : allowed) {
+          list += (list.empty() ? "" : ", ") + std::string(a);
+        }
+        fail(at(ptr, key), "unknown key '" + key + "'; allowed here: " + list);
+      }
+    }
+  }
+
+  const Json& required(const Json& obj, const std::string& ptr, const char* key) const {
+    if (!obj.contains(key)) {
+      fail(ptr, std::string("missing required key '") + key + "'");
+    }
+    return obj.at(key);
+  }
+
+  double number(const Json& j, const std::string& ptr, const std::string& unit) const {
+    if (!j.is_number()) {
+      fail(ptr, "expected a number" + (unit.empty() ? "" : " in " + unit) + ", got " +
+                    type_name(j) + " " + shown(j));
+    }
+    const double v = j.get<double>();
+    if (!std::isfinite(v)) {
+      fail(ptr, "expected a finite number" + (unit.empty() ? "" : " in " + unit));
+    }
+    return v;
+  }
+
+  // A number in [lo, hi] (open at lo when lo_open), or the default when the key is absent.
+  double number_in(const Json& obj, const std::string& ptr, const char* key, double fallback,
+                   double lo, double hi, const std::string& unit, bool lo_open = false,
+                   bool inf_allowed = false) const {
+    if (!obj.contains(key)) {
+      return fallback;
+    }
+    const std::string p = at(ptr, key);
+    const Json& j = obj.at(key);
+    if (inf_allowed && j.is_string() && j.get<std::string>() == "inf") {
+      return kInf;
+    }
+    const double v = number(j, p, unit);
+    if (v < lo || (lo_open && v == lo) || v > hi) {
+      std::ostringstream range;
+      range << (lo_open ? "> " : ">= ") << lo;
+      if (std::isfinite(hi)) {
+        range << " and <= " << hi;
+      }
+      fail(p, "expected a number " + range.str() + (unit.empty() ? "" : " in " + unit) + ", got " +
+                  shown(j));
+    }
+    return v;
+  }
+
+  std::string string(const Json& j, const std::string& ptr, const std::string& what) const {
+    if (!j.is_string()) {
+      fail(ptr, "expected " + what + " (a string), got " + type_name(j));
+    }
+    return j.get<std::string>();
+  }
+
+  std::string nonempty_string(const Json& j, const std::string& ptr,
+                              const std::string& what) const {
+    std::string s = string(j, ptr, what);
+    if (s.empty()) {
+      fail(ptr, "expected " + what + ", got an empty string");
+    }
+    return s;
+  }
+
+  std::string one_of(const Json& j, const std::string& ptr,
+                     std::initializer_list<const char*> choices) const {
+    std::string list;
+    for (const char* c : choices) {
+      list += (list.empty() ? "'" : ", '") + std::string(c) + "'";
+    }
+    if (j.is_string()) {
+      const std::string s = j.get<std::string>();
+      for (const char* c : choices) {
+        if (s == c) {
+          return s;
+        }
+      }
+    }
+    fail(ptr, "expected one of " + list + ", got " + shown(j));
+  }
+
+  Vec3 vec3(const Json& j, const std::string& ptr, const std::string& unit) const {
+    if (!j.is_array() || j.size() != 3) {
+      fail(ptr, "expected [x, y, z] (3 numbers" + (unit.empty() ? "" : " in " + unit) + "), got " +
+                    shown(j));
+    }
+    Vec3 v;
+    for (std::size_t i = 0; i < 3; ++i) {
+      v[static_cast<Eigen::Index>(i)] = number(j[i], at(ptr, i), unit);
+    }
+    return v;
+  }
+
+  std::filesystem::path path(const Json& j, const std::string& ptr, const std::string& what) {
+    const std::string s = nonempty_string(j, ptr, what);
+    if (s.rfind("data:", 0) == 0) {
+      return data_dir(ptr) / s.substr(5);
+    }
+    const std::filesystem::path p(s);
+    return p.is_absolute() ? p : file_.parent_path() / p;
+  }
+
+  std::filesystem::path data_dir(const std::string& ptr) {
+    if (!options_.data_dir.empty()) {
+      if (!std::filesystem::is_directory(options_.data_dir)) {
+        fail(ptr, "the data folder " + options_.data_dir.string() + " does not exist");
+      }
+      return options_.data_dir;
+    }
+    // ../shared/data beside the checkout holding scenes/: <checkout>/scenes/x.json.
+    const std::filesystem::path beside =
+        std::filesystem::absolute(file_).parent_path().parent_path().parent_path() / "shared" /
+        "data";
+    const std::optional<std::filesystem::path> root = find_data_dir(beside);
+    if (!root) {
+      fail(ptr, "needs the real-data folder: set HAPSIM_DATA or give --data DIR (looked in " +
+                    beside.lexically_normal().string() + ")");
+    }
+    const std::filesystem::path dir = *root / data_default_;
+    if (!std::filesystem::is_directory(dir)) {
+      fail(ptr,
+           "needs the data folder " + dir.string() + ", which does not exist; give --data DIR");
+    }
+    return dir;
+  }
+
+  void parse_materials(const Json& j, const std::string& ptr, WorldDescription& world);
+  void parse_body(const Json& j, const std::string& ptr, WorldDescription& world);
+  void parse_geometry(const Json& j, const std::string& ptr, BodyDescription& body,
+                      std::vector<std::optional<TissueKind>>& tissues);
+  void parse_body_materials(const Json& j, const std::string& ptr, BodyDescription& body,
+                            const std::vector<std::optional<TissueKind>>& tissues);
+  Iso3 parse_pose(const Json& j, const std::string& ptr) const;
+  ToolDescription parse_tool(const Json& j, const std::string& ptr) const;
+  void parse_device(const Json& j, const std::string& ptr, SceneDescription& scene);
+  std::uint32_t material_ref(const Json& j, const std::string& ptr) const;
+
+  std::filesystem::path file_;
+  SceneLoadOptions options_;
+  std::string data_default_;
+  std::map<std::string, std::uint32_t> material_index_;
+};
+
+SceneDescription Parser::parse(const Json& root) {
+  object(root, "", "a scene");
+  allow_keys(root, "",
+             {"$schema", "format", "description", "data", "world", "materials", "bodies", "tools",
+              "device", "run"});
+  const Json& format = required(root, "", "format");
+  if (!format.is_string() || format.get<std::string>() != "hapsim-scene/1") {
+    fail("/format", "expected \"hapsim-scene/1\", got " + shown(format));
+  }
+  SceneDescription scene;
+  scene.file = file_;
+  if (root.contains("description")) {
+    scene.description = string(root["description"], "/description", "a description");
+  }
+  if (root.contains("data")) {
+    const Json& data = object(root["data"], "/data", "the data folder settings");
+    allow_keys(data, "/data", {"default"});
+    data_default_ = nonempty_string(required(data, "/data", "default"), "/data/default",
+                                    "a folder under the data root");
+  }
+  scene.world.name = file_.stem().string();
+  if (root.contains("world")) {
+    const Json& w = object(root["world"], "/world", "world settings");
+    allow_keys(w, "/world", {"name", "passivity_damping_factor"});
+    if (w.contains("name")) {
+      scene.world.name = nonempty_string(w["name"], "/world/name", "a world name");
+    }
+    scene.world.passivity_damping_factor =
+        number_in(w, "/world", "passivity_damping_factor", 1.0, 0.0, 100.0, "");
+  }
+  parse_materials(required(root, "", "materials"), "/materials", scene.world);
+
+  const Json& bodies = array(required(root, "", "bodies"), "/bodies", "a list of bodies");
+  if (bodies.empty()) {
+    fail("/bodies", "expected at least one body");
+  }
+  std::set<std::string> body_names;
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    report_progress(options_.progress, "scene: bodies",
+                    static_cast<double>(i) / static_cast<double>(bodies.size()));
+    parse_body(bodies[i], at("/bodies", i), scene.world);
+    if (!body_names.insert(scene.world.bodies.back().name).second) {
+      fail(at(at("/bodies", i), "name"),
+           "expected a unique body name; '" + scene.world.bodies.back().name + "' is used twice");
+    }
+  }
+
+  const Json& tools = array(required(root, "", "tools"), "/tools", "a list of tools");
+  if (tools.empty()) {
+    fail("/tools", "expected at least one tool (the device drives its tools)");
+  }
+  std::set<std::string> tool_names;
+  std::set<int> fingers;
+  for (std::size_t i = 0; i < tools.size(); ++i) {
+    scene.world.tools.push_back(parse_tool(tools[i], at("/tools", i)));
+    const ToolDescription& t = scene.world.tools.back();
+    if (!tool_names.insert(t.name).second) {
+      fail(at(at("/tools", i), "name"),
+           "expected a unique tool name; '" + t.name + "' is used twice");
+    }
+    if (t.finger >= 0 && !fingers.insert(t.finger).second) {
+      fail(at(at("/tools", i), "finger"),
+           "expected each finger actuator to drive one tool; finger " + std::to_string(t.finger) +
+               " is used twice");
+    }
+  }
+
+  parse_device(required(root, "", "device"), "/device", scene);
+
+  if (root.contains("run")) {
+    const Json& run = object(root["run"], "/run", "run settings");
+    allow_keys(run, "/run", {"duration_s", "dt_s"});
+    scene.run.duration_s = number_in(run, "/run", "duration_s", 0.0, 0.0, 86400.0, "seconds");
+    scene.run.dt_s = number_in(run, "/run", "dt_s", 0.001, 0.0, 0.01, "seconds", true);
+  }
+  // Palpation targets must name what exists.
+  if (scene.device.has_palpation) {
+    for (std::size_t i = 0; i < scene.device.palpation.targets.size(); ++i) {
+      const PalpationTargetDescription& t = scene.device.palpation.targets[i];
+      const std::string p = at("/device/palpation/targets", i);
+      const auto body = std::find_if(scene.world.bodies.begin(), scene.world.bodies.end(),
+                                     [&](const BodyDescription& b) { return b.name == t.body; });
+      if (body == scene.world.bodies.end()) {
+        fail(at(p, "body"), "expected the name of a body in /bodies, got '" + t.body + "'");
+      }
+      if (std::none_of(body->segments.begin(), body->segments.end(),
+                       [&](const SegmentDescription& s) { return s.name == t.segment; })) {
+        std::string names;
+        for (std::size_t s = 0; s < body->segments.size() && s < 40; ++s) {
+          names += (names.empty() ? "" : ", ") + body->segments[s].name;
+        }
+        fail(at(p, "segment"), "expected a segment of body '" + t.body + "' (" + names +
+                                   "), got '" + t.segment + "'");
+      }
+    }
+  }
+  report_progress(options_.progress, "scene: loaded", 1.0);
+  return scene;
+}
+
+void Parser::parse_materials(const Json& j, const std::string& ptr, WorldDescription& world) {
+  object(j, ptr, "materials by name");
+  if (j.empty()) {
+    fail(ptr, "expected at least one material");
+  }
+  for (const auto& [name, m] : j.items()) {
+    const std::string p = at(ptr, name);
+    object(m, p, "a material");
+    allow_keys(m, p,
+               {"description", "response", "stiffness_n_per_m", "max_penetration_m", "max_force_n",
+                "damping_n_s_per_m", "static_friction", "dynamic_friction", "deformation"});
+    MaterialDescription md;
+    md.name = name;
+    if (m.contains("response")) {
+      md.response = one_of(m["response"], at(p, "response"), {"proxy", "penalty"}) == "proxy"
+                        ? ContactResponse::kProxy
+                        : ContactResponse::kPenalty;
+    }
+    ContactMaterial& c = md.contact;
+    c.stiffness_n_per_m =
+        number_in(m, p, "stiffness_n_per_m", c.stiffness_n_per_m, 0.0, 1e7, "N/m", true);
+    c.max_penetration_m =
+        number_in(m, p, "max_penetration_m", c.max_penetration_m, 0.0, 1.0, "m", true);
+    c.max_force_n = number_in(m, p, "max_force_n", c.max_force_n, 0.0, 1e4, "N", true);
+    c.damping_n_s_per_m =
+        number_in(m, p, "damping_n_s_per_m", c.damping_n_s_per_m, 0.0, 1e5, "N*s/m");
+    c.static_friction = number_in(m, p, "static_friction", c.static_friction, 0.0, 10.0, "");
+    c.dynamic_friction = number_in(m, p, "dynamic_friction", c.dynamic_friction, 0.0, 10.0, "");
+    if (c.dynamic_friction > c.static_friction) {
+      fail(at(p, "dynamic_friction"), "expected dynamic friction <= static friction (" +
+                                          std::to_string(c.static_friction) + ")");
+    }
+    if (m.contains("deformation")) {
+      const std::string dp = at(p, "deformation");
+      const Json& d = object(m["deformation"], dp, "deformation parameters");
+      allow_keys(d, dp,
+                 {"elasticity_factor", "recovery_time_constant_s", "max_recovery_speed_m_per_s",
+                  "max_deflection_m"});
+      DeflectionParams& f = md.deflection;
+      f.elasticity_factor =
+          number_in(d, dp, "elasticity_factor", f.elasticity_factor, 0.0, 100.0, "", true);
+      f.recovery_time_constant_s = number_in(d, dp, "recovery_time_constant_s",
+                                             f.recovery_time_constant_s, 0.0, 3600.0, "seconds");
+      f.max_recovery_speed_m_per_s =
+          number_in(d, dp, "max_recovery_speed_m_per_s", f.max_recovery_speed_m_per_s, 0.0, kInf,
+                    "m/s", true, true);
+      f.max_deflection_m =
+          number_in(d, dp, "max_deflection_m", f.max_deflection_m, 0.0, kInf, "m", true, true);
+    }
+    material_index_[name] = static_cast<std::uint32_t>(world.materials.size());
+    world.materials.push_back(std::move(md));
+  }
+}
+
+std::uint32_t Parser::material_ref(const Json& j, const std::string& ptr) const {
+  const std::string name = nonempty_string(j, ptr, "a material name");
+  const auto it = material_index_.find(name);
+  if (it == material_index_.end()) {
+    std::string names;
+    for (const auto& [n, i] : material_index_) {
+      names += (names.empty() ? "" : ", ") + n;
+    }
+    fail(ptr, "expected the name of a material in /materials (" + names + "), got '" + name + "'");
+  }
+  return it->second;
+}
+
+Iso3 Parser::parse_pose(const Json& j, const std::string& ptr) const {
+  object(j, ptr, "a pose");
+  allow_keys(j, ptr, {"position_m", "rotation_deg", "quaternion_wxyz"});
+  Iso3 X = Iso3::Identity();
+  if (j.contains("position_m")) {
+    X.translation() = vec3(j["position_m"], at(ptr, "position_m"), "m");
+  }
+  if (j.contains("rotation_deg") && j.contains("quaternion_wxyz")) {
+    fail(ptr, "expected one of 'rotation_deg' or 'quaternion_wxyz', not both");
+  }
+  if (j.contains("rotation_deg")) {
+    const Vec3 deg = vec3(j["rotation_deg"], at(ptr, "rotation_deg"), "degrees");
+    const Vec3 rad = deg * (3.14159265358979323846 / 180.0);
+    // Fixed-axis x, then y, then z: R = Rz * Ry * Rx.
+    X.linear() =
+        (Eigen::AngleAxisd(rad.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rad.y(), Vec3::UnitY()) *
+         Eigen::AngleAxisd(rad.x(), Vec3::UnitX()))
+            .toRotationMatrix();
+  }
+  if (j.contains("quaternion_wxyz")) {
+    const std::string qp = at(ptr, "quaternion_wxyz");
+    const Json& q = j["quaternion_wxyz"];
+    if (!q.is_array() || q.size() != 4) {
+      fail(qp, "expected [w, x, y, z], got " + shown(q));
+    }
+    Quat quat(number(q[0], at(qp, std::size_t{0}), ""), number(q[1], at(qp, 1), ""),
+              number(q[2], at(qp, 2), ""), number(q[3], at(qp, 3), ""));
+    if (std::abs(quat.norm() - 1.0) > 1e-6) {
+      fail(qp, "expected a unit quaternion, got norm " + std::to_string(quat.norm()));
+    }
+    X.linear() = quat.normalized().toRotationMatrix();
+  }
+  return X;
+}
+
+void Parser::parse_body(const Json& j, const std::string& ptr, WorldDescription& world) {
+  object(j, ptr, "a body");
+  allow_keys(j, ptr, {"name", "type", "pose", "contact_method", "geometry", "materials"});
+  BodyDescription body;
+  body.name = nonempty_string(required(j, ptr, "name"), at(ptr, "name"), "a body name");
+  if (j.contains("type")) {
+    const std::string t = one_of(j["type"], at(ptr, "type"), {"static", "deformable", "dynamic"});
+    body.kind = t == "static"       ? BodyKind::kStatic
+                : t == "deformable" ? BodyKind::kDeformable
+                                    : BodyKind::kDynamic;
+  }
+  if (j.contains("pose")) {
+    body.X_world_body = parse_pose(j["pose"], at(ptr, "pose"));
+  }
+  if (j.contains("contact_method")) {
+    const std::string m =
+        one_of(j["contact_method"], at(ptr, "contact_method"), {"exact", "spheretree", "knee"});
+    body.method = m == "exact"        ? ContactMethod::kExact
+                  : m == "spheretree" ? ContactMethod::kSphereTree
+                                      : ContactMethod::kKnee;
+  }
+  std::vector<std::optional<TissueKind>> tissues;
+  parse_geometry(required(j, ptr, "geometry"), at(ptr, "geometry"), body, tissues);
+  parse_body_materials(required(j, ptr, "materials"), at(ptr, "materials"), body, tissues);
+  world.bodies.push_back(std::move(body));
+}
+
+void Parser::parse_geometry(const Json& j, const std::string& ptr, BodyDescription& body,
+                            std::vector<std::optional<TissueKind>>& tissues) {
+  object(j, ptr, "a geometry");
+  const char* kinds[] = {"procedural", "box", "sphere", "sheet", "mesh", "mesh_folder"};
+  std::string kind;
+  for (const char* k : kinds) {
+    if (j.contains(k)) {
+      if (!kind.empty()) {
+        fail(ptr, "expected exactly one geometry kind, got both '" + kind + "' and '" + k + "'");
+      }
+      kind = k;
+    }
+  }
+  if (kind.empty()) {
+    fail(ptr, "expected one geometry kind: procedural, box, sphere, sheet, mesh or mesh_folder");
+  }
+  const std::string kp = at(ptr, kind);
+  auto add = [&](std::string name, TriangleMesh mesh, std::optional<TissueKind> tissue,
+                 bool two_sided = false) {
+    SegmentDescription s;
+    s.name = std::move(name);
+    s.mesh = std::move(mesh);
+    s.two_sided = two_sided;
+    body.segments.push_back(std::move(s));
+    tissues.push_back(tissue);
+  };
+  if (kind == "procedural") {
+    allow_keys(j, ptr, {"procedural", "resolution_scale", "include_skin"});
+    one_of(j["procedural"], kp, {"knee"});
+    ProceduralKneeOptions o;
+    o.resolution_scale = number_in(j, ptr, "resolution_scale", 1.0, 0.25, 4.0, "", true);
+    if (j.contains("include_skin")) {
+      if (!j["include_skin"].is_boolean()) {
+        fail(at(ptr, "include_skin"), "expected true or false, got " + shown(j["include_skin"]));
+      }
+      o.include_skin = j["include_skin"].get<bool>();
+    }
+    report_progress(options_.progress, "scene: generating the procedural knee", 0.0);
+    for (KneePart& part : make_procedural_knee(o)) {
+      add(part.name, std::move(part.mesh), part.tissue);
+    }
+    return;
+  }
+  allow_keys(j, ptr, {kind.c_str()});
+  if (kind == "box") {
+    const Json& b = object(j[kind], kp, "box settings");
+    allow_keys(b, kp, {"half_extents_m"});
+    const Vec3 h = vec3(required(b, kp, "half_extents_m"), at(kp, "half_extents_m"), "m");
+    if (!(h.minCoeff() > 0.0)) {
+      fail(at(kp, "half_extents_m"), "expected half extents > 0 m");
+    }
+    add(body.name, make_box(h), std::nullopt);
+  } else if (kind == "sphere") {
+    const Json& s = object(j[kind], kp, "sphere settings");
+    allow_keys(s, kp, {"radius_m", "segments"});
+    if (!s.contains("radius_m")) {
+      fail(kp, "missing required key 'radius_m'");
+    }
+    const double r = number_in(s, kp, "radius_m", 0.0, 0.0, 100.0, "m", true);
+    const auto n = static_cast<int>(number_in(s, kp, "segments", 64, 8, 1024, ""));
+    add(body.name, make_uv_sphere(r, n, n / 2), std::nullopt);
+  } else if (kind == "sheet") {
+    const Json& s = object(j[kind], kp, "sheet settings");
+    allow_keys(s, kp, {"size_m", "nodes_per_side"});
+    if (!s.contains("size_m")) {
+      fail(kp, "missing required key 'size_m'");
+    }
+    const double size = number_in(s, kp, "size_m", 0.0, 0.0, 100.0, "m", true);
+    const auto n = static_cast<int>(number_in(s, kp, "nodes_per_side", 32, 2, 2048, ""));
+    add(body.name, make_sheet(n, size), std::nullopt, true);
+  } else if (kind == "mesh" || kind == "mesh_folder") {
+    const Json& m = object(j[kind], kp, kind + " settings");
+    if (kind == "mesh") {
+      allow_keys(m, kp, {"file", "scale"});
+    } else {
+      allow_keys(m, kp, {"folder", "pattern", "scale", "strip_prefix", "strip_suffix"});
+    }
+    MeshLoadOptions lo;
+    lo.scale = number_in(m, kp, "scale", 1.0, 0.0, 1e6, "metres per file unit", true);
+    auto load = [&](const std::filesystem::path& file, const std::string& p) {
+      try {
+        return load_mesh(file, lo);
+      } catch (const Error& e) {
+        fail(p, "cannot load mesh " + e.where() + ": " + e.detail());
+      }
+    };
+    if (kind == "mesh") {
+      const std::string fp = at(kp, "file");
+      const std::filesystem::path file = path(required(m, kp, "file"), fp, "a mesh file path");
+      add(body.name, load(file, fp), std::nullopt);
+    } else {
+      const std::string fp = at(kp, "folder");
+      const std::filesystem::path folder = path(required(m, kp, "folder"), fp, "a folder path");
+      if (!std::filesystem::is_directory(folder)) {
+        fail(fp, "expected a folder of mesh files; " + folder.string() + " is not a folder");
+      }
+      std::string pattern = "*.stl";
+      if (m.contains("pattern")) {
+        pattern = nonempty_string(m["pattern"], at(kp, "pattern"), "a file pattern like *.stl");
+        if (pattern.rfind("*", 0) != 0 || pattern.find('*', 1) != std::string::npos) {
+          fail(at(kp, "pattern"), "expected '*' followed by a file-name ending, e.g. '*.stl'");
+        }
+      }
+      const std::string ending = lower(pattern.substr(1));
+      const std::string prefix = m.contains("strip_prefix")
+                                     ? string(m["strip_prefix"], at(kp, "strip_prefix"), "text")
+                                     : "";
+      const std::string suffix = m.contains("strip_suffix")
+                                     ? string(m["strip_suffix"], at(kp, "strip_suffix"), "text")
+                                     : "";
+      std::vector<std::filesystem::path> files;
+      for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+        const std::string name = lower(entry.path().filename().string());
+        if (entry.is_regular_file() && name.size() >= ending.size() &&
+            name.compare(name.size() - ending.size(), ending.size(), ending) == 0) {
+          files.push_back(entry.path());
+        }
+      }
+      std::sort(files.begin(), files.end());
+      if (files.empty()) {
+        fail(fp, "no file matching '" + pattern + "' in " + folder.string());
+      }
+      std::set<std::string> names;
+      for (std::size_t i = 0; i < files.size(); ++i) {
+        report_progress(options_.progress, "scene: loading " + files[i].filename().string(),
+                        static_cast<double>(i) / static_cast<double>(files.size()));
+        std::string name = files[i].stem().string();
+        if (!prefix.empty() && name.rfind(prefix, 0) == 0) {
+          name = name.substr(prefix.size());
+        }
+        if (!suffix.empty() && name.size() > suffix.size() &&
+            name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+          name = name.substr(0, name.size() - suffix.size());
+        }
+        if (!names.insert(name).second) {
+          fail(fp, "two files give the segment name '" + name + "'");
+        }
+        add(name, load(files[i], fp), std::nullopt);
+      }
+    }
+  }
+}
+
+void Parser::parse_body_materials(const Json& j, const std::string& ptr, BodyDescription& body,
+                                  const std::vector<std::optional<TissueKind>>& tissues) {
+  // A plain string: one material for every segment.
+  if (j.is_string()) {
+    const std::uint32_t m = material_ref(j, ptr);
+    for (SegmentDescription& s : body.segments) {
+      s.material = m;
+    }
+    return;
+  }
+  object(j, ptr, "a material name or material rules");
+  allow_keys(j, ptr, {"default", "by_tissue", "by_name", "segments"});
+  std::optional<std::uint32_t> fallback;
+  if (j.contains("default")) {
+    fallback = material_ref(j["default"], at(ptr, "default"));
+  }
+  std::map<std::string, std::uint32_t> by_tissue;
+  if (j.contains("by_tissue")) {
+    const std::string tp = at(ptr, "by_tissue");
+    for (const auto& [tissue, name] : object(j["by_tissue"], tp, "materials by tissue").items()) {
+      const char* known[] = {"bone", "cartilage", "muscle", "tendon", "ligament", "skin"};
+      if (std::none_of(std::begin(known), std::end(known),
+                       [&](const char* k) { return tissue == k; })) {
+        fail(at(tp, tissue), "unknown tissue '" + tissue +
+                                 "'; expected bone, cartilage, muscle, tendon, ligament or skin");
+      }
+      by_tissue[tissue] = material_ref(name, at(tp, tissue));
+    }
+  }
+  std::vector<std::pair<std::string, std::uint32_t>> by_name;
+  if (j.contains("by_name")) {
+    const std::string np = at(ptr, "by_name");
+    const Json& rules = array(j["by_name"], np, "name rules");
+    for (std::size_t i = 0; i < rules.size(); ++i) {
+      const std::string rp = at(np, i);
+      object(rules[i], rp, "a name rule {contains, material}");
+      allow_keys(rules[i], rp, {"contains", "material"});
+      const std::string text =
+          nonempty_string(required(rules[i], rp, "contains"), at(rp, "contains"), "text");
+      by_name.emplace_back(lower(text),
+                           material_ref(required(rules[i], rp, "material"), at(rp, "material")));
+    }
+  }
+  std::map<std::string, std::uint32_t> by_segment;
+  if (j.contains("segments")) {
+    const std::string sp = at(ptr, "segments");
+    for (const auto& [name, m] : object(j["segments"], sp, "materials by segment").items()) {
+      if (std::none_of(body.segments.begin(), body.segments.end(),
+                       [&](const SegmentDescription& s) { return s.name == name; })) {
+        fail(at(sp, name),
+             "expected the name of a segment of body '" + body.name + "', got '" + name + "'");
+      }
+      by_segment[name] = material_ref(m, at(sp, name));
+    }
+  }
+  // Most specific first: the segment's own entry, a name rule, its tissue, the default.
+  for (std::size_t i = 0; i < body.segments.size(); ++i) {
+    SegmentDescription& s = body.segments[i];
+    if (const auto it = by_segment.find(s.name); it != by_segment.end()) {
+      s.material = it->second;
+      continue;
+    }
+    const std::string name = lower(s.name);
+    const auto rule = std::find_if(by_name.begin(), by_name.end(), [&](const auto& r) {
+      return name.find(r.first) != std::string::npos;
+    });
+    if (rule != by_name.end()) {
+      s.material = rule->second;
+      continue;
+    }
+    if (tissues[i]) {
+      if (const auto it = by_tissue.find(std::string(tissue_kind_name(*tissues[i])));
+          it != by_tissue.end()) {
+        s.material = it->second;
+        continue;
+      }
+    }
+    if (!fallback) {
+      fail(ptr, "segment '" + s.name + "' gets no material: add a 'default' or a rule for it");
+    }
+    s.material = *fallback;
+  }
+}
+
+ToolDescription Parser::parse_tool(const Json& j, const std::string& ptr) const {
+  object(j, ptr, "a tool");
+  allow_keys(j, ptr, {"name", "radius_m", "offset_m", "finger"});
+  ToolDescription t;
+  t.name = nonempty_string(required(j, ptr, "name"), at(ptr, "name"), "a tool name");
+  t.radius_m = number_in(j, ptr, "radius_m", t.radius_m, 0.0, 0.1, "m");
+  if (j.contains("offset_m")) {
+    t.offset_device = vec3(j["offset_m"], at(ptr, "offset_m"), "m");
+  }
+  if (j.contains("finger")) {
+    const std::string fp = at(ptr, "finger");
+    const Json& f = j["finger"];
+    if (!f.is_number_integer() || f.get<int>() < -1 || f.get<int>() >= kMaxFingers) {
+      fail(fp, "expected -1 (the tip force) or a finger index 0.." +
+                   std::to_string(kMaxFingers - 1) + ", got " + shown(f));
+    }
+    t.finger = f.get<int>();
+  }
+  return t;
+}
+
+void Parser::parse_device(const Json& j, const std::string& ptr, SceneDescription& scene) {
+  object(j, ptr, "the device");
+  allow_keys(j, ptr, {"type", "profile", "trajectory", "palpation"});
+  DeviceDescription& d = scene.device;
+  if (j.contains("type")) {
+    d.type = one_of(j["type"], at(ptr, "type"), {"simulated"});
+  }
+  if (j.contains("profile")) {
+    d.profile = nonempty_string(j["profile"], at(ptr, "profile"), "a device profile name");
+    const auto names = device_profile_names();
+    if (std::find(names.begin(), names.end(), d.profile) == names.end()) {
+      std::string list;
+      for (const auto& n : names) {
+        list += (list.empty() ? "" : ", ") + n;
+      }
+      fail(at(ptr, "profile"), "expected one of " + list + ", got '" + d.profile + "'");
+    }
+  }
+  for (const ToolDescription& t : scene.world.tools) {
+    if (t.finger >= 0 && t.finger >= device_profile(d.profile).finger_count) {
+      fail(at(ptr, "profile"), "device '" + d.profile + "' has " +
+                                   std::to_string(device_profile(d.profile).finger_count) +
+                                   " finger actuator(s); tool '" + t.name + "' uses finger " +
+                                   std::to_string(t.finger));
+    }
+  }
+  if (j.contains("trajectory") == j.contains("palpation")) {
+    fail(ptr, "expected exactly one of 'trajectory' (a CSV file) or 'palpation' (a script)");
+  }
+  if (j.contains("trajectory")) {
+    d.trajectory_file = path(j["trajectory"], at(ptr, "trajectory"), "a trajectory CSV path");
+    if (!std::filesystem::is_regular_file(d.trajectory_file)) {
+      fail(at(ptr, "trajectory"), "no such file: " + d.trajectory_file.string());
+    }
+    return;
+  }
+  const std::string pp = at(ptr, "palpation");
+  const Json& p = object(j["palpation"], pp, "a palpation script");
+  allow_keys(p, pp, {"standoff_m", "move_s", "approach_s", "press_s", "release_s", "targets"});
+  d.has_palpation = true;
+  PalpationScriptDescription& s = d.palpation;
+  s.standoff_m = number_in(p, pp, "standoff_m", s.standoff_m, 0.0, 1.0, "m");
+  s.move_s = number_in(p, pp, "move_s", s.move_s, 0.0, 60.0, "seconds", true);
+  s.approach_s = number_in(p, pp, "approach_s", s.approach_s, 0.0, 60.0, "seconds", true);
+  s.press_s = number_in(p, pp, "press_s", s.press_s, 0.0, 60.0, "seconds", true);
+  s.release_s = number_in(p, pp, "release_s", s.release_s, 0.0, 60.0, "seconds", true);
+  const std::string tp = at(pp, "targets");
+  const Json& targets = array(required(p, pp, "targets"), tp, "palpation targets");
+  if (targets.empty()) {
+    fail(tp, "expected at least one target");
+  }
+  for (std::size_t i = 0; i < targets.size(); ++i) {
+    const std::string ip = at(tp, i);
+    const Json& t = object(targets[i], ip, "a palpation target");
+    allow_keys(t, ip, {"body", "segment", "from", "depth_m", "hold_s"});
+    PalpationTargetDescription target;
+    target.body = nonempty_string(required(t, ip, "body"), at(ip, "body"), "a body name");
+    target.segment =
+        nonempty_string(required(t, ip, "segment"), at(ip, "segment"), "a segment name");
+    target.from_world = vec3(required(t, ip, "from"), at(ip, "from"), "");
+    if (!(target.from_world.norm() > 1e-9)) {
+      fail(at(ip, "from"), "expected a non-zero direction (from the segment towards the probe)");
+    }
+    target.from_world.normalize();
+    target.depth_m = number_in(t, ip, "depth_m", target.depth_m, 0.0, 0.1, "m");
+    target.hold_s = number_in(t, ip, "hold_s", target.hold_s, 0.0, 60.0, "seconds");
+    s.targets.push_back(target);
+  }
+}
+
+// 1-based line and column of a byte offset, for JSON syntax errors.
+std::string line_column(std::string_view text, std::size_t byte) {
+  byte = std::min(byte, text.size());
+  std::size_t line = 1;
+  std::size_t column = 1;
+  for (std::size_t i = 0; i < byte; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return std::to_string(line) + ":" + std::to_string(column);
+}
+
+}  // namespace
+
+SceneDescription parse_scene(std::string_view json_text, const std::filesystem::path& file,
+                             const SceneLoadOptions& options) {
+  Json root;
+  try {
+    root = Json::parse(json_text.begin(), json_text.end());
+  } catch (const Json::parse_error& e) {
+    // e.byte is one past the offending character.
+    const std::size_t byte = e.byte > 0 ? e.byte - 1 : 0;
+    std::string what = e.what();
+    if (const auto pos = what.find("syntax error"); pos != std::string::npos) {
+      what = what.substr(pos);
+    }
+    throw Error(file.string() + ":" + line_column(json_text, byte), "invalid JSON: " + what);
+  }
+  return Parser(file, options).parse(root);
+}
+
+SceneDescription load_scene(const std::filesystem::path& file, const SceneLoadOptions& options) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in || std::filesystem::is_directory(file)) {
+    throw Error(file.string(), "cannot open the scene file (missing or unreadable)");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), file, options);
+}
+
+}  // namespace hapsim

@@ -1,0 +1,35 @@
+// Reading scene files ("format": "hapsim-scene/1", docs/scene-format.md, scenes/scene.schema.json)
+// into a SceneDescription: materials, bodies and their geometry (procedural knee, box, sphere,
+// sheet, a mesh file, or a folder of mesh files, one segment each), tools, the device and the
+// run. Every error is a hapsim::Error whose where() is "<file>:<JSON pointer>" and whose message
+// says what was expected; unknown keys are errors; a load either returns a complete description
+// or throws (nothing half-loads).
+#pragma once
+
+#include "hapsim/core/progress.h"
+#include "hapsim/scene/scene_description.h"
+
+#include <filesystem>
+#include <string_view>
+
+namespace hapsim {
+
+struct SceneLoadOptions {
+  /// The scene's data folder: paths written "data:REL" resolve against it. Empty: the scene's
+  /// "data" default folder under the hapsim data root ($HAPSIM_DATA, else ../shared/data beside
+  /// the checkout that holds the scene).
+  std::filesystem::path data_dir;
+  /// Progress while loading meshes and generating geometry. May be empty.
+  ProgressFn progress;
+};
+
+/// Reads and parses `file`. Relative paths in the scene resolve against the file's folder.
+[[nodiscard]] SceneDescription load_scene(const std::filesystem::path& file,
+                                          const SceneLoadOptions& options = {});
+
+/// Parses scene JSON text; `file` names it in errors and anchors relative paths.
+[[nodiscard]] SceneDescription parse_scene(std::string_view json_text,
+                                           const std::filesystem::path& file,
+                                           const SceneLoadOptions& options = {});
+
+}  // namespace hapsim
