@@ -65,6 +65,10 @@ struct World::Tool {
   std::vector<ProxySurface> surfaces;        // one per proxy segment
   std::vector<std::size_t> surface_segment;  // flat segment of each surface
   std::vector<QueryHint> hints;              // one per flat segment (temporal coherence)
+  // Per flat segment: the tool was within reach of, or inside, it last step. Only then can it be
+  // deeper than the reach now (it moves far less than a reach per cycle), so only then is the
+  // costly deep-inside query needed.
+  std::vector<std::uint8_t> near_last_step;
   Vec3 p_previous_world = Vec3::Zero();
   bool has_previous = false;
 };
@@ -182,6 +186,7 @@ World::World(WorldDescription description, WorldOptions options)
     auto tool = std::make_unique<Tool>();
     tool->proxy = GodObject(gp);
     tool->hints.resize(segments_.size());
+    tool->near_last_step.assign(segments_.size(), 0);
     for (std::size_t i = 0; i < segments_.size(); ++i) {
       const Segment& seg = *segments_[i];
       if (seg.response != ContactResponse::kProxy) {
@@ -282,6 +287,8 @@ void World::step_tool(std::size_t t, const Vec3& p_world, double dt_s) {
   const Vec3 v_world = tool.has_previous && dt_s > 0.0
                            ? Vec3((p_world - tool.p_previous_world) / dt_s)
                            : Vec3::Zero();
+  const double moved_m =
+      tool.has_previous ? (p_world - tool.p_previous_world).norm() : kInf;
   tool.p_previous_world = p_world;
   tool.has_previous = true;
   state.p_world = p_world;
@@ -323,17 +330,22 @@ void World::step_tool(std::size_t t, const Vec3& p_world, double dt_s) {
       continue;
     }
     SurfacePoint sp;
+    std::uint8_t& near = tool.near_last_step[i];
     if (!seg.rest_query->contact_within(p_body, reach, &sp, &tool.hints[i])) {
-      // Either clear of the surface or deeper inside than the reach (saturated spring): only a
-      // point within the bounds can be inside.
-      if (!seg.rest_bounds_body.contains(p_body)) {
+      // Either clear of the surface or deeper inside than the reach (saturated spring). Deeper
+      // is only possible inside the bounds, and only for a tool that was near or inside last
+      // step or has moved more than a reach since (a first cycle, a jump).
+      if (!seg.rest_bounds_body.contains(p_body) || (near == 0 && moved_m < reach)) {
+        near = 0;
         continue;
       }
       sp = seg.rest_query->closest_point(p_body, &tool.hints[i]);
       if (!(sp.signed_distance < 0.0)) {
+        near = 0;
         continue;
       }
     }
+    near = 1;
     const double depth = radius - sp.signed_distance;
     if (!(depth > 0.0) || !std::isfinite(depth)) {
       continue;
