@@ -169,8 +169,10 @@ VertexDeflection::VertexDeflection(TriangleMesh rest_mesh, VertexDeflectionOptio
   target_stamp_.assign(n, 0);
   normal_pending_flag_.assign(n, 0);
   normals_pending_.reserve(n);
+  moved_since_normals_flag_.assign(n, 0);
+  moved_since_normals_.reserve(n);
   decay_per_segment_.assign(segments_.size(), 0.0);
-  triangle_stamp_.assign(mesh.triangle_count(), 0);
+  triangle_stamp_lazy_.assign(mesh.triangle_count(), 0);
   in_active_.assign(n, 0);
   active_.reserve(n);
   touched_.reserve(n);
@@ -191,12 +193,13 @@ void VertexDeflection::next_stamp() {
   if (++stamp_ == 0) {
     // Wrapped after 2^32 cycles (~50 days at 1 kHz): clear the marks once.
     std::fill(target_stamp_.begin(), target_stamp_.end(), 0);
-    std::fill(triangle_stamp_.begin(), triangle_stamp_.end(), 0);
+    std::fill(triangle_stamp_lazy_.begin(), triangle_stamp_lazy_.end(), 0);
     stamp_ = 1;
   }
   touched_.clear();
   moved_vertices_.clear();
   moved_triangles_.clear();
+  moved_triangles_ready_ = false;
 }
 
 // haptic path
@@ -218,6 +221,10 @@ void VertexDeflection::set_offset(std::uint32_t v, double offset_m) {
   // Exactly the rest position at zero, so a released surface is bit-identical to rest.
   mesh_->vertices[v] = offset_m > 0.0 ? Vec3(rest_[v] + offset_m * direction_[v]) : rest_[v];
   moved_vertices_.push_back(v);
+  if (moved_since_normals_flag_[v] == 0) {
+    moved_since_normals_flag_[v] = 1;
+    moved_since_normals_.push_back(v);
+  }
 }
 
 // haptic path
@@ -295,33 +302,40 @@ void VertexDeflection::step(std::span<const DeflectionContact> contacts, double 
     max_deflection_m_ = std::max(max_deflection_m_, offset_m_[v]);
     ++k;
   }
-
-  finish_cycle();
 }
 
-// haptic path: moved triangles for local refit; their corners' normals become stale.
-void VertexDeflection::finish_cycle() {
-  for (const std::uint32_t v : moved_vertices_) {
-    for (std::uint32_t e = vertex_tri_start_[v]; e < vertex_tri_start_[v + 1]; ++e) {
-      const std::uint32_t t = vertex_tris_[e];
-      if (triangle_stamp_[t] != stamp_) {
-        triangle_stamp_[t] = stamp_;
-        moved_triangles_.push_back(t);
+// haptic path: the triangles around the last step's moved vertices, gathered once per step.
+std::span<const std::uint32_t> VertexDeflection::moved_triangles() const {
+  if (!moved_triangles_ready_) {
+    for (const std::uint32_t v : moved_vertices_) {
+      for (std::uint32_t e = vertex_tri_start_[v]; e < vertex_tri_start_[v + 1]; ++e) {
+        const std::uint32_t t = vertex_tris_[e];
+        if (triangle_stamp_lazy_[t] != stamp_) {
+          triangle_stamp_lazy_[t] = stamp_;
+          moved_triangles_.push_back(t);
+        }
       }
     }
+    moved_triangles_ready_ = true;
   }
-  for (const std::uint32_t t : moved_triangles_) {
-    for (const std::uint32_t v : mesh_->triangles[t]) {
-      if (normal_pending_flag_[v] == 0) {
-        normal_pending_flag_[v] = 1;
-        normals_pending_.push_back(v);
-      }
-    }
-  }
+  return moved_triangles_;
 }
 
 void VertexDeflection::update_normals() {
   TriangleMesh& mesh = *mesh_;
+  // A moved vertex changes the normals of every corner of its triangles.
+  for (const std::uint32_t m : moved_since_normals_) {
+    moved_since_normals_flag_[m] = 0;
+    for (std::uint32_t e = vertex_tri_start_[m]; e < vertex_tri_start_[m + 1]; ++e) {
+      for (const std::uint32_t v : mesh.triangles[vertex_tris_[e]]) {
+        if (normal_pending_flag_[v] == 0) {
+          normal_pending_flag_[v] = 1;
+          normals_pending_.push_back(v);
+        }
+      }
+    }
+  }
+  moved_since_normals_.clear();
   for (const std::uint32_t v : normals_pending_) {
     const std::span<const std::uint32_t> tris(vertex_tris_.data() + vertex_tri_start_[v],
                                               vertex_tri_start_[v + 1] - vertex_tri_start_[v]);
@@ -339,7 +353,6 @@ void VertexDeflection::reset() {
   }
   active_.clear();
   max_deflection_m_ = 0.0;
-  finish_cycle();
 }
 
 }  // namespace hapsim

@@ -112,7 +112,8 @@ class VertexDeflection {
   /// Vertices whose position changed in the last step()/reset(), each once.
   [[nodiscard]] std::span<const std::uint32_t> moved_vertices() const { return moved_vertices_; }
   /// Triangles with a moved corner in the last step()/reset(), each once (refit these).
-  [[nodiscard]] std::span<const std::uint32_t> moved_triangles() const { return moved_triangles_; }
+  /// Gathered on the first call after a step, so a step that nobody refits does not pay for it.
+  [[nodiscard]] std::span<const std::uint32_t> moved_triangles() const;
   /// Largest current deflection after the last step, metres.
   [[nodiscard]] double max_deflection_m() const { return max_deflection_m_; }
   /// Vertices currently away from rest.
@@ -124,7 +125,6 @@ class VertexDeflection {
  private:
   void set_offset(std::uint32_t v, double offset_m);
   void next_stamp();
-  void finish_cycle();
   [[nodiscard]] double recovered_gap_m(std::uint32_t segment, double gap_m, double dt_s) const;
 
   std::unique_ptr<TriangleMesh> mesh_;
@@ -141,15 +141,21 @@ class VertexDeflection {
   std::vector<double> target_m_;
   /// Per-vertex/triangle "seen in this cycle" marks, so nothing is cleared per cycle.
   std::vector<std::uint32_t> target_stamp_;
-  std::vector<std::uint32_t> triangle_stamp_;
   std::uint32_t stamp_ = 0;
   std::vector<std::uint8_t> in_active_;
   /// Vertices away from rest (recovering or held), pre-sized to the vertex count.
   std::vector<std::uint32_t> active_;
   std::vector<std::uint32_t> touched_;
   std::vector<std::uint32_t> moved_vertices_;
-  std::vector<std::uint32_t> moved_triangles_;
-  /// Vertices whose normal is stale (pending update_normals()), each once.
+  // Filled lazily by moved_triangles() (a cache of the last step's moved vertices).
+  mutable std::vector<std::uint32_t> moved_triangles_;
+  mutable std::vector<std::uint32_t> triangle_stamp_lazy_;
+  mutable bool moved_triangles_ready_ = true;
+  /// Vertices moved since the last update_normals(), each once: their one-ring's normals are
+  /// stale.
+  std::vector<std::uint32_t> moved_since_normals_;
+  std::vector<std::uint8_t> moved_since_normals_flag_;
+  /// Scratch of update_normals(): vertices whose normal is recomputed, each once.
   std::vector<std::uint32_t> normals_pending_;
   std::vector<std::uint8_t> normal_pending_flag_;
   /// Per segment, exp(−dt/τ) for this step's dt: one exp per segment instead of per vertex.

@@ -130,9 +130,8 @@ void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface>
   }
   const Vec3 previous = proxy_world_;
   // Look only as far as this cycle's motion can reach (queries exit early beyond it).
-  const double margin =
-      std::max((device_p_world - proxy_world_).norm(), params_.max_substep_m) +
-      params_.contact_tolerance_m;
+  const double margin = std::max((device_p_world - proxy_world_).norm(), params_.max_substep_m) +
+                        params_.contact_tolerance_m;
   double least = resolve_penetration(surfaces, margin);
   iterations_used_ = 0;
   while (iterations_used_ < params_.max_iterations) {

@@ -287,8 +287,7 @@ void World::step_tool(std::size_t t, const Vec3& p_world, double dt_s) {
   const Vec3 v_world = tool.has_previous && dt_s > 0.0
                            ? Vec3((p_world - tool.p_previous_world) / dt_s)
                            : Vec3::Zero();
-  const double moved_m =
-      tool.has_previous ? (p_world - tool.p_previous_world).norm() : kInf;
+  const double moved_m = tool.has_previous ? (p_world - tool.p_previous_world).norm() : kInf;
   tool.p_previous_world = p_world;
   tool.has_previous = true;
   state.p_world = p_world;
