@@ -54,6 +54,9 @@ double GodObject::scan(std::span<const ProxySurface> surfaces, double margin_m) 
   double least = margin_m;
   const int n = static_cast<int>(std::min<std::size_t>(surfaces.size(), kMaxSurfaces));
   for (int i = 0; i < n; ++i) {
+    if (cull_ && nearby_[static_cast<std::size_t>(i)] == 0) {
+      continue;  // out of this update's reach (see update()): clearance >= margin_m
+    }
     const Probe pr = probe(surfaces[static_cast<std::size_t>(i)], i, proxy_world_, margin_m);
     least = std::min(least, pr.clearance_m);
     if (!(pr.clearance_m < params_.contact_tolerance_m)) {
@@ -132,6 +135,18 @@ void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface>
   // Look only as far as this cycle's motion can reach (queries exit early beyond it).
   const double margin = std::max((device_p_world - proxy_world_).norm(), params_.max_substep_m) +
                         params_.contact_tolerance_m;
+  // Broad phase: every step of the loop below moves the proxy along a projection of (device -
+  // proxy), which never increases its distance to the device, so the proxy stays within
+  // 2·|device - proxy| <= 2·margin of where it starts (push-outs are within the tolerance). A
+  // surface that matters must come within `margin` of one of those positions: one with nothing
+  // within 3·margin (plus the tolerance) now is not probed again this cycle.
+  const double reach = 3.0 * margin + params_.contact_tolerance_m;
+  const int n = static_cast<int>(std::min<std::size_t>(surfaces.size(), kMaxSurfaces));
+  for (int i = 0; i < n; ++i) {
+    const Probe pr = probe(surfaces[static_cast<std::size_t>(i)], i, proxy_world_, reach);
+    nearby_[static_cast<std::size_t>(i)] = pr.clearance_m < reach ? 1 : 0;
+  }
+  cull_ = true;
   double least = resolve_penetration(surfaces, margin);
   iterations_used_ = 0;
   while (iterations_used_ < params_.max_iterations) {
@@ -149,6 +164,7 @@ void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface>
     least = resolve_penetration(surfaces, margin);
   }
   apply_friction(previous, device_p_world, surfaces, margin);
+  cull_ = false;
 }
 
 // haptic path

@@ -22,26 +22,26 @@ namespace hapsim {
 
 /// One surface the proxy must stay outside of (owned by the world; the proxy only reads it).
 struct ProxySurface {
-  const ProximityQuery* query = nullptr;    // answers in the body frame
-  Iso3 X_world_body = Iso3::Identity();     // where the body is
+  const ProximityQuery* query = nullptr;  // answers in the body frame
+  Iso3 X_world_body = Iso3::Identity();   // where the body is
   const ContactMaterial* material = nullptr;
-  bool two_sided = false;                   // open mesh: both sides are outside
-  QueryHint* hint = nullptr;                // temporal coherence, one per tool-surface pair
+  bool two_sided = false;     // open mesh: both sides are outside
+  QueryHint* hint = nullptr;  // temporal coherence, one per tool-surface pair
 };
 
 struct ProxyContact {
-  int surface = -1;                         // index into the span given to update()
-  Vec3 point_world = Vec3::Zero();          // closest surface point
-  Vec3 normal_world = Vec3::Zero();         // unit, pointing from the surface to the proxy
+  int surface = -1;                  // index into the span given to update()
+  Vec3 point_world = Vec3::Zero();   // closest surface point
+  Vec3 normal_world = Vec3::Zero();  // unit, pointing from the surface to the proxy
   std::uint32_t triangle = kNoTriangle;
-  double clearance_m = 0.0;                 // proxy-to-surface gap (< 0 while penetrating)
+  double clearance_m = 0.0;  // proxy-to-surface gap (< 0 while penetrating)
 };
 
 struct GodObjectParams {
-  double radius_m = 0.0;                    // tool sphere radius (0: a point probe)
-  double contact_tolerance_m = 1e-5;        // within this of a surface counts as touching
-  double max_substep_m = 2.5e-4;            // step length while in contact
-  int max_iterations = 16;                  // work bound per cycle (motion carries over)
+  double radius_m = 0.0;              // tool sphere radius (0: a point probe)
+  double contact_tolerance_m = 1e-5;  // within this of a surface counts as touching
+  double max_substep_m = 2.5e-4;      // step length while in contact
+  int max_iterations = 16;            // work bound per cycle (motion carries over)
 };
 
 class GodObject {
@@ -90,6 +90,9 @@ class GodObject {
   int iterations_used_ = 0;
   /// Side of each two-sided surface the proxy is on (+1 front, −1 back, 0 unknown yet).
   std::array<std::int8_t, kMaxSurfaces> side_{};
+  /// Broad phase of one update(): surfaces with something within reach of this update's motion.
+  std::array<std::uint8_t, kMaxSurfaces> nearby_{};
+  bool cull_ = false;
 };
 
 /// Spring force from the device to the proxy with the touched material's stiffness, maximum
