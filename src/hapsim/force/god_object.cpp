@@ -132,15 +132,19 @@ void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface>
     return;  // never follow a NaN: hold the proxy where it is
   }
   const Vec3 previous = proxy_world_;
-  // Look only as far as this cycle's motion can reach (queries exit early beyond it).
-  const double margin = std::max((device_p_world - proxy_world_).norm(), params_.max_substep_m) +
+  // Look only as far as this cycle's motion can reach (queries exit early beyond it), and never
+  // farther than max_probe_margin_m.
+  const double gap = (device_p_world - proxy_world_).norm();
+  const double margin = std::min(std::max(gap, params_.max_substep_m),
+                                 std::max(params_.max_probe_margin_m, params_.max_substep_m)) +
                         params_.contact_tolerance_m;
   // Broad phase: every step of the loop below moves the proxy along a projection of (device -
-  // proxy), which never increases its distance to the device, so the proxy stays within
-  // 2·|device - proxy| <= 2·margin of where it starts (push-outs are within the tolerance). A
-  // surface that matters must come within `margin` of one of those positions: one with nothing
-  // within 3·margin (plus the tolerance) now is not probed again this cycle.
-  const double reach = 3.0 * margin + params_.contact_tolerance_m;
+  // proxy), which never brings it farther from the device, so it stays within 2·gap of where it
+  // starts; and each of at most max_iterations steps is at most `margin` long (push-outs are
+  // within the tolerance). A surface that matters must come within `margin` of one of those
+  // positions: one with nothing that close to the reachable ball now is not probed again.
+  const double travel = std::min(2.0 * gap, params_.max_iterations * margin);
+  const double reach = travel + margin + params_.contact_tolerance_m;
   const int n = static_cast<int>(std::min<std::size_t>(surfaces.size(), kMaxSurfaces));
   for (int i = 0; i < n; ++i) {
     const Probe pr = probe(surfaces[static_cast<std::size_t>(i)], i, proxy_world_, reach);

@@ -42,6 +42,10 @@ struct GodObjectParams {
   double contact_tolerance_m = 1e-5;  // within this of a surface counts as touching
   double max_substep_m = 2.5e-4;      // step length while in contact
   int max_iterations = 16;            // work bound per cycle (motion carries over)
+  /// Farthest a probe looks (and so the longest free-space stride): a proxy left far behind
+  /// (the device pushed through a body) would otherwise probe every surface out to that
+  /// distance. It still travels up to max_iterations strides a cycle.
+  double max_probe_margin_m = 0.01;
 };
 
 class GodObject {
