@@ -157,5 +157,50 @@ TEST(PalpationTrajectory, RejectsBadParameters) {
   EXPECT_THROW((void)make_palpation_plan(bad, params()), Error);
 }
 
+// Targets on opposite sides of a limb along z: a straight move would pass through its axis; the
+// move round the axis never comes closer to it than the stand-offs, and still ends exactly there.
+TEST(PalpationTrajectory, MovesGoRoundTheAxisInsteadOfThroughTheBody) {
+  std::vector<PalpationTarget> targets(2);
+  targets[0].p_world = Vec3(0.05, 0.0, 0.02);
+  targets[0].press_dir_world = -Vec3::UnitX();
+  targets[1].p_world = Vec3(-0.05, 0.001, -0.03);
+  targets[1].press_dir_world = Vec3::UnitX();
+  PalpationParams p = params();
+  p.start_p_world = Vec3(0.1, 0.0, 0.02);
+  p.around_point_world = Vec3(0.0, 0.0, 0.1);  // any point on the axis
+  p.around_axis_world = Vec3(0.0, 0.0, 2.0);   // normalised by the planner
+  p.around_radius_m = 0.09;
+  const PalpationPlan plan = make_palpation_plan(targets, p);
+  const auto move = std::find_if(plan.phases.begin(), plan.phases.end(), [](const auto& ph) {
+    return ph.kind == PalpationPhaseKind::kMove && ph.target_index == 1;
+  });
+  ASSERT_NE(move, plan.phases.end());
+  const double standoff_r = 0.05 + p.standoff_m;
+  double least_r = kInf;
+  double most_r = 0.0;
+  for (const DeviceInput& s : plan.trajectory.samples) {
+    if (s.time_s >= move->start_s && s.time_s <= move->end_s) {
+      const double r = std::hypot(s.p_world.x(), s.p_world.y());
+      least_r = std::min(least_r, r);
+      most_r = std::max(most_r, r);
+    }
+  }
+  EXPECT_GE(least_r, standoff_r - 0.002);  // the second stand-off is 1 mm off the x axis
+  EXPECT_NEAR(most_r, 0.09, 1e-9);         // round on the cylinder
+  EXPECT_EQ(plan.trajectory.sample_at(move->end_s).p_world,
+            targets[1].p_world - p.standoff_m * Vec3::UnitX());
+  // Without the cylinder the same move goes straight through the axis.
+  p.around_radius_m = 0.0;
+  const PalpationPlan straight = make_palpation_plan(targets, p);
+  double straight_least = kInf;
+  for (const DeviceInput& s : straight.trajectory.samples) {
+    straight_least = std::min(straight_least, std::hypot(s.p_world.x(), s.p_world.y()));
+  }
+  EXPECT_LT(straight_least, 0.005);
+  p.around_radius_m = 0.09;
+  p.around_axis_world = Vec3::Zero();
+  EXPECT_THROW((void)make_palpation_plan(targets, p), Error);
+}
+
 }  // namespace
 }  // namespace hapsim

@@ -34,6 +34,13 @@ struct PalpationParams {
   double approach_s = 0.5;
   double press_s = 0.5;
   double release_s = 0.5;
+  /// Moves between targets go around the body instead of straight through it: out to
+  /// `around_radius_m` from the axis through `around_point_world` along `around_axis_world`, round
+  /// the axis on that cylinder, and in to the next stand-off. Off while the radius is 0 (a limb
+  /// is long along its axis, so a cylinder hugs it far better than a bounding sphere).
+  Vec3 around_point_world = Vec3::Zero();
+  Vec3 around_axis_world = Vec3::UnitZ();
+  double around_radius_m = 0.0;
   /// Longest spacing between samples of a moving phase, seconds (> 0). 1 ms matches the haptic
   /// rate, so linear interpolation between samples adds no visible error.
   double sample_period_s = 0.001;

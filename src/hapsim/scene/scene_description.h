@@ -29,6 +29,10 @@ struct PalpationScriptDescription {
   double approach_s = 0.5;
   double press_s = 0.5;
   double release_s = 0.5;
+  /// Moves between targets go round this axis (through the body's centre) on a cylinder that
+  /// clears the body and the tools, instead of straight through the body. Optional.
+  bool has_around_axis = false;
+  Vec3 around_axis_world = Vec3::UnitZ();
 };
 
 struct DeviceDescription {

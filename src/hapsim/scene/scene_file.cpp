@@ -775,7 +775,9 @@ void Parser::parse_device(const Json& j, const std::string& ptr, SceneDescriptio
   }
   const std::string pp = at(ptr, "palpation");
   const Json& p = object(j["palpation"], pp, "a palpation script");
-  allow_keys(p, pp, {"standoff_m", "move_s", "approach_s", "press_s", "release_s", "targets"});
+  allow_keys(
+      p, pp,
+      {"standoff_m", "move_s", "approach_s", "press_s", "release_s", "around_axis", "targets"});
   d.has_palpation = true;
   PalpationScriptDescription& s = d.palpation;
   s.standoff_m = number_in(p, pp, "standoff_m", s.standoff_m, 0.0, 1.0, "m");
@@ -783,6 +785,14 @@ void Parser::parse_device(const Json& j, const std::string& ptr, SceneDescriptio
   s.approach_s = number_in(p, pp, "approach_s", s.approach_s, 0.0, 60.0, "seconds", true);
   s.press_s = number_in(p, pp, "press_s", s.press_s, 0.0, 60.0, "seconds", true);
   s.release_s = number_in(p, pp, "release_s", s.release_s, 0.0, 60.0, "seconds", true);
+  if (p.contains("around_axis")) {
+    s.around_axis_world = vec3(p["around_axis"], at(pp, "around_axis"), "");
+    if (!(s.around_axis_world.norm() > 1e-9)) {
+      fail(at(pp, "around_axis"), "expected a non-zero direction (e.g. the limb's long axis)");
+    }
+    s.around_axis_world.normalize();
+    s.has_around_axis = true;
+  }
   const std::string tp = at(pp, "targets");
   const Json& targets = array(required(p, pp, "targets"), tp, "palpation targets");
   if (targets.empty()) {
