@@ -188,7 +188,7 @@ class Parser {
       list += (list.empty() ? "'" : ", '") + std::string(c) + "'";
     }
     if (j.is_string()) {
-      const std::string s = j.get<std::string>();
+      std::string s = j.get<std::string>();
       for (const char* c : choices) {
         if (s == c) {
           return s;
@@ -235,7 +235,7 @@ class Parser {
       fail(ptr, "needs the real-data folder: set HAPSIM_DATA or give --data DIR (looked in " +
                     beside.lexically_normal().string() + ")");
     }
-    const std::filesystem::path dir = *root / data_default_;
+    std::filesystem::path dir = *root / data_default_;
     if (!std::filesystem::is_directory(dir)) {
       fail(ptr,
            "needs the data folder " + dir.string() + ", which does not exist; give --data DIR");
@@ -588,7 +588,7 @@ void Parser::parse_geometry(const Json& j, const std::string& ptr, BodyDescripti
       std::string pattern = "*.stl";
       if (m.contains("pattern")) {
         pattern = nonempty_string(m["pattern"], at(kp, "pattern"), "a file pattern like *.stl");
-        if (pattern.rfind("*", 0) != 0 || pattern.find('*', 1) != std::string::npos) {
+        if (pattern.rfind('*', 0) != 0 || pattern.find('*', 1) != std::string::npos) {
           fail(at(kp, "pattern"), "expected '*' followed by a file-name ending, e.g. '*.stl'");
         }
       }
