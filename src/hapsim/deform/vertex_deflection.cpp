@@ -52,7 +52,40 @@ Vec3 vertex_normal(const TriangleMesh& mesh, std::span<const std::uint32_t> tris
   return len > 0.0 && std::isfinite(len) ? Vec3(sum / len) : Vec3::Zero();
 }
 
+// (cos(π·t) + 1)/2 = cos²(π·t/2) for u = t² in [0, 1], without sqrt or cos: cos(π/2·√u) is a
+// power series in u; terms up to u^8 leave an error below 1e-10 (the next term is
+// (π/2)^18/18! < 4e-12), far below anything a vertex position can show. Hot loop of step().
+constexpr double half_cos_series_term(int k) {
+  double term = 1.0;
+  for (int i = 1; i <= k; ++i) {
+    term *=
+        -(std::numbers::pi * std::numbers::pi / 4.0) / static_cast<double>((2 * i - 1) * (2 * i));
+  }
+  return term;
+}
+
+inline double raised_cosine_of_squared(double u) {
+  constexpr double c0 = half_cos_series_term(0), c1 = half_cos_series_term(1),
+                   c2 = half_cos_series_term(2), c3 = half_cos_series_term(3),
+                   c4 = half_cos_series_term(4), c5 = half_cos_series_term(5),
+                   c6 = half_cos_series_term(6), c7 = half_cos_series_term(7),
+                   c8 = half_cos_series_term(8);
+  const double c =
+      c0 + u * (c1 + u * (c2 + u * (c3 + u * (c4 + u * (c5 + u * (c6 + u * (c7 + u * c8)))))));
+  return c * c;
+}
+
 }  // namespace
+
+double VertexDeflection::deflection_profile_from_squared_m(double distance_sq_m2,
+                                                           double penetration_m,
+                                                           double zero_distance_m) {
+  const double d0_sq = zero_distance_m * zero_distance_m;
+  if (!(distance_sq_m2 >= 0.0) || !(distance_sq_m2 < d0_sq) || !(penetration_m > 0.0)) {
+    return 0.0;
+  }
+  return penetration_m * raised_cosine_of_squared(distance_sq_m2 / d0_sq);
+}
 
 VertexDeflection::VertexDeflection(TriangleMesh rest_mesh, VertexDeflectionOptions options)
     : mesh_(std::make_unique<TriangleMesh>(std::move(rest_mesh))),
@@ -178,6 +211,7 @@ VertexDeflection::VertexDeflection(TriangleMesh rest_mesh, VertexDeflectionOptio
   touched_.reserve(n);
   moved_vertices_.reserve(n);
   moved_triangles_.reserve(mesh.triangle_count());
+  last_contacts_.reserve(kMaxHeldContacts);
 }
 
 double VertexDeflection::deflection_profile_m(double distance_m, double penetration_m,
@@ -193,10 +227,18 @@ void VertexDeflection::next_stamp() {
   if (++stamp_ == 0) {
     // Wrapped after 2^32 cycles (~50 days at 1 kHz): clear the marks once.
     std::fill(target_stamp_.begin(), target_stamp_.end(), 0);
-    std::fill(triangle_stamp_lazy_.begin(), triangle_stamp_lazy_.end(), 0);
     stamp_ = 1;
   }
   touched_.clear();
+  next_moved_stamp();
+}
+
+// haptic path: a new "moved in this step" generation (every step, held or not).
+void VertexDeflection::next_moved_stamp() {
+  if (++moved_stamp_ == 0) {
+    std::fill(triangle_stamp_lazy_.begin(), triangle_stamp_lazy_.end(), 0);
+    moved_stamp_ = 1;
+  }
   moved_vertices_.clear();
   moved_triangles_.clear();
   moved_triangles_ready_ = false;
@@ -228,61 +270,91 @@ void VertexDeflection::set_offset(std::uint32_t v, double offset_m) {
 }
 
 // haptic path
+bool VertexDeflection::same_contacts_as_last(std::span<const DeflectionContact> contacts) const {
+  return held_ && contacts.size() == last_contacts_.size() &&
+         std::equal(contacts.begin(), contacts.end(), last_contacts_.begin(),
+                    [](const DeflectionContact& a, const DeflectionContact& b) {
+                      return a.p_mesh == b.p_mesh && a.penetration_m == b.penetration_m &&
+                             a.contact_radius_m == b.contact_radius_m && a.segment == b.segment;
+                    });
+}
+
 void VertexDeflection::step(std::span<const DeflectionContact> contacts, double dt_s) {
-  next_stamp();
   if (!std::isfinite(dt_s) || dt_s < 0.0) {
     dt_s = 0.0;
+  }
+  // A held press (bit-identical contacts, every touched vertex already at its target) gives the
+  // same targets again: keep last step's marks instead of recomputing thousands of vertices.
+  const bool held = same_contacts_as_last(contacts);
+  if (held) {
+    next_moved_stamp();
+  } else {
+    next_stamp();
   }
   for (std::size_t s = 0; s < segments_.size(); ++s) {
     const double tau_s = segments_[s].recovery_time_constant_s;
     decay_per_segment_[s] = tau_s > 0.0 ? std::exp(-dt_s / tau_s) : 0.0;
   }
 
-  // 1. Target deflection of every vertex near a contact (deepest wins).
-  for (const DeflectionContact& c : contacts) {
-    if (!c.p_mesh.allFinite() || !std::isfinite(c.penetration_m) ||
-        std::isnan(c.contact_radius_m) || c.segment >= segments_.size()) {
-      ++rejected_;
-      continue;
-    }
-    const DeflectionParams& p = segments_[c.segment];
-    const double x_m = std::min(c.penetration_m, p.max_deflection_m);
-    if (!(x_m > 0.0)) {
-      continue;
-    }
-    const double r_m = std::max(c.contact_radius_m, 0.0);
-    const double d0_m = zero_deflection_distance_m(x_m, r_m, p.elasticity_factor);
-    if (!std::isfinite(d0_m)) {
-      ++rejected_;
-      continue;
-    }
-    grid_->for_each_within(c.p_mesh, d0_m, [&](std::uint32_t v, double d2) {
-      if (segment_of_vertex_[v] != c.segment) {
-        return;
+  if (!held) {
+    const std::size_t rejected_before = rejected_;
+    // 1. Target deflection of every vertex near a contact (deepest wins).
+    for (const DeflectionContact& c : contacts) {
+      if (!c.p_mesh.allFinite() || !std::isfinite(c.penetration_m) ||
+          std::isnan(c.contact_radius_m) || c.segment >= segments_.size()) {
+        ++rejected_;
+        continue;
       }
-      const double delta_m = deflection_profile_m(std::sqrt(d2), x_m, d0_m);
-      if (target_stamp_[v] != stamp_) {
-        target_stamp_[v] = stamp_;
-        target_m_[v] = delta_m;
-        touched_.push_back(v);
-      } else {
-        target_m_[v] = std::max(target_m_[v], delta_m);
+      const DeflectionParams& p = segments_[c.segment];
+      const double x_m = std::min(c.penetration_m, p.max_deflection_m);
+      if (!(x_m > 0.0)) {
+        continue;
       }
-    });
-  }
+      const double r_m = std::max(c.contact_radius_m, 0.0);
+      const double d0_m = zero_deflection_distance_m(x_m, r_m, p.elasticity_factor);
+      if (!std::isfinite(d0_m)) {
+        ++rejected_;
+        continue;
+      }
+      if (!(d0_m > 0.0)) {
+        continue;  // an underflowing depth deflects nothing
+      }
+      const double inv_d0_sq = 1.0 / (d0_m * d0_m);
+      grid_->for_each_within(c.p_mesh, d0_m, [&](std::uint32_t v, double d2) {
+        if (segment_of_vertex_[v] != c.segment) {
+          return;
+        }
+        // d2 < d0² here (the grid's test), so the profile needs no range checks.
+        const double delta_m = x_m * raised_cosine_of_squared(d2 * inv_d0_sq);
+        if (target_stamp_[v] != stamp_) {
+          target_stamp_[v] = stamp_;
+          target_m_[v] = delta_m;
+          touched_.push_back(v);
+        } else {
+          target_m_[v] = std::max(target_m_[v], delta_m);
+        }
+      });
+    }
 
-  // 2. Touched vertices: press at once, or recover towards a shallower target.
-  for (const std::uint32_t v : touched_) {
-    const double target_m = target_m_[v];
-    const double current_m = offset_m_[v];
-    const double next_m =
-        target_m >= current_m
-            ? target_m
-            : target_m + recovered_gap_m(segment_of_vertex_[v], current_m - target_m, dt_s);
-    set_offset(v, next_m);
-    if (next_m > 0.0 && in_active_[v] == 0) {
-      in_active_[v] = 1;
-      active_.push_back(v);
+    // 2. Touched vertices: press at once, or recover towards a shallower target.
+    bool settled = true;
+    for (const std::uint32_t v : touched_) {
+      const double target_m = target_m_[v];
+      const double current_m = offset_m_[v];
+      const double next_m =
+          target_m >= current_m
+              ? target_m
+              : target_m + recovered_gap_m(segment_of_vertex_[v], current_m - target_m, dt_s);
+      settled = settled && next_m == target_m;
+      set_offset(v, next_m);
+      if (next_m > 0.0 && in_active_[v] == 0) {
+        in_active_[v] = 1;
+        active_.push_back(v);
+      }
+    }
+    held_ = settled && rejected_ == rejected_before && contacts.size() <= last_contacts_.capacity();
+    if (held_) {
+      last_contacts_.assign(contacts.begin(), contacts.end());  // within capacity: no allocation
     }
   }
 
@@ -310,8 +382,8 @@ std::span<const std::uint32_t> VertexDeflection::moved_triangles() const {
     for (const std::uint32_t v : moved_vertices_) {
       for (std::uint32_t e = vertex_tri_start_[v]; e < vertex_tri_start_[v + 1]; ++e) {
         const std::uint32_t t = vertex_tris_[e];
-        if (triangle_stamp_lazy_[t] != stamp_) {
-          triangle_stamp_lazy_[t] = stamp_;
+        if (triangle_stamp_lazy_[t] != moved_stamp_) {
+          triangle_stamp_lazy_[t] = moved_stamp_;
           moved_triangles_.push_back(t);
         }
       }
@@ -347,6 +419,7 @@ void VertexDeflection::update_normals() {
 
 void VertexDeflection::reset() {
   next_stamp();
+  held_ = false;
   for (const std::uint32_t v : active_) {
     set_offset(v, 0.0);
     in_active_[v] = 0;

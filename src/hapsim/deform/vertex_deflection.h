@@ -94,6 +94,11 @@ class VertexDeflection {
   /// Eq. 1: δ(d) = (x/2)·(cos(π·d/d0) + 1) for 0 ≤ d < d0, else 0.
   [[nodiscard]] static double deflection_profile_m(double distance_m, double penetration_m,
                                                    double zero_distance_m);
+  /// The same profile from the squared distance, as step() evaluates it (a polynomial in
+  /// d²/d0², within 1e-10·x of eq. 1, no sqrt or cos).
+  [[nodiscard]] static double deflection_profile_from_squared_m(double distance_sq_m2,
+                                                                double penetration_m,
+                                                                double zero_distance_m);
   /// d0 = (x + r_eff) · elasticity_factor.
   [[nodiscard]] static double zero_deflection_distance_m(double penetration_m,
                                                          double contact_radius_m,
@@ -125,6 +130,8 @@ class VertexDeflection {
  private:
   void set_offset(std::uint32_t v, double offset_m);
   void next_stamp();
+  void next_moved_stamp();
+  [[nodiscard]] bool same_contacts_as_last(std::span<const DeflectionContact> contacts) const;
   [[nodiscard]] double recovered_gap_m(std::uint32_t segment, double gap_m, double dt_s) const;
 
   std::unique_ptr<TriangleMesh> mesh_;
@@ -142,6 +149,13 @@ class VertexDeflection {
   /// Per-vertex/triangle "seen in this cycle" marks, so nothing is cleared per cycle.
   std::vector<std::uint32_t> target_stamp_;
   std::uint32_t stamp_ = 0;
+  /// Generation of moved_vertices_/moved_triangles_ (advances every step, also when held).
+  std::uint32_t moved_stamp_ = 0;
+  /// Last step's contacts when every touched vertex reached its target (a held press repeats
+  /// them); at most kMaxHeldContacts, reserved once.
+  static constexpr std::size_t kMaxHeldContacts = 64;
+  std::vector<DeflectionContact> last_contacts_;
+  bool held_ = false;
   std::vector<std::uint8_t> in_active_;
   /// Vertices away from rest (recovering or held), pre-sized to the vertex count.
   std::vector<std::uint32_t> active_;
