@@ -99,9 +99,36 @@ TEST(GodObject, StaticFrictionHoldsAndDynamicFrictionTrails) {
   proxy.update(Vec3(0.0008, 0, -0.002), surfaces);  // inside the cone: stick
   EXPECT_NEAR(proxy.proxy_world().x(), 0.0, 1e-9);
   const Vec3 fx = proxy_force(proxy, surfaces, Vec3(0.0008, 0, -0.002), Vec3::Zero());
-  EXPECT_LT(fx.x(), -0.5);  // friction force resists the sideways push
+  EXPECT_LT(fx.x(), -0.5);                         // friction force resists the sideways push
   proxy.update(Vec3(0.005, 0, -0.002), surfaces);  // outside: slip, trail by 0.3 * 2 mm
   EXPECT_NEAR(proxy.proxy_world().x(), 0.005 - 0.3 * 0.002, 2e-5);
+}
+
+// The static cone is anchored at where the proxy is: a device drifting inside it leaves the proxy
+// exactly in place, and no sliding iteration is spent first (on a curved surface the old
+// slide-then-undo did up to max_iterations probes per cycle for nothing).
+TEST(GodObject, InsideTheStaticConeTheProxyStaysWithoutSliding) {
+  test::SolidSphere ball(0.05);
+  ContactMaterial m = wall_material(1000.0, 0.0);
+  m.static_friction = 0.5;
+  m.dynamic_friction = 0.3;
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&ball, Iso3::Identity(), &m, false, &hint}}};
+  GodObject proxy;
+  proxy.reset(Vec3(0, 0, 0.06));
+  proxy.update(Vec3(0, 0, 0.046), surfaces);  // press 4 mm in: cone radius 2 mm
+  ASSERT_TRUE(proxy.in_contact());
+  const Vec3 held = proxy.proxy_world();
+  EXPECT_NEAR(held.z(), 0.05, 1e-5);
+  for (int k = 1; k <= 100; ++k) {  // drift sideways up to 1.5 mm: inside the cone
+    proxy.update(Vec3(1.5e-5 * k, 0, 0.046), surfaces);
+    ASSERT_EQ(proxy.iterations_used(), 0) << k;
+    ASSERT_LT((proxy.proxy_world() - held).norm(), 1e-9) << k;
+  }
+  proxy.update(Vec3(0.004, 0, 0.046), surfaces);  // 4 mm sideways: outside, slips
+  EXPECT_GT(proxy.iterations_used(), 0);
+  EXPECT_GT(proxy.proxy_world().x(), 1e-3);
+  EXPECT_NEAR(proxy.proxy_world().norm(), 0.05, 3e-5);  // still on the surface
 }
 
 TEST(GodObject, NaNDeviceInputHoldsTheProxy) {
@@ -119,10 +146,10 @@ TEST(GodObject, NaNDeviceInputHoldsTheProxy) {
 
 // A device of mass m is pressed onto a stiff virtual wall by a steady hand force and bounces.
 // The force is computed at 1 kHz from the sampled position and a backward-difference velocity
-// and held between samples (zero-order hold); the device itself moves continuously (exactly). Sampling
-// makes a pure spring active (Colgate & Schenkel 1997: it needs damping b > K·T/2). With the
-// damping hapsim ships (K·T) the excess energy above the resting state must never grow over
-// 10 s; without it, it must (the control case, so the test can fail).
+// and held between samples (zero-order hold); the device itself moves continuously (exactly).
+// Sampling makes a pure spring active (Colgate & Schenkel 1997: it needs damping b > K·T/2). With
+// the damping hapsim ships (K·T) the excess energy above the resting state must never grow over 10
+// s; without it, it must (the control case, so the test can fail).
 struct WallRun {
   double initial_excess_j;
   double max_excess_j;

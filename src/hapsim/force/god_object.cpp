@@ -153,6 +153,13 @@ void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface>
   cull_ = true;
   double least = resolve_penetration(surfaces, margin);
   iterations_used_ = 0;
+  // Inside the static friction cone the proxy keeps its place whatever the loop below would do
+  // (apply_friction undoes the tangential part): do not pay for sliding it first. A finger held
+  // on bone while the device drifts inside it is the common case.
+  if (sticks(previous, device_p_world, surfaces)) {
+    cull_ = false;
+    return;
+  }
   while (iterations_used_ < params_.max_iterations) {
     ++iterations_used_;
     const Vec3 motion = project_onto_contacts(device_p_world - proxy_world_, contacts());
@@ -169,6 +176,27 @@ void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface>
   }
   apply_friction(previous, device_p_world, surfaces, margin);
   cull_ = false;
+}
+
+// haptic path
+bool GodObject::sticks(const Vec3& previous_proxy_world, const Vec3& device_p_world,
+                       std::span<const ProxySurface> surfaces) const {
+  if (contact_count_ == 0) {
+    return false;
+  }
+  const ProxyContact& c = contacts_[0];
+  const ContactMaterial* material = surfaces[static_cast<std::size_t>(c.surface)].material;
+  if (material == nullptr || material->static_friction <= 0.0) {
+    return false;
+  }
+  const Vec3& n = c.normal_world;
+  const double depth = (proxy_world_ - device_p_world).dot(n);
+  if (depth <= 0.0) {
+    return false;
+  }
+  const Vec3 offset = device_p_world - previous_proxy_world;
+  const Vec3 tangential = offset - offset.dot(n) * n;
+  return tangential.norm() <= material->static_friction * depth;
 }
 
 // haptic path

@@ -84,6 +84,10 @@ class GodObject {
   double scan(std::span<const ProxySurface> surfaces, double margin_m);
   /// Pushes the proxy out of any surface it penetrates, along that surface's normal.
   double resolve_penetration(std::span<const ProxySurface> surfaces, double margin_m);
+  /// Whether the device is inside the static friction cone of the first contact, seen from the
+  /// proxy's position before this update moved it along the surface.
+  [[nodiscard]] bool sticks(const Vec3& previous_proxy_world, const Vec3& device_p_world,
+                            std::span<const ProxySurface> surfaces) const;
   void apply_friction(const Vec3& previous_proxy_world, const Vec3& device_p_world,
                       std::span<const ProxySurface> surfaces, double margin_m);
 
