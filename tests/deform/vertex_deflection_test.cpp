@@ -376,6 +376,31 @@ TEST(VertexDeflection, ResetReturnsToRest) {
   }
 }
 
+// The automatic grid cell: twice the mean edge, or a quarter of a typical press's d0 when that
+// is larger, so a 25 mm dent on a 1 mm mesh looks up ~8^3 cells, not ~20^3. The deflection
+// itself does not depend on the cell (same vertices, same values).
+TEST(VertexDeflection, GridCellFollowsTheTypicalDent) {
+  const TriangleMesh patch = flat_patch();  // 1 mm grid: mean edge (1 + 1 + sqrt 2) / 3 mm
+  const double mean_edge = (2.0 + std::sqrt(2.0)) / 3.0 * 1e-3;
+  VertexDeflectionOptions bone;
+  bone.segments = {{.elasticity_factor = 0.3, .max_deflection_m = 0.0005}};
+  bone.typical_contact_radius_m = 0.007;
+  EXPECT_NEAR(VertexDeflection(patch, bone).grid().cell_m(), 2.0 * mean_edge, 1e-9);
+  VertexDeflectionOptions muscle;
+  muscle.segments = {{.elasticity_factor = 1.5, .max_deflection_m = 0.015}};
+  muscle.typical_contact_radius_m = 0.007;
+  VertexDeflection wide(patch, muscle);
+  EXPECT_NEAR(wide.grid().cell_m(), 0.25 * 1.5 * (0.010 + 0.007), 1e-12);
+  muscle.grid_cell_m = 0.001;  // given explicitly: used as is
+  VertexDeflection fine(patch, muscle);
+  EXPECT_EQ(fine.grid().cell_m(), 0.001);
+  const DeflectionContact c{Vec3(0.0013, -0.0021, 0.0), 0.009, 0.007, 0};
+  wide.step({&c, 1}, 1e-3);
+  fine.step({&c, 1}, 1e-3);
+  EXPECT_EQ(wide.mesh().vertices, fine.mesh().vertices);
+  EXPECT_GT(wide.deformed_vertex_count(), 1000u);
+}
+
 TEST(VertexDeflection, NoAllocationPerStep) {
   VertexDeflection deflection(flat_patch());
   std::vector<DeflectionContact> contacts{{Vec3(-0.01, 0.0, 0.0), 0.003, 0.005, 0},

@@ -189,6 +189,14 @@ VertexDeflection::VertexDeflection(TriangleMesh rest_mesh, VertexDeflectionOptio
       edge_sum_m += (c[1] - c[0]).norm() + (c[2] - c[1]).norm() + (c[0] - c[2]).norm();
     }
     cell_m = mesh.triangle_count() > 0 ? 2.0 * edge_sum_m / (3.0 * mesh.triangle_count()) : 0.0;
+    // A typical press: a query of radius d0 then spans about 8^3 cells instead of (d0/edge)^3.
+    const double r_m = std::isfinite(options.typical_contact_radius_m)
+                           ? std::max(options.typical_contact_radius_m, 0.0)
+                           : 0.0;
+    for (const DeflectionParams& p : segments_) {
+      const double x_m = std::min(p.max_deflection_m, 0.01);
+      cell_m = std::max(cell_m, 0.25 * zero_deflection_distance_m(x_m, r_m, p.elasticity_factor));
+    }
     if (!(cell_m > 0.0)) {
       const double diag_m = n > 0 ? mesh.bounds().diagonal().norm() : 0.0;
       cell_m = diag_m > 0.0 ? diag_m / std::cbrt(static_cast<double>(n)) : 1.0;

@@ -49,8 +49,13 @@ struct VertexDeflectionOptions {
   std::vector<std::uint32_t> segment_of_vertex;
   /// Parameters per segment. Empty → one segment with default parameters.
   std::vector<DeflectionParams> segments;
-  /// Edge of the rest-position hash grid cells, metres. 0 → twice the mean edge length.
+  /// Edge of the rest-position hash grid cells, metres. 0 → automatic: twice the mean edge
+  /// length, or a quarter of a typical contact's d0 when that is larger (a wide dent on a fine
+  /// mesh would otherwise look up thousands of empty cells).
   double grid_cell_m = 0.0;
+  /// Radius of the tools expected to press the surface, metres (≥ 0); only sizes the automatic
+  /// grid: a typical contact presses min(max_deflection_m, 10 mm) with this radius.
+  double typical_contact_radius_m = 0.005;
 };
 
 struct DeflectionContact {

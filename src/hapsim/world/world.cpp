@@ -113,6 +113,10 @@ World::World(WorldDescription description, WorldOptions options)
     : description_(std::move(description)), options_(options) {
   const Stopwatch watch;
   const std::size_t tool_count = description_.tools.size();
+  double max_tool_radius_m = 0.0;
+  for (const ToolDescription& t : description_.tools) {
+    max_tool_radius_m = std::max(max_tool_radius_m, t.radius_m);
+  }
   for (std::size_t b = 0; b < description_.bodies.size(); ++b) {
     const BodyDescription& body = description_.bodies[b];
     body_first_segment_.push_back(segments_.size());
@@ -142,6 +146,7 @@ World::World(WorldDescription description, WorldOptions options)
       if (body.kind == BodyKind::kDeformable) {
         VertexDeflectionOptions dopt;
         dopt.segments = {description_.materials[sd.material].deflection};
+        dopt.typical_contact_radius_m = max_tool_radius_m;
         if (body.method == ContactMethod::kKnee) {
           // The knee paper moves vertices along their group's radial direction.
           const auto& knee = static_cast<const KneeIndex&>(*seg->rest_query);
