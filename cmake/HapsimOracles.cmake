@@ -6,7 +6,16 @@
 find_package(CGAL QUIET)
 find_package(fcl QUIET)
 find_package(embree 3 QUIET)
-message(STATUS "hapsim oracles: CGAL=${CGAL_FOUND} FCL=${fcl_FOUND} Embree=${embree_FOUND}")
+# orocos-kdl (kinematics oracle): plain find_path/find_library, as its CMake config and
+# kdl_parser's pull in ROS; the tests read the URDF with urdfdom themselves.
+find_path(KDL_INCLUDE_DIR kdl/chain.hpp)
+find_library(KDL_LIBRARY orocos-kdl)
+if(KDL_INCLUDE_DIR AND KDL_LIBRARY)
+  set(KDL_FOUND TRUE)
+else()
+  set(KDL_FOUND FALSE)
+endif()
+message(STATUS "hapsim oracles: CGAL=${CGAL_FOUND} FCL=${fcl_FOUND} Embree=${embree_FOUND} KDL=${KDL_FOUND}")
 
 set(_oracle_sources "${CMAKE_SOURCE_DIR}/oracles/closest_point_oracle.cpp")
 # Each adapter is added only once its file exists, so a partial checkout still configures.
@@ -27,5 +36,10 @@ if(embree_FOUND AND EXISTS "${CMAKE_SOURCE_DIR}/oracles/embree_oracle.cpp")
   list(APPEND _oracle_sources "${CMAKE_SOURCE_DIR}/oracles/embree_oracle.cpp")
   target_link_libraries(hapsim_oracles PRIVATE embree)
   target_compile_definitions(hapsim_oracles PUBLIC HAPSIM_HAVE_EMBREE=1)
+endif()
+if(KDL_FOUND)
+  target_include_directories(hapsim_oracles PUBLIC "${KDL_INCLUDE_DIR}")
+  target_link_libraries(hapsim_oracles PUBLIC "${KDL_LIBRARY}" urdfdom::urdfdom_model)
+  target_compile_definitions(hapsim_oracles PUBLIC HAPSIM_HAVE_KDL=1)
 endif()
 target_sources(hapsim_oracles PRIVATE ${_oracle_sources})

@@ -13,8 +13,8 @@ HAPSIM_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   # product libraries
   libeigen3-dev libassimp-dev liburdfdom-dev nlohmann-json3-dev libcli11-dev libspdlog-dev
-  # tests and benchmarks; CGAL, FCL and Embree are reference oracles only
-  libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libfcl-dev libembree-dev
+  # tests and benchmarks; CGAL, FCL, Embree and orocos-kdl are reference oracles only
+  libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev
 )
 
 hapsim_install_packages() {

@@ -1,0 +1,299 @@
+#include "hapsim/kinematics/urdf_chain.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/geometry/csg.h"
+#include "hapsim/geometry/mesh_io.h"
+#include "hapsim/geometry/polygonizer.h"
+#include "hapsim/geometry/procedural.h"
+
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+namespace hapsim {
+
+namespace {
+
+Iso3 to_iso(const urdf::Pose& pose) {
+  double x = 0.0, y = 0.0, z = 0.0, w = 1.0;
+  pose.rotation.getQuaternion(x, y, z, w);
+  Iso3 X = Iso3::Identity();
+  X.linear() = Quat(w, x, y, z).normalized().toRotationMatrix();
+  X.translation() = Vec3(pose.position.x, pose.position.y, pose.position.z);
+  return X;
+}
+
+int movable_joints_to_root(const urdf::ModelInterface& model, const urdf::LinkConstSharedPtr& link,
+                           const std::string& base) {
+  int n = 0;
+  for (urdf::LinkConstSharedPtr l = link; l && l->name != base; l = l->getParent()) {
+    const urdf::JointSharedPtr& j = l->parent_joint;
+    if (!j) {
+      return -1;  // reached the root without meeting the base: not below it
+    }
+    n += j->type == urdf::Joint::FIXED ? 0 : 1;
+  }
+  (void)model;
+  return n;
+}
+
+class UrdfReader {
+ public:
+  UrdfReader(std::string name, std::filesystem::path folder, const UrdfChainOptions& options)
+      : name_(std::move(name)), folder_(std::move(folder)), options_(options) {}
+
+  SerialChain read(std::string_view xml) {
+    // urdfdom reports parse problems through console_bridge on stderr; we report them ourselves.
+    const console_bridge::LogLevel level = console_bridge::getLogLevel();
+    console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
+    urdf::ModelInterfaceSharedPtr model;
+    try {
+      model = urdf::parseURDF(std::string(xml));
+    } catch (const std::exception& e) {
+      console_bridge::setLogLevel(level);
+      throw Error(name_, std::string("not a valid URDF: ") + e.what());
+    }
+    console_bridge::setLogLevel(level);
+    if (!model) {
+      throw Error(name_,
+                  "not a valid URDF (urdfdom could not read a <robot> with connected "
+                  "links, named joints and known joint types from it)");
+    }
+    return build(*model);
+  }
+
+ private:
+  urdf::LinkConstSharedPtr link(const urdf::ModelInterface& model, const std::string& name,
+                                const char* role) const {
+    urdf::LinkConstSharedPtr l = model.getLink(name);
+    if (!l) {
+      std::string names;
+      for (const auto& [n, ptr] : model.links_) {
+        names += (names.empty() ? "" : ", ") + n;
+      }
+      throw Error(name_, std::string("no ") + role + " link '" + name + "'; links: " + names);
+    }
+    return l;
+  }
+
+  SerialChain build(const urdf::ModelInterface& model) {
+    const urdf::LinkConstSharedPtr root = model.getRoot();
+    if (!root) {
+      throw Error(name_, "the URDF has no root link");
+    }
+    const std::string base =
+        options_.base_link.empty() ? root->name : link(model, options_.base_link, "base")->name;
+    urdf::LinkConstSharedPtr tip;
+    if (!options_.tip_link.empty()) {
+      tip = link(model, options_.tip_link, "tip");
+      if (movable_joints_to_root(model, tip, base) < 0) {
+        throw Error(name_, "link '" + tip->name + "' is not below the base link '" + base + "'");
+      }
+    } else {
+      int best = -1;
+      std::vector<std::string> ties;
+      for (const auto& [n, l] : model.links_) {
+        if (!l->child_links.empty()) {
+          continue;  // leaves only
+        }
+        const int depth = movable_joints_to_root(model, l, base);
+        if (depth > best) {
+          best = depth;
+          tip = l;
+          ties = {n};
+        } else if (depth == best) {
+          ties.push_back(n);
+        }
+      }
+      if (ties.size() > 1) {
+        std::string list;
+        for (const auto& t : ties) {
+          list += (list.empty() ? "" : ", ") + t;
+        }
+        throw Error(name_, "several tip links are equally deep (" + list + "); choose one (--tip)");
+      }
+      if (!tip) {
+        throw Error(name_, "no link below the base link '" + base + "'");
+      }
+    }
+
+    // The path base -> tip, as the links from the tip up.
+    std::vector<urdf::LinkConstSharedPtr> path;
+    for (urdf::LinkConstSharedPtr l = tip; l; l = l->getParent()) {
+      path.push_back(l);
+      if (l->name == base) {
+        break;
+      }
+    }
+    std::reverse(path.begin(), path.end());
+
+    std::vector<ChainJoint> joints;
+    Iso3 pending = Iso3::Identity();  // fixed transforms since the last movable joint's frame
+    struct Attached {
+      urdf::LinkConstSharedPtr link;
+      int frame;
+      Iso3 X_frame_link;
+    };
+    std::vector<Attached> attached{{path.front(), -1, Iso3::Identity()}};
+    for (std::size_t k = 1; k < path.size(); ++k) {
+      const urdf::JointSharedPtr& uj = path[k]->parent_joint;
+      const Iso3 origin = to_iso(uj->parent_to_joint_origin_transform);
+      const std::string where = name_ + ": joint '" + uj->name + "'";
+      switch (uj->type) {
+        case urdf::Joint::FIXED:
+          pending = pending * origin;
+          break;
+        case urdf::Joint::REVOLUTE:
+        case urdf::Joint::CONTINUOUS:
+        case urdf::Joint::PRISMATIC: {
+          ChainJoint j;
+          j.name = uj->name;
+          j.type =
+              uj->type == urdf::Joint::PRISMATIC ? JointType::kPrismatic : JointType::kRevolute;
+          j.X_parent_joint = pending * origin;
+          j.axis = Vec3(uj->axis.x, uj->axis.y, uj->axis.z);
+          if (uj->type != urdf::Joint::CONTINUOUS && uj->limits) {
+            j.lower = uj->limits->lower;
+            j.upper = uj->limits->upper;
+          }
+          if (uj->limits && uj->limits->velocity > 0.0) {
+            j.max_velocity = uj->limits->velocity;
+          }
+          j.child_link = path[k]->name;
+          try {
+            (void)SerialChain("", {j}, Iso3::Identity(), "");  // checks this joint alone
+          } catch (const Error& e) {
+            throw Error(where, e.detail());
+          }
+          joints.push_back(std::move(j));
+          pending = Iso3::Identity();
+          break;
+        }
+        default:
+          throw Error(where,
+                      "is floating or planar; a serial chain takes revolute, continuous, "
+                      "prismatic and fixed joints");
+      }
+      attached.push_back({path[k], static_cast<int>(joints.size()) - 1, pending});
+    }
+    SerialChain chain(base, std::move(joints), pending, tip->name);
+    if (options_.load_collision_meshes) {
+      std::vector<ChainLinkGeometry> links;
+      for (const Attached& a : attached) {
+        add_collision(*a.link, a.frame, a.X_frame_link, links);
+      }
+      chain.set_link_geometry(std::move(links));
+    }
+    return chain;
+  }
+
+  void add_collision(const urdf::Link& link, int frame, const Iso3& X_frame_link,
+                     std::vector<ChainLinkGeometry>& out) const {
+    std::size_t index = 0;
+    for (const urdf::CollisionSharedPtr& c : link.collision_array) {
+      if (!c || !c->geometry) {
+        continue;
+      }
+      const std::string where =
+          name_ + ": link '" + link.name + "' collision " + std::to_string(index++);
+      ChainLinkGeometry g;
+      g.link = link.name;
+      g.frame = frame;
+      g.X_frame_mesh = X_frame_link * to_iso(c->origin);
+      g.mesh = geometry_mesh(*c->geometry, where);
+      out.push_back(std::move(g));
+    }
+  }
+
+  TriangleMesh geometry_mesh(const urdf::Geometry& geometry, const std::string& where) const {
+    switch (geometry.type) {
+      case urdf::Geometry::MESH: {
+        const auto& m = static_cast<const urdf::Mesh&>(geometry);
+        std::string file = m.filename;
+        if (file.rfind("package://", 0) == 0) {
+          throw Error(where, "mesh '" + file +
+                                 "': package:// paths need ROS; give a path relative to the URDF");
+        }
+        if (file.rfind("file://", 0) == 0) {
+          file = file.substr(7);
+        }
+        std::filesystem::path p(file);
+        if (p.is_relative()) {
+          p = folder_ / p;
+        }
+        TriangleMesh mesh;
+        try {
+          mesh = load_mesh(p);
+        } catch (const Error& e) {
+          throw Error(where, "cannot load mesh " + e.where() + ": " + e.detail());
+        }
+        const Vec3 scale(m.scale.x, m.scale.y, m.scale.z);
+        if (!(scale.minCoeff() > 0.0) || !scale.allFinite()) {
+          throw Error(where, "mesh scale must be > 0 on every axis");
+        }
+        if (scale != Vec3::Ones()) {
+          for (Vec3& v : mesh.vertices) {
+            v = v.cwiseProduct(scale);
+          }
+          mesh.compute_vertex_normals();
+        }
+        return mesh;
+      }
+      case urdf::Geometry::BOX: {
+        const auto& b = static_cast<const urdf::Box&>(geometry);
+        const Vec3 half(b.dim.x / 2, b.dim.y / 2, b.dim.z / 2);
+        if (!(half.minCoeff() > 0.0)) {
+          throw Error(where, "box size must be > 0 on every axis");
+        }
+        return make_box(half);
+      }
+      case urdf::Geometry::SPHERE: {
+        const auto& s = static_cast<const urdf::Sphere&>(geometry);
+        if (!(s.radius > 0.0)) {
+          throw Error(where, "sphere radius must be > 0");
+        }
+        return make_uv_sphere(s.radius, 32, 16);
+      }
+      case urdf::Geometry::CYLINDER: {
+        const auto& c = static_cast<const urdf::Cylinder&>(geometry);
+        if (!(c.radius > 0.0) || !(c.length > 0.0)) {
+          throw Error(where, "cylinder radius and length must be > 0");
+        }
+        PolygonizeOptions po;
+        po.max_cells_per_axis = 40;
+        po.threads = 1;
+        TriangleMesh mesh = polygonize(CsgSolid::cylinder(c.radius, c.length / 2), po);
+        mesh.compute_vertex_normals();
+        return mesh;
+      }
+    }
+    throw Error(where, "unknown collision geometry type");
+  }
+
+  std::string name_;
+  std::filesystem::path folder_;
+  UrdfChainOptions options_;
+};
+
+}  // namespace
+
+SerialChain parse_urdf_chain(std::string_view urdf_xml, std::string_view name,
+                             const std::filesystem::path& folder, const UrdfChainOptions& options) {
+  return UrdfReader(std::string(name), folder, options).read(urdf_xml);
+}
+
+SerialChain load_urdf_chain(const std::filesystem::path& file, const UrdfChainOptions& options) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in || std::filesystem::is_directory(file)) {
+    throw Error(file.string(), "cannot open the URDF file (missing or unreadable)");
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_urdf_chain(text.str(), file.string(), file.parent_path(), options);
+}
+
+}  // namespace hapsim
