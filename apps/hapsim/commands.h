@@ -22,5 +22,6 @@ void add_info_command(CLI::App& app);
 void add_query_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_run_command(CLI::App& app);
+void add_kinematics_commands(CLI::App& app);
 
 }  // namespace hapsim::app

@@ -30,7 +30,7 @@ namespace {
 
 struct RunArgs {
   std::string scene;
-  std::string device;  // "sim" or "sim:FILE"
+  std::string device;                                            // "sim" or "sim:FILE"
   double duration_s = std::numeric_limits<double>::quiet_NaN();  // NaN: not given
   std::string record_path;
   std::string replay_path;

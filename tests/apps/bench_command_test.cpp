@@ -24,10 +24,10 @@ TEST(CollisionBenchOracles, EveryOracleFindsTheExactClosestPointOnABox) {
     Vec3 closest;
   };
   const Case cases[] = {
-      {Vec3(0.05, 0.0, 0.0), Vec3(0.01, 0.0, 0.0)},          // face
-      {Vec3(0.02, 0.03, 0.0), Vec3(0.01, 0.02, 0.0)},        // edge
-      {Vec3(0.02, 0.03, 0.04), Vec3(0.01, 0.02, 0.03)},      // vertex
-      {Vec3(0.0, 0.0, 0.025), Vec3(0.0, 0.0, 0.03)},         // inside, nearest face +z
+      {Vec3(0.05, 0.0, 0.0), Vec3(0.01, 0.0, 0.0)},               // face
+      {Vec3(0.02, 0.03, 0.0), Vec3(0.01, 0.02, 0.0)},             // edge
+      {Vec3(0.02, 0.03, 0.04), Vec3(0.01, 0.02, 0.03)},           // vertex
+      {Vec3(0.0, 0.0, 0.025), Vec3(0.0, 0.0, 0.03)},              // inside, nearest face +z
       {Vec3(-0.004, 0.001, -0.002), Vec3(-0.01, 0.001, -0.002)},  // inside, nearest face -x
   };
   const auto names = oracle::available_oracles();

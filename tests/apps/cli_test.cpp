@@ -1,9 +1,9 @@
 // The `hapsim` command as a user runs it: exit codes, one-line messages naming the bad input,
 // and query output checked against analytic answers on a built-in box.
+#include "hapsim_process.h"
+
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,50 +15,12 @@
 
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-RunResult run_hapsim(const std::string& args) {
-  const std::string cmd = std::string(HAPSIM_BIN_PATH) + " " + args + " 2>&1";
-  RunResult result;
-  std::FILE* pipe = popen(cmd.c_str(), "r");
-  if (pipe == nullptr) {
-    return result;
-  }
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe) != nullptr) {
-    result.output += buffer.data();
-  }
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using hapsim::test::read_csv_numbers;
+using hapsim::test::run_hapsim;
+using hapsim::test::RunResult;
 
 std::filesystem::path temp_file(const std::string& name, const std::string& content) {
-  const auto dir = std::filesystem::temp_directory_path() / "hapsim_cli_test";
-  std::filesystem::create_directories(dir);
-  const auto path = dir / name;
-  std::ofstream(path) << content;
-  return path;
-}
-
-std::vector<std::vector<double>> read_csv_numbers(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);  // header
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> row;
-    std::stringstream ss(line);
-    std::string field;
-    while (std::getline(ss, field, ',')) {
-      row.push_back(std::stod(field));
-    }
-    rows.push_back(row);
-  }
-  return rows;
+  return hapsim::test::write_file(name, content);
 }
 
 TEST(Cli, NoSubcommandExitsTwo) {

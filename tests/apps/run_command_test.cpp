@@ -3,12 +3,10 @@
 // for bit, and every bad input is one named line with exit status 2.
 #include <nlohmann/json.hpp>
 
+#include "hapsim_process.h"
+
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -16,39 +14,10 @@
 
 namespace {
 
-struct RunResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
-
-RunResult run_hapsim(const std::string& args) {
-  const std::string cmd = std::string(HAPSIM_BIN_PATH) + " " + args + " 2>&1";
-  RunResult result;
-  std::FILE* pipe = popen(cmd.c_str(), "r");
-  if (pipe == nullptr) {
-    return result;
-  }
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe) != nullptr) {
-    result.output += buffer.data();
-  }
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
-
-std::filesystem::path temp_path(const std::string& name) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("hapsim_run_test_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir / name;
-}
-
-std::filesystem::path write_file(const std::string& name, const std::string& content) {
-  const auto path = temp_path(name);
-  std::ofstream(path) << content;
-  return path;
-}
+using hapsim::test::run_hapsim;
+using hapsim::test::RunResult;
+using hapsim::test::temp_path;
+using hapsim::test::write_file;
 
 const std::string kKnee = std::string(HAPSIM_SCENES_DIR) + "/knee.json";
 
