@@ -2,6 +2,7 @@
 // joint vectors inside the limits), a clear "not reached" for poses out of reach, joint limits
 // never exceeded, tracking converges in a few iterations, and nothing is allocated.
 #include "hapsim/kinematics/inverse_kinematics.h"
+#include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/dh_chain.h"
 #include "hapsim/kinematics/urdf_chain.h"
 
@@ -42,22 +43,9 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kTolM = 1e-4;                 // 0.1 mm
 constexpr double kTolRad = 0.1 * kPi / 180.0;  // 0.1°
 
-// A 6-axis industrial arm with a spherical wrist (the procedural slave's layout).
+// The procedural slave: 6 axes, spherical wrist, the GP7's lengths and limits.
 SerialChain six_axis() {
-  const std::vector<DhRow> rows{
-      {.a_m = 0.04, .alpha_rad = -kPi / 2, .d_m = 0.33, .lower = -2.9, .upper = 2.9},
-      {.a_m = 0.445,
-       .alpha_rad = 0.0,
-       .d_m = 0.0,
-       .theta_rad = -kPi / 2,
-       .lower = -1.1,
-       .upper = 2.5},
-      {.a_m = 0.04, .alpha_rad = -kPi / 2, .d_m = 0.0, .lower = -1.2, .upper = 3.3},
-      {.a_m = 0.0, .alpha_rad = kPi / 2, .d_m = 0.44, .lower = -3.3, .upper = 3.3},
-      {.a_m = 0.0, .alpha_rad = -kPi / 2, .d_m = 0.0, .lower = -2.3, .upper = 2.3},
-      {.a_m = 0.0, .alpha_rad = 0.0, .d_m = 0.08, .lower = -6.2, .upper = 6.2},
-  };
-  return make_dh_chain(rows);
+  return make_procedural_motoman();
 }
 
 std::vector<double> random_q(const SerialChain& chain, std::mt19937& rng, double margin = 0.05) {

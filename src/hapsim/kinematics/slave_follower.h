@@ -1,0 +1,81 @@
+// The slave side of teleoperation: each cycle the master's hand pose, scaled and offset, is the
+// slave tip's target; IK starts from the slave's current joints (one cycle's motion is small, so
+// it converges in a few iterations), and the joints move towards the answer no faster than their
+// speed limits allow — all joints slowed by the same factor, so the tip keeps its direction. The
+// gripper opening follows the master's fingers within its own speed limit.
+#pragma once
+
+#include "hapsim/kinematics/inverse_kinematics.h"
+#include "hapsim/kinematics/serial_chain.h"
+
+#include <array>
+#include <span>
+
+namespace hapsim {
+
+struct TeleopMapping {
+  /// Slave motion per unit of master motion.
+  double scale = 1.6;
+  /// The master's (scaled) base frame in the slave's base frame.
+  Iso3 X_slave_master = Iso3::Identity();
+  /// Slave tool orientation (base frame) when the master's base angle is 0; the master's base
+  /// rotation turns it about the slave's z. Default: the tool's z pointing down.
+  Mat3 R_tool = (Mat3() << 1, 0, 0, 0, -1, 0, 0, 0, -1).finished();
+};
+
+/// The slave tip's target for a master hand position (master base frame) and base angle.
+[[nodiscard]] Iso3 slave_target(const TeleopMapping& mapping, const Vec3& p_master_hand,
+                                double master_base_rad) noexcept;
+
+struct SlaveFollowerOptions {
+  IkOptions ik = real_time_ik();
+  /// Parallel gripper: fully open width and opening/closing speed.
+  double gripper_max_width_m = 0.10;
+  double gripper_speed_m_per_s = 0.25;
+
+  /// Tracking from last cycle's joints: no restarts, a few iterations.
+  static IkOptions real_time_ik() {
+    IkOptions o;
+    o.restarts = 0;
+    o.max_iterations = 20;
+    return o;
+  }
+};
+
+struct SlaveStep {
+  /// IK reached the target this cycle (the joints may still be catching up, see below).
+  bool ik_reached = false;
+  /// The joints were slowed to their speed limits this cycle.
+  bool velocity_limited = false;
+  /// Tip error after the move, metres and radians.
+  double position_error_m = 0.0;
+  double rotation_error_rad = 0.0;
+};
+
+class SlaveFollower {
+ public:
+  /// `q_start`: dof() joint values (clamped into the limits); the gripper starts open. Throws
+  /// hapsim::Error on a chain with a joint lacking a finite speed limit or on bad gripper settings.
+  SlaveFollower(const SerialChain& chain, std::span<const double> q_start,
+                SlaveFollowerOptions options = {});
+
+  /// One cycle towards `target` and `gripper_width_target_m`. A non-finite target leaves the
+  /// joints where they are. haptic path (no allocation)
+  SlaveStep step(const Iso3& target, double gripper_width_target_m, double dt_s) noexcept;
+
+  [[nodiscard]] std::span<const double> q() const {
+    return {q_.data(), static_cast<std::size_t>(chain_->dof())};
+  }
+  [[nodiscard]] Iso3 tip_pose() const noexcept { return chain_->forward(q()); }
+  [[nodiscard]] double gripper_width_m() const { return gripper_width_m_; }
+  [[nodiscard]] const SerialChain& chain() const { return *chain_; }
+
+ private:
+  const SerialChain* chain_;
+  SlaveFollowerOptions options_;
+  std::array<double, kMaxChainJoints> q_{};
+  std::array<double, kMaxChainJoints> goal_{};
+  double gripper_width_m_ = 0.0;
+};
+
+}  // namespace hapsim
