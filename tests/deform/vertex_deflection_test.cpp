@@ -4,6 +4,8 @@
 #include "hapsim/deform/point_hash_grid.h"
 #include "hapsim/geometry/procedural.h"
 
+#include "support/allocation_counter.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -16,26 +18,6 @@
 #include <random>
 #include <set>
 #include <vector>
-
-// Counts every allocation in this test executable, to prove the haptic path allocates nothing.
-// GCC flags free() on memory from the replaced operator new as mismatched; here it is the pair.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) {
-    return p;
-  }
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace hapsim {
 namespace {
@@ -408,7 +390,7 @@ TEST(VertexDeflection, NoAllocationPerStep) {
   const Vec3* vertices = deflection.mesh().vertices.data();
   const std::uint32_t* moved = deflection.moved_vertices().data();
   deflection.step(contacts, 1e-3);  // warm-up (first touch of every buffer)
-  const long before = g_allocations.load();
+  const long before = test::allocation_count();
   for (int k = 0; k < 2000; ++k) {
     contacts[0].p_mesh.x() = -0.04 + 4e-5 * k;  // sweeps: presses and recoveries every step
     deflection.step(k % 3 == 0 ? std::span<const DeflectionContact>() : contacts, 1e-3);
@@ -417,13 +399,13 @@ TEST(VertexDeflection, NoAllocationPerStep) {
     }
   }
   deflection.reset();
-  const long after = g_allocations.load();
+  const long after = test::allocation_count();
   EXPECT_EQ(after - before, 0);
   EXPECT_EQ(deflection.mesh().vertices.data(), vertices);
   EXPECT_EQ(deflection.moved_vertices().data(), moved);
   // The counter itself works (otherwise the check above could not fail).
   auto* probe = new int(1);
-  EXPECT_GT(g_allocations.load(), after);
+  EXPECT_GT(test::allocation_count(), after);
   delete probe;
 }
 

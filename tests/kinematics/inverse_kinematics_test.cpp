@@ -2,9 +2,11 @@
 // joint vectors inside the limits), a clear "not reached" for poses out of reach, joint limits
 // never exceeded, tracking converges in a few iterations, and nothing is allocated.
 #include "hapsim/kinematics/inverse_kinematics.h"
-#include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/dh_chain.h"
+#include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
+
+#include "support/allocation_counter.h"
 
 #include <gtest/gtest.h>
 
@@ -15,25 +17,6 @@
 #include <numbers>
 #include <random>
 #include <vector>
-
-// Counts every allocation in this test executable, to prove IK allocates nothing.
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-namespace {
-std::atomic<long> g_allocations{0};
-}  // namespace
-void* operator new(std::size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) {
-    return p;
-  }
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t) noexcept {
-  std::free(p);
-}
 
 namespace hapsim {
 namespace {
@@ -155,14 +138,14 @@ TEST(InverseKinematics, NoAllocation) {
   }
   targets.push_back(Iso3(Eigen::Translation3d(5.0, 0.0, 0.0)));  // unreachable: all restarts
   std::vector<double> q(6), seed(6, 0.0);
-  const long before = g_allocations.load();
+  const long before = test::allocation_count();
   for (const Iso3& t : targets) {
     (void)solve_ik(arm, t, seed, q);
     (void)arm.jacobian(q);
   }
-  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(test::allocation_count() - before, 0);
   auto* probe = new int(1);  // the counter itself works
-  EXPECT_GT(g_allocations.load(), before);
+  EXPECT_GT(test::allocation_count(), before);
   delete probe;
 }
 

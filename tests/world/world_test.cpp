@@ -6,6 +6,8 @@
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/geometry/procedural.h"
 
+#include "support/allocation_counter.h"
+
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -14,28 +16,6 @@
 #include <cstring>
 #include <limits>
 #include <new>
-
-// Allocation counter for the "no allocation on the haptic path" test: counts only while armed.
-namespace {
-std::atomic<bool> g_count_allocations{false};
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (g_count_allocations.load(std::memory_order_relaxed)) {
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  }
-  if (void* p = std::malloc(size == 0 ? 1 : size)) {
-    return p;
-  }
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept {
-  std::free(p);
-}
-void operator delete(void* p, std::size_t /*size*/) noexcept {
-  std::free(p);
-}
 
 namespace hapsim {
 namespace {
@@ -245,13 +225,11 @@ TEST(World, StepAllocatesNothing) {
   World world(sheet_world(0.004));
   const auto path = press_path();
   world.step(path[0], 1e-3);
-  g_allocations = 0;
-  g_count_allocations = true;
+  const long before = test::allocation_count();
   for (const DeviceInput& in : path) {
     world.step(in, 1e-3);
   }
-  g_count_allocations = false;
-  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_EQ(test::allocation_count() - before, 0);
   EXPECT_GT(world.current_deflection_m(0, 0), 0.0);  // the path did press in
 }
 
