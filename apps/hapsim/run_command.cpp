@@ -3,6 +3,7 @@
 // simulated time, and reports contacts, forces, deflection, pop-throughs and the step cost.
 #include "commands.h"
 #include "progress_printer.h"
+#include "teleop_run.h"
 
 #include "hapsim/core/error.h"
 #include "hapsim/core/stopwatch.h"
@@ -134,6 +135,22 @@ void run(const RunArgs& args) {
   load_options.progress = progress;
   const Stopwatch load_watch;
   SceneDescription scene = load_scene(args.scene, load_options);
+  if (scene.is_teleop) {
+    if (!args.replay_path.empty() || !args.record_path.empty() || !args.method.empty() ||
+        args.realtime) {
+      throw CommandError(args.scene +
+                         ": --record, --replay, --method and --realtime are not available for "
+                         "teleoperation scenes yet");
+    }
+    TeleopRunOptions teleop;
+    teleop.duration_s = args.duration_s;
+    teleop.trajectory = trajectory;
+    teleop.json_path = args.json_path;
+    teleop.progress = progress;
+    json_out.reset();  // run_teleop writes the file itself
+    run_teleop(scene, teleop);
+    return;
+  }
   if (!args.method.empty()) {
     for (BodyDescription& b : scene.world.bodies) {
       b.method = parse_method(args.method);

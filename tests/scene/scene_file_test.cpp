@@ -547,6 +547,53 @@ TEST_F(SceneFileTest, TrajectoryPathsResolveBesideTheSceneFile) {
   EXPECT_FALSE(s.device.has_palpation);
 }
 
+TEST_F(SceneFileTest, TeleopScenesNameTheirMistakes) {
+  const Json teleop = Json::parse(R"({
+    "format": "hapsim-scene/1",
+    "teleop": { "slave": { "model": "procedural" }, "ball": { "start_m": [0.5, -0.25, 0.03] } },
+    "device": { "pick_and_place": { "place_m": [0.5, 0.25, 0.08] } }
+  })");
+  const Mutation cases[] = {
+      {"bodies in a teleop scene", [](Json& j) { j["bodies"] = Json::array(); }, "/bodies",
+       "unknown key 'bodies'"},
+      {"unknown slave model", [](Json& j) { j["teleop"]["slave"]["model"] = "kuka"; },
+       "/teleop/slave/model", "expected one of 'procedural'"},
+      {"missing URDF",
+       [](Json& j) {
+         j["teleop"]["slave"] = {{"urdf", "nowhere.urdf"}};
+       },
+       "/teleop/slave/urdf", "no such file"},
+      {"neither slave kind", [](Json& j) { j["teleop"]["slave"] = Json::object(); },
+       "/teleop/slave", "expected one of 'model'"},
+      {"zero scale",
+       [](Json& j) {
+         j["teleop"]["mapping"] = {{"scale", 0}};
+       },
+       "/teleop/mapping/scale", "expected a number > 0"},
+      {"heavy ball", [](Json& j) { j["teleop"]["ball"]["mass_kg"] = 500; }, "/teleop/ball/mass_kg",
+       "<= 100"},
+      {"no script", [](Json& j) { j["device"].erase("pick_and_place"); }, "/device",
+       "exactly one of 'trajectory'"},
+      {"script without a place", [](Json& j) { j["device"]["pick_and_place"].erase("place_m"); },
+       "/device/pick_and_place", "missing required key 'place_m'"},
+      {"palpation in a teleop scene", [](Json& j) { j["device"]["palpation"] = 1; },
+       "/device/palpation", "unknown key 'palpation'"},
+  };
+  for (const Mutation& c : cases) {
+    SCOPED_TRACE(c.name);
+    Json scene = teleop;
+    c.change(scene);
+    expect_error(scene, c.where, c.fragment);
+  }
+  const SceneDescription s = load_scene(write("teleop.json", teleop.dump()));
+  EXPECT_TRUE(s.is_teleop);
+  EXPECT_TRUE(s.teleop.slave_urdf.empty());
+  EXPECT_TRUE(s.device.has_pick_and_place);
+  EXPECT_TRUE(s.device.pick_and_place.place_m.isApprox(Vec3(0.5, 0.25, 0.08)));
+  EXPECT_EQ(s.teleop.scale, 1.6);  // the default
+  EXPECT_TRUE(s.world.bodies.empty());
+}
+
 TEST(ShippedScenes, KneeLoadsElevenSegmentsWithTissueMaterials) {
   const SceneDescription s = load_scene(fs::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
   ASSERT_EQ(s.world.bodies.size(), 1u);

@@ -170,6 +170,13 @@ class SchemaValidator {
         }
         if (passing != 1)
           why = "matches " + std::to_string(passing) + " of oneOf, not 1";
+      } else if (key == "anyOf") {
+        bool any = false;
+        for (const Json& option : value) {
+          any = any || check(option, j, at).empty();
+        }
+        if (!any)
+          why = "matches none of anyOf";
       } else if (key == "not") {
         if (check(value, j, at).empty())
           why = "matches a 'not'";
@@ -216,7 +223,7 @@ Json small_scene() {
 
 TEST(SceneSchema, ShippedScenesAndASmallSceneSatisfyIt) {
   const SchemaValidator v = schema();
-  for (const char* name : {"knee.json", "knee_vhf.json"}) {
+  for (const char* name : {"knee.json", "knee_vhf.json", "teleop.json", "teleop_gp7.json"}) {
     EXPECT_EQ(v.validate(read_json(kScenes / name)), "") << name;
   }
   EXPECT_EQ(v.validate(small_scene()), "");
@@ -292,6 +299,45 @@ TEST(SceneSchema, BadScenesAreRefusedByTheSchemaAndTheLoader) {
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);
     Json scene = small_scene();
+    c.change(scene);
+    EXPECT_NE(v.validate(scene), "") << "the schema accepts it";
+    std::ofstream(file) << scene.dump();
+    EXPECT_THROW((void)load_scene(file), Error) << "the loader accepts it";
+  }
+  fs::remove(file);
+}
+
+TEST(SceneSchema, BadTeleopScenesAreRefusedByTheSchemaAndTheLoader) {
+  struct Case {
+    const char* name;
+    std::function<void(Json&)> change;
+  };
+  const Case cases[] = {
+      {"teleop and bodies", [](Json& j) { j["bodies"] = Json::array(); }},
+      {"unknown teleop key", [](Json& j) { j["teleop"]["robot"] = "gp7"; }},
+      {"both slave kinds", [](Json& j) { j["teleop"]["slave"]["urdf"] = "gp7.urdf"; }},
+      {"unknown slave model", [](Json& j) { j["teleop"]["slave"]["model"] = "kuka"; }},
+      {"zero scale", [](Json& j) { j["teleop"]["mapping"]["scale"] = 0; }},
+      {"negative ball mass", [](Json& j) { j["teleop"]["ball"]["mass_kg"] = -0.1; }},
+      {"two-number ball start",
+       [](Json& j) {
+         j["teleop"]["ball"]["start_m"] = {0.5, 0.1};
+       }},
+      {"one-node sheet", [](Json& j) { j["teleop"]["sheet"]["nodes_per_side"] = 1; }},
+      {"no place", [](Json& j) { j["device"]["pick_and_place"].erase("place_m"); }},
+      {"script and trajectory", [](Json& j) { j["device"]["trajectory"] = "m.csv"; }},
+      {"palpation in a teleop scene",
+       [](Json& j) {
+         j["device"].erase("pick_and_place");
+         j["device"]["palpation"] = {{"targets", Json::array()}};
+       }},
+  };
+  const SchemaValidator v = schema();
+  const Json teleop = read_json(kScenes / "teleop.json");
+  const fs::path file = fs::temp_directory_path() / "hapsim_schema_bad_teleop.json";
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    Json scene = teleop;
     c.change(scene);
     EXPECT_NE(v.validate(scene), "") << "the schema accepts it";
     std::ofstream(file) << scene.dump();

@@ -35,6 +35,15 @@ struct PalpationScriptDescription {
   Vec3 around_axis_world = Vec3::UnitZ();
 };
 
+/// The teleoperation scene's scripted master (device/pick_and_place_trajectory.h): picks the ball
+/// where it starts and places it at `place_m` (the ball's resting centre).
+struct PickAndPlaceDescription {
+  Vec3 place_m = Vec3(0.5, 0.25, 0.08);
+  double clearance_m = 0.12;
+  /// Seconds for the carry from above the ball to above the target.
+  double carry_s = 2.0;
+};
+
 struct DeviceDescription {
   /// Only "simulated" for now (a trajectory file or a palpation script).
   std::string type = "simulated";
@@ -45,6 +54,27 @@ struct DeviceDescription {
   std::filesystem::path trajectory_file;
   bool has_palpation = false;
   PalpationScriptDescription palpation;
+  bool has_pick_and_place = false;
+  PickAndPlaceDescription pick_and_place;
+};
+
+/// A teleoperation scene (000): master arm → slave arm with a parallel gripper → ball → sheet.
+struct TeleopSceneDescription {
+  /// Empty: the procedural Motoman; else a URDF file and its tip link (empty: the deepest).
+  std::filesystem::path slave_urdf;
+  std::string slave_tip;
+  double scale = 1.6;
+  Vec3 offset_m = Vec3::Zero();
+  double gripper_max_force_n = 20.0;
+  double gripper_max_width_m = 0.10;
+  double gripper_speed_m_per_s = 0.25;
+  double ball_mass_kg = 0.1;
+  double ball_radius_m = 0.03;
+  Vec3 ball_start_m = Vec3(0.5, -0.25, 0.03);
+  int sheet_nodes_per_side = 16;
+  double sheet_size_m = 0.2;
+  Vec3 sheet_position_m = Vec3(0.5, 0.25, 0.05);
+  double floor_z_m = 0.0;
 };
 
 struct RunDescription {
@@ -57,6 +87,9 @@ struct RunDescription {
 struct SceneDescription {
   std::filesystem::path file;  // where it was read from (empty when built in code)
   std::string description;
+  /// Set for a teleoperation scene; then `world` is empty.
+  bool is_teleop = false;
+  TeleopSceneDescription teleop;
   WorldDescription world;
   DeviceDescription device;
   RunDescription run;

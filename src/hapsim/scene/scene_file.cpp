@@ -252,6 +252,9 @@ class Parser {
   Iso3 parse_pose(const Json& j, const std::string& ptr) const;
   ToolDescription parse_tool(const Json& j, const std::string& ptr) const;
   void parse_device(const Json& j, const std::string& ptr, SceneDescription& scene);
+  void parse_teleop(const Json& j, const std::string& ptr, TeleopSceneDescription& t);
+  void parse_teleop_device(const Json& j, const std::string& ptr, SceneDescription& scene);
+  void parse_run(const Json& root, SceneDescription& scene) const;
   std::uint32_t material_ref(const Json& j, const std::string& ptr) const;
 
   std::filesystem::path file_;
@@ -262,9 +265,14 @@ class Parser {
 
 SceneDescription Parser::parse(const Json& root) {
   object(root, "", "a scene");
-  allow_keys(root, "",
-             {"$schema", "format", "description", "data", "world", "materials", "bodies", "tools",
-              "device", "run"});
+  const bool teleop = root.is_object() && root.contains("teleop");
+  if (teleop) {
+    allow_keys(root, "", {"$schema", "format", "description", "data", "teleop", "device", "run"});
+  } else {
+    allow_keys(root, "",
+               {"$schema", "format", "description", "data", "world", "materials", "bodies", "tools",
+                "device", "run"});
+  }
   const Json& format = required(root, "", "format");
   if (!format.is_string() || format.get<std::string>() != "hapsim-scene/1") {
     fail("/format", "expected \"hapsim-scene/1\", got " + shown(format));
@@ -281,6 +289,14 @@ SceneDescription Parser::parse(const Json& root) {
                                     "a folder under the data root");
   }
   scene.world.name = file_.stem().string();
+  if (teleop) {
+    scene.is_teleop = true;
+    parse_teleop(root["teleop"], "/teleop", scene.teleop);
+    parse_teleop_device(required(root, "", "device"), "/device", scene);
+    parse_run(root, scene);
+    report_progress(options_.progress, "scene: loaded", 1.0);
+    return scene;
+  }
   if (root.contains("world")) {
     const Json& w = object(root["world"], "/world", "world settings");
     allow_keys(w, "/world", {"name", "passivity_damping_factor"});
@@ -329,12 +345,7 @@ SceneDescription Parser::parse(const Json& root) {
 
   parse_device(required(root, "", "device"), "/device", scene);
 
-  if (root.contains("run")) {
-    const Json& run = object(root["run"], "/run", "run settings");
-    allow_keys(run, "/run", {"duration_s", "dt_s"});
-    scene.run.duration_s = number_in(run, "/run", "duration_s", 0.0, 0.0, 86400.0, "seconds");
-    scene.run.dt_s = number_in(run, "/run", "dt_s", 0.001, 0.0, 0.01, "seconds", true);
-  }
+  parse_run(root, scene);
   // Palpation targets must name what exists.
   if (scene.device.has_palpation) {
     for (std::size_t i = 0; i < scene.device.palpation.targets.size(); ++i) {
@@ -815,6 +826,110 @@ void Parser::parse_device(const Json& j, const std::string& ptr, SceneDescriptio
     target.hold_s = number_in(t, ip, "hold_s", target.hold_s, 0.0, 60.0, "seconds");
     s.targets.push_back(target);
   }
+}
+
+void Parser::parse_run(const Json& root, SceneDescription& scene) const {
+  if (root.contains("run")) {
+    const Json& run = object(root["run"], "/run", "run settings");
+    allow_keys(run, "/run", {"duration_s", "dt_s"});
+    scene.run.duration_s = number_in(run, "/run", "duration_s", 0.0, 0.0, 86400.0, "seconds");
+    scene.run.dt_s = number_in(run, "/run", "dt_s", 0.001, 0.0, 0.01, "seconds", true);
+  }
+}
+
+void Parser::parse_teleop(const Json& j, const std::string& ptr, TeleopSceneDescription& t) {
+  object(j, ptr, "teleoperation settings");
+  allow_keys(j, ptr, {"slave", "mapping", "gripper", "ball", "sheet", "floor_z_m"});
+  if (j.contains("slave")) {
+    const std::string sp = at(ptr, "slave");
+    const Json& s = object(j["slave"], sp, "the slave arm");
+    allow_keys(s, sp, {"model", "urdf", "tip"});
+    if (s.contains("model") == s.contains("urdf")) {
+      fail(sp, "expected one of 'model' (\"procedural\") or 'urdf' (a URDF file)");
+    }
+    if (s.contains("model")) {
+      one_of(s["model"], at(sp, "model"), {"procedural"});
+    } else {
+      t.slave_urdf = path(s["urdf"], at(sp, "urdf"), "a URDF file path");
+      if (!std::filesystem::is_regular_file(t.slave_urdf)) {
+        fail(at(sp, "urdf"), "no such file: " + t.slave_urdf.string());
+      }
+    }
+    if (s.contains("tip")) {
+      t.slave_tip = nonempty_string(s["tip"], at(sp, "tip"), "a link name");
+    }
+  }
+  if (j.contains("mapping")) {
+    const std::string mp = at(ptr, "mapping");
+    const Json& m = object(j["mapping"], mp, "the master-to-slave mapping");
+    allow_keys(m, mp, {"scale", "offset_m"});
+    t.scale = number_in(m, mp, "scale", t.scale, 0.0, 100.0, "", true);
+    if (m.contains("offset_m")) {
+      t.offset_m = vec3(m["offset_m"], at(mp, "offset_m"), "m");
+    }
+  }
+  if (j.contains("gripper")) {
+    const std::string gp = at(ptr, "gripper");
+    const Json& g = object(j["gripper"], gp, "gripper settings");
+    allow_keys(g, gp, {"max_force_n", "max_width_m", "speed_m_per_s"});
+    t.gripper_max_force_n =
+        number_in(g, gp, "max_force_n", t.gripper_max_force_n, 0.0, 1000.0, "N", true);
+    t.gripper_max_width_m =
+        number_in(g, gp, "max_width_m", t.gripper_max_width_m, 0.0, 1.0, "m", true);
+    t.gripper_speed_m_per_s =
+        number_in(g, gp, "speed_m_per_s", t.gripper_speed_m_per_s, 0.0, 10.0, "m/s", true);
+  }
+  if (j.contains("ball")) {
+    const std::string bp = at(ptr, "ball");
+    const Json& b = object(j["ball"], bp, "ball settings");
+    allow_keys(b, bp, {"mass_kg", "radius_m", "start_m"});
+    t.ball_mass_kg = number_in(b, bp, "mass_kg", t.ball_mass_kg, 0.0, 100.0, "kg", true);
+    t.ball_radius_m = number_in(b, bp, "radius_m", t.ball_radius_m, 0.0, 1.0, "m", true);
+    if (b.contains("start_m")) {
+      t.ball_start_m = vec3(b["start_m"], at(bp, "start_m"), "m");
+    }
+  }
+  if (j.contains("sheet")) {
+    const std::string shp = at(ptr, "sheet");
+    const Json& sh = object(j["sheet"], shp, "sheet settings");
+    allow_keys(sh, shp, {"nodes_per_side", "size_m", "position_m"});
+    t.sheet_nodes_per_side = static_cast<int>(number_in(sh, shp, "nodes_per_side", 16, 2, 512, ""));
+    t.sheet_size_m = number_in(sh, shp, "size_m", t.sheet_size_m, 0.0, 100.0, "m", true);
+    if (sh.contains("position_m")) {
+      t.sheet_position_m = vec3(sh["position_m"], at(shp, "position_m"), "m");
+    }
+  }
+  t.floor_z_m = number_in(j, ptr, "floor_z_m", t.floor_z_m, -100.0, 100.0, "m");
+}
+
+void Parser::parse_teleop_device(const Json& j, const std::string& ptr, SceneDescription& scene) {
+  object(j, ptr, "the master device");
+  allow_keys(j, ptr, {"type", "trajectory", "pick_and_place"});
+  DeviceDescription& d = scene.device;
+  d.profile = "simulated";
+  if (j.contains("type")) {
+    d.type = one_of(j["type"], at(ptr, "type"), {"simulated"});
+  }
+  if (j.contains("trajectory") == j.contains("pick_and_place")) {
+    fail(ptr,
+         "expected exactly one of 'trajectory' (a CSV of master joints j0..j2 and fingers "
+         "f0, f1) or 'pick_and_place' (a script)");
+  }
+  if (j.contains("trajectory")) {
+    d.trajectory_file = path(j["trajectory"], at(ptr, "trajectory"), "a trajectory CSV path");
+    if (!std::filesystem::is_regular_file(d.trajectory_file)) {
+      fail(at(ptr, "trajectory"), "no such file: " + d.trajectory_file.string());
+    }
+    return;
+  }
+  const std::string pp = at(ptr, "pick_and_place");
+  const Json& p = object(j["pick_and_place"], pp, "a pick-and-place script");
+  allow_keys(p, pp, {"place_m", "clearance_m", "carry_s"});
+  d.has_pick_and_place = true;
+  PickAndPlaceDescription& s = d.pick_and_place;
+  s.place_m = vec3(required(p, pp, "place_m"), at(pp, "place_m"), "m");
+  s.clearance_m = number_in(p, pp, "clearance_m", s.clearance_m, 0.0, 1.0, "m", true);
+  s.carry_s = number_in(p, pp, "carry_s", s.carry_s, 0.0, 60.0, "seconds", true);
 }
 
 // 1-based line and column of a byte offset, for JSON syntax errors.

@@ -1,0 +1,224 @@
+// `hapsim run` on a teleoperation scene (scenes/teleop.json): the master (scripted pick-and-place
+// or a trajectory of master joints) drives the slave, which grasps the ball and places it on the
+// sheet; the summary says whether and when it was grasped and released, how high it went, where
+// it ended and how far from the target, the peak grasp force, the sheet's deepest dent and the
+// step cost.
+#include "teleop_run.h"
+
+#include "commands.h"
+
+#include "hapsim/core/stopwatch.h"
+#include "hapsim/device/pick_and_place_trajectory.h"
+#include "hapsim/kinematics/procedural_motoman.h"
+#include "hapsim/kinematics/urdf_chain.h"
+#include "hapsim/world/teleop_world.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <vector>
+
+namespace hapsim::app {
+namespace {
+
+TeleopWorldDescription world_description(const SceneDescription& scene) {
+  const TeleopSceneDescription& t = scene.teleop;
+  TeleopWorldDescription d;
+  if (t.slave_urdf.empty()) {
+    d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
+  } else {
+    UrdfChainOptions o;
+    o.tip_link = t.slave_tip;
+    o.load_collision_meshes = false;  // the run needs the kinematics; meshes are for display
+    d.slave = std::make_shared<const SerialChain>(load_urdf_chain(t.slave_urdf, o));
+  }
+  d.mapping.scale = t.scale;
+  d.mapping.X_slave_master = Iso3(Eigen::Translation3d(t.offset_m));
+  d.gripper.max_force_n = t.gripper_max_force_n;
+  d.follower.gripper_max_width_m = t.gripper_max_width_m;
+  d.follower.gripper_speed_m_per_s = t.gripper_speed_m_per_s;
+  d.ball.mass_kg = t.ball_mass_kg;
+  d.ball.radius_m = t.ball_radius_m;
+  d.ball_start_world = t.ball_start_m;
+  d.sheet.nodes_per_side = t.sheet_nodes_per_side;
+  d.sheet.side_m = t.sheet_size_m;
+  d.environment.X_world_sheet = Iso3(Eigen::Translation3d(t.sheet_position_m));
+  d.environment.floor_z_m = t.floor_z_m;
+  return d;
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) {
+    return 0.0;
+  }
+  std::sort(v.begin(), v.end());
+  const auto i = static_cast<std::size_t>(p * static_cast<double>(v.size() - 1) + 0.5);
+  return v[std::min(i, v.size() - 1)];
+}
+
+}  // namespace
+
+void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) {
+  if (std::isfinite(options.duration_s) && !(options.duration_s > 0.0)) {
+    throw CommandError("--duration: expected a positive number of seconds");
+  }
+  TeleopWorldDescription d = world_description(scene);
+  const MasterArm master(d.master);
+  Trajectory trajectory;
+  bool has_target = false;
+  Vec3 target = Vec3::Zero();
+  std::string device_name;
+  if (options.trajectory || !scene.device.has_pick_and_place) {
+    const std::filesystem::path file =
+        options.trajectory ? *options.trajectory : scene.device.trajectory_file;
+    trajectory = load_trajectory_csv(file);
+    if (trajectory.joint_count < 3 || trajectory.finger_count < 2) {
+      throw CommandError(file.string() +
+                         ": a master trajectory needs joint columns j0..j2 (base, shoulder, "
+                         "elbow) and finger columns f0, f1");
+    }
+    device_name = "simulated master (trajectory " + file.string() + ")";
+  } else {
+    PickAndPlaceScript script;
+    script.pick_world = d.ball_start_world;
+    script.place_world = scene.device.pick_and_place.place_m;
+    script.clearance_m = scene.device.pick_and_place.clearance_m;
+    script.carry_s = scene.device.pick_and_place.carry_s;
+    script.pad_depth_m = d.gripper.pad_depth_m;
+    script.open_width_m = 0.9 * d.follower.gripper_max_width_m;
+    trajectory = make_pick_and_place_plan(script, master, d.mapping, d.follower.gripper_max_width_m)
+                     .trajectory;
+    has_target = true;
+    target = script.place_world;
+    device_name = "simulated master (scripted pick-and-place)";
+  }
+
+  // The slave starts where the master's first pose asks it to be (one cold IK, before the run).
+  const DeviceInput first = trajectory.sample_at(trajectory.start_time_s());
+  const Iso3 start = slave_target(
+      d.mapping,
+      master.hand_pose({first.joint_rad[0], first.joint_rad[1], first.joint_rad[2]}).translation(),
+      first.joint_rad[0]);
+  const std::vector<double> seed(static_cast<std::size_t>(d.slave->dof()), 0.0);
+  d.slave_start_rad.assign(seed.size(), 0.0);
+  if (!solve_ik(*d.slave, start, seed, d.slave_start_rad).reached) {
+    throw CommandError(scene.file.string() +
+                       ": the master's first pose puts the slave's target out of its reach");
+  }
+  const std::string slave_name =
+      scene.teleop.slave_urdf.empty() ? "procedural Motoman" : scene.teleop.slave_urdf.string();
+  TeleopWorld world(std::move(d));
+  std::printf(
+      "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
+      "sheet %dx%d\n",
+      scene.file.string().c_str(), slave_name.c_str(), world.slave().chain().dof(),
+      world.ball().params().mass_kg * 1e3, world.ball().params().radius_m * 1e3,
+      scene.teleop.sheet_nodes_per_side, scene.teleop.sheet_nodes_per_side);
+  std::printf("device       %s\n", device_name.c_str());
+
+  const double dt = scene.run.dt_s;
+  double duration = trajectory.end_time_s() - trajectory.start_time_s();
+  if (scene.run.duration_s > 0.0) {
+    duration = scene.run.duration_s;
+  }
+  if (std::isfinite(options.duration_s)) {
+    duration = options.duration_s;
+  }
+  const auto steps = static_cast<std::size_t>(std::llround(duration / dt));
+  std::vector<double> step_us;
+  step_us.reserve(steps);
+  bool grasped = false;
+  double grasp_time = -1.0;
+  double release_time = -1.0;
+  double lift = 0.0;
+  double peak_grasp = 0.0;
+  double deepest_sheet = 0.0;
+  double slave_error = 0.0;
+  std::size_t nonfinite = 0;
+  const double start_z = world.ball().p_world().z();
+  const Stopwatch wall;
+  for (std::size_t k = 1; k <= steps; ++k) {
+    const DeviceInput in = trajectory.sample_at(trajectory.start_time_s() + k * dt);
+    const Stopwatch watch;
+    const TeleopStepResult& r = world.step(in, dt);
+    step_us.push_back(watch.elapsed_s() * 1e6);
+    if (r.gripper.grasped_now && !grasped) {
+      grasped = true;
+      grasp_time = r.time_s;
+    }
+    if (r.gripper.released_now && grasped && release_time < 0.0) {
+      release_time = r.time_s;
+    }
+    lift = std::max(lift, r.ball_p_world.z() - start_z);
+    peak_grasp = std::max(peak_grasp, r.gripper.grasp_force_n());
+    deepest_sheet = std::max(deepest_sheet, r.sheet_depth_m);
+    slave_error = std::max(slave_error, r.slave.position_error_m);
+    nonfinite += r.ball_p_world.allFinite() ? 0 : 1;
+    if (options.progress && k % std::max<std::size_t>(steps / 100, 1) == 0) {
+      options.progress("run", static_cast<double>(k) / static_cast<double>(steps));
+    }
+  }
+  const double wall_s = wall.elapsed_s();
+  const Vec3 final_p = world.ball().p_world();
+  const double target_error = has_target ? (final_p - target).norm() : -1.0;
+  const double p50 = percentile(step_us, 0.5), p99 = percentile(step_us, 0.99),
+               max_us = step_us.empty() ? 0.0 : *std::max_element(step_us.begin(), step_us.end());
+
+  std::printf("%zu steps, %.3f s simulated in %.3f s wall\n", steps, steps * dt, wall_s);
+  if (grasped) {
+    std::printf("grasp        achieved at %.3f s, peak grasp force %.2f N, ball lifted %.1f mm\n",
+                grasp_time, peak_grasp, lift * 1e3);
+  } else {
+    std::printf("grasp        never achieved\n");
+  }
+  if (release_time >= 0.0) {
+    std::printf("release      at %.3f s\n", release_time);
+  }
+  std::printf("ball         ends at (%.4f, %.4f, %.4f) m", final_p.x(), final_p.y(), final_p.z());
+  if (has_target) {
+    std::printf(", %.2f mm from the target spot", target_error * 1e3);
+  }
+  std::printf("\nsheet        deepest dent %.3f mm\n", deepest_sheet * 1e3);
+  std::printf("slave        largest tip error while tracking %.3f mm\n", slave_error * 1e3);
+  std::printf("step cost: p50 %.2f us, p99 %.2f us, max %.1f us\n", p50, p99, max_us);
+
+  const bool ok =
+      nonfinite == 0 && (!has_target || (grasped && release_time >= 0.0 && target_error <= 0.005));
+  if (!ok) {
+    std::printf("FAILED: the pick-and-place did not end with the ball within 5 mm of the target\n");
+    exit_status() = 1;
+  }
+  if (!options.json_path.empty()) {
+    nlohmann::json j;
+    j["scene"] = scene.file.string();
+    j["device"] = device_name;
+    j["slave"] = slave_name;
+    j["steps"] = steps;
+    j["dt_s"] = dt;
+    j["grasped"] = grasped;
+    j["grasp_time_s"] = grasped ? nlohmann::json(grasp_time) : nlohmann::json(nullptr);
+    j["release_time_s"] =
+        release_time >= 0.0 ? nlohmann::json(release_time) : nlohmann::json(nullptr);
+    j["ball_lift_m"] = lift;
+    j["ball_final_position_m"] = {final_p.x(), final_p.y(), final_p.z()};
+    j["ball_target_error_m"] = has_target ? nlohmann::json(target_error) : nlohmann::json(nullptr);
+    j["peak_grasp_force_n"] = peak_grasp;
+    j["max_sheet_deflection_m"] = deepest_sheet;
+    j["max_slave_tracking_error_m"] = slave_error;
+    j["step_us"] = {{"p50", p50}, {"p99", p99}, {"max", max_us}};
+    j["wall_s"] = wall_s;
+    j["ok"] = ok;
+    std::ofstream out(options.json_path);
+    out << j.dump(2) << '\n';
+    if (!out) {
+      throw CommandError("--json " + options.json_path + ": write failed");
+    }
+    std::printf("wrote        %s\n", options.json_path.c_str());
+  }
+}
+
+}  // namespace hapsim::app
