@@ -6,11 +6,14 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace hapsim {
 
 BallEnvironment::BallEnvironment(VirtualSheet& sheet, BallEnvironmentOptions options)
-    : sheet_(&sheet), options_(options), X_sheet_world_(options.X_world_sheet.inverse()) {
+    : sheet_(&sheet),
+      options_(std::move(options)),
+      X_sheet_world_(options_.X_world_sheet.inverse()) {
   if (!options_.X_world_sheet.matrix().allFinite()) {
     throw Error("ball environment", "sheet pose must be finite");
   }

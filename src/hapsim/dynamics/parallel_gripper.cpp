@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace hapsim {
 
@@ -13,7 +14,7 @@ constexpr std::array<double, 2> kSide{1.0, -1.0};
 
 }  // namespace
 
-ParallelGripper::ParallelGripper(ParallelGripperParams params) : params_(params) {
+ParallelGripper::ParallelGripper(ParallelGripperParams params) : params_(std::move(params)) {
   if (!(params_.pad_half_m.minCoeff() > 0.0) || !params_.pad_half_m.allFinite() ||
       !std::isfinite(params_.pad_depth_m)) {
     throw Error("gripper", "pad sizes must be finite and > 0 m");

@@ -4,11 +4,12 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace hapsim {
 
 RigidBall::RigidBall(RigidBallParams params, const Vec3& p_world, const Vec3& v_world)
-    : params_(params), p_(p_world), v_(v_world) {
+    : params_(std::move(params)), p_(p_world), v_(v_world) {
   if (!std::isfinite(params_.mass_kg) || params_.mass_kg <= 0.0) {
     throw Error("ball", "mass must be > 0 kg, got " + std::to_string(params_.mass_kg));
   }

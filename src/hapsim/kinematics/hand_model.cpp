@@ -133,7 +133,8 @@ GloveReading glove_reading(const Iso3& X_world_hand, std::span<const double> joi
   r.X_world_hand = X_world_hand;
   for (int f = 0; f < kHandFingers; ++f) {
     for (int k = 0; k < kGloveAnglesPerFinger; ++k) {
-      const auto i = static_cast<std::size_t>(f * kGloveAnglesPerFinger + k);
+      const std::size_t i =
+          static_cast<std::size_t>(f) * kGloveAnglesPerFinger + static_cast<std::size_t>(k);
       r.angles_rad[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)] =
           i < joint_rad.size() ? joint_rad[i] : 0.0;
     }

@@ -30,7 +30,7 @@ SerialChain::SerialChain(std::string base_link, std::vector<ChainJoint> joints, 
                          std::string tip_link)
     : base_link_(std::move(base_link)),
       joints_(std::move(joints)),
-      X_last_tip_(X_last_tip),
+      X_last_tip_(std::move(X_last_tip)),
       tip_link_(std::move(tip_link)) {
   if (joints_.size() > static_cast<std::size_t>(kMaxChainJoints)) {
     throw Error("chain " + base_link_ + " -> " + tip_link_,

@@ -110,13 +110,19 @@ class Parser {
 
   void allow_keys(const Json& obj, const std::string& ptr,
                   std::initializer_list<const char*> allowed) const {
-    for (const auto& [key, value] : obj.items()) {
+    for (const auto& item : obj.items()) {
+      const std::string& key = item.key();
       if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
         std::string list;
         for (const char* a : allowed) {
-          list += (list.empty() ? "" : ", ") + std::string(a);
+          list += list.empty() ? "" : ", ";
+          list += a;
         }
-        fail(at(ptr, key), "unknown key '" + key + "'; allowed here: " + list);
+        std::string what = "unknown key '";
+        what += key;
+        what += "'; allowed here: ";
+        what += list;
+        fail(at(ptr, key), what);
       }
     }
   }
@@ -662,7 +668,9 @@ void Parser::parse_body_materials(const Json& j, const std::string& ptr, BodyDes
   std::map<std::string, std::uint32_t> by_tissue;
   if (j.contains("by_tissue")) {
     const std::string tp = at(ptr, "by_tissue");
-    for (const auto& [tissue, name] : object(j["by_tissue"], tp, "materials by tissue").items()) {
+    for (const auto& item : object(j["by_tissue"], tp, "materials by tissue").items()) {
+      const std::string& tissue = item.key();
+      const Json& name = item.value();
       const char* known[] = {"bone", "cartilage", "muscle", "tendon", "ligament", "skin"};
       if (std::none_of(std::begin(known), std::end(known),
                        [&](const char* k) { return tissue == k; })) {
@@ -689,7 +697,9 @@ void Parser::parse_body_materials(const Json& j, const std::string& ptr, BodyDes
   std::map<std::string, std::uint32_t> by_segment;
   if (j.contains("segments")) {
     const std::string sp = at(ptr, "segments");
-    for (const auto& [name, m] : object(j["segments"], sp, "materials by segment").items()) {
+    for (const auto& item : object(j["segments"], sp, "materials by segment").items()) {
+      const std::string& name = item.key();
+      const Json& m = item.value();
       if (std::none_of(body.segments.begin(), body.segments.end(),
                        [&](const SegmentDescription& s) { return s.name == name; })) {
         fail(at(sp, name),
