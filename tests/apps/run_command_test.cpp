@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
 namespace {
@@ -53,6 +54,33 @@ TEST(RunCommand, KneePalpationReportsAndWritesJson) {
   EXPECT_GT(contacts, 100u);
   EXPECT_GT(deflection, 0.0);
   EXPECT_LT(deflection, 0.02);
+}
+
+// The hand variant: two fingers press at once, the index on the patella and the middle finger on
+// the patellar tendon, each feeling its own segment through its own glove actuator.
+TEST(RunCommand, KneeHandPressesTwoSegmentsWithTwoFingers) {
+  const auto json_path = temp_path("knee_hand.json");
+  const RunResult r = run_hapsim("run " + std::string(HAPSIM_SCENES_DIR) +
+                                 "/knee_hand.json -q --json " + json_path.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  std::map<std::string, double> tool_peak;
+  for (const auto& t : j.at("tools")) {
+    tool_peak[t.at("name").get<std::string>()] = t.at("peak_force_n").get<double>();
+  }
+  EXPECT_GT(tool_peak.at("index"), 0.5);
+  EXPECT_GT(tool_peak.at("middle"), 0.5);
+  EXPECT_EQ(tool_peak.at("thumb"), 0.0);  // curled out of the way
+  EXPECT_EQ(tool_peak.at("ring"), 0.0);
+  std::map<std::string, std::size_t> contacts;
+  for (const auto& s : j.at("segments")) {
+    contacts[s.at("name").get<std::string>()] = s.at("contacts").get<std::size_t>();
+  }
+  EXPECT_GT(contacts["patella"], 100u);
+  EXPECT_GT(contacts["patellar_tendon"], 100u);
+  EXPECT_EQ(j.at("pop_throughs").get<std::size_t>(), 0u);
+  EXPECT_EQ(j.at("max_force_limit_violations").get<std::size_t>(), 0u);
 }
 
 TEST(RunCommand, RecordingReplaysBitForBit) {

@@ -594,6 +594,56 @@ TEST_F(SceneFileTest, TeleopScenesNameTheirMistakes) {
   EXPECT_TRUE(s.world.bodies.empty());
 }
 
+TEST_F(SceneFileTest, GloveScenesNameTheirMistakes) {
+  Json glove = base();
+  glove["tools"] = {{{"name", "index"}, {"finger", 1}}, {{"name", "middle"}, {"finger", 2}}};
+  glove["device"] = Json::parse(R"({
+    "type": "glove", "profile": "simulated",
+    "glove_palpation": { "from": [0, 0, 1],
+                         "fingers": [ { "finger": 1, "body": "block", "segment": "block" } ] }
+  })");
+  const Mutation cases[] = {
+      {"palpation for a glove", [](Json& j) { j["device"]["palpation"] = Json::object(); },
+       "/device/palpation", "scripted by 'glove_palpation'"},
+      {"a tool on no finger", [](Json& j) { j["tools"][1]["finger"] = -1; }, "/tools/1/finger",
+       "a glove drives the tools"},
+      {"a finger without a tool",
+       [](Json& j) { j["device"]["glove_palpation"]["fingers"][0]["finger"] = 3; },
+       "/device/glove_palpation/fingers/0/finger", "no tool in /tools sits on finger 3"},
+      {"a finger twice",
+       [](Json& j) {
+         j["device"]["glove_palpation"]["fingers"].push_back(
+             j["device"]["glove_palpation"]["fingers"][0]);
+       },
+       "/device/glove_palpation/fingers/1/finger", "listed twice"},
+      {"an unknown segment",
+       [](Json& j) { j["device"]["glove_palpation"]["fingers"][0]["segment"] = "patella"; },
+       "/device/glove_palpation/fingers/0/segment", "got 'patella'"},
+      {"no direction",
+       [](Json& j) {
+         j["device"]["glove_palpation"]["from"] = {0, 0, 0};
+       },
+       "/device/glove_palpation/from", "non-zero direction"},
+      {"glove script on a stylus", [](Json& j) { j["device"]["type"] = "simulated"; }, "/device",
+       "need \"type\": \"glove\""},
+      {"bad coupling",
+       [](Json& j) {
+         j["device"]["hand"] = {{"dip_per_pip", -1}};
+       },
+       "/device/hand/dip_per_pip", ">= 0"},
+  };
+  for (const Mutation& c : cases) {
+    SCOPED_TRACE(c.name);
+    Json scene = glove;
+    c.change(scene);
+    expect_error(scene, c.where, c.fragment);
+  }
+  const SceneDescription s = load_scene(write("glove.json", glove.dump()));
+  EXPECT_TRUE(s.world.has_hand);
+  EXPECT_TRUE(s.device.has_glove_palpation);
+  EXPECT_EQ(s.device.glove_palpation.fingers.at(0).finger, 1);
+}
+
 TEST(ShippedScenes, KneeLoadsElevenSegmentsWithTissueMaterials) {
   const SceneDescription s = load_scene(fs::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
   ASSERT_EQ(s.world.bodies.size(), 1u);

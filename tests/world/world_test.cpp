@@ -4,6 +4,7 @@
 // replays to the same bits.
 #include "hapsim/world/world.h"
 #include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/core/error.h"
 #include "hapsim/geometry/procedural.h"
 
 #include "support/allocation_counter.h"
@@ -219,6 +220,43 @@ std::vector<DeviceInput> press_path() {
     path.push_back(at(Vec3(0.01 * std::sin(20 * t), 0.003 * t, 0.004 - 0.03 * t), t));
   }
   return path;
+}
+
+// A glove drives the tools: each finger tool sits at the virtual hand's fingertip for the
+// tracker pose and the glove angles, and its force goes to its own finger actuator.
+TEST(World, GloveFingertipsPlaceTheTools) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.008);
+  w.tools[0].name = "index";
+  w.tools[0].finger = 1;
+  ToolDescription middle = w.tools[0];
+  middle.name = "middle";
+  middle.finger = 2;
+  w.tools.push_back(middle);
+  w.has_hand = true;
+  World world(w);
+  DeviceInput in = at(Vec3(-0.1, -0.02, 0.05));
+  in.q_world = Quat(Eigen::AngleAxisd(0.1, Vec3::UnitZ()));  // fingers along +x over the block
+  in.joint_count = 15;
+  in.joint_rad[3 + 1] = 0.9;  // index MCP flexion: curls the index down onto the block
+  in.joint_rad[3 + 2] = 0.6;  // index PIP
+  const StepResult& r = world.step(in, 1e-3);
+  const HandModel hand(w.hand);
+  GloveReading g;
+  g.X_world_hand = Eigen::Translation3d(in.p_world) * in.q_world;
+  g.angles_rad[1] = {0.0, 0.9, 0.6};
+  const auto tips = hand.fingertips_world(g);
+  EXPECT_NEAR((r.tools[0].p_world - tips[1]).norm(), 0.0, 1e-15);
+  EXPECT_NEAR((r.tools[1].p_world - tips[2]).norm(), 0.0, 1e-15);
+  // The curled index presses into the block's top (z = 0); the straight middle finger is above.
+  ASSERT_LT(tips[1].z(), 0.008);
+  ASSERT_GT(tips[2].z(), 0.008);
+  EXPECT_GT(r.command.finger_force_n[1], 0.0);
+  EXPECT_EQ(r.command.finger_force_n[2], 0.0);
+  EXPECT_EQ(r.command.force_world_n, Vec3::Zero());  // a glove has no tip actuator
+
+  WorldDescription bad = w;
+  bad.tools[1].finger = -1;
+  EXPECT_THROW(World{bad}, Error);
 }
 
 TEST(World, StepAllocatesNothing) {

@@ -35,6 +35,27 @@ struct PalpationScriptDescription {
   Vec3 around_axis_world = Vec3::UnitZ();
 };
 
+/// One finger of a glove palpation: the finger (0 thumb .. 4 little) presses the named segment.
+struct GloveFingerTarget {
+  int finger = 1;
+  std::string body;
+  std::string segment;
+};
+
+/// A scripted glove palpation (knee paper §3.1, the hand variant): the hand comes at the body from
+/// `from_world` with its fingers formed so each chosen fingertip lands on its own segment, presses
+/// `depth_m` in, holds and backs off; fingers not chosen stay curled out of the way.
+struct GlovePalpationDescription {
+  std::vector<GloveFingerTarget> fingers;
+  Vec3 from_world = Vec3::UnitY();
+  double depth_m = 0.006;
+  double standoff_m = 0.03;
+  double move_s = 0.8;
+  double press_s = 0.6;
+  double hold_s = 0.6;
+  double release_s = 0.6;
+};
+
 /// The teleoperation scene's scripted master (device/pick_and_place_trajectory.h): picks the ball
 /// where it starts and places it at `place_m` (the ball's resting centre).
 struct PickAndPlaceDescription {
@@ -45,7 +66,8 @@ struct PickAndPlaceDescription {
 };
 
 struct DeviceDescription {
-  /// Only "simulated" for now (a trajectory file or a palpation script).
+  /// "simulated" (a stylus-like device playing a trajectory or a palpation script) or "glove"
+  /// (a tracker pose plus three angles per finger, driving the virtual hand).
   std::string type = "simulated";
   /// Built-in device profile (device_profile.h), e.g. "touch", "omega3".
   std::string profile = "touch";
@@ -56,6 +78,9 @@ struct DeviceDescription {
   PalpationScriptDescription palpation;
   bool has_pick_and_place = false;
   PickAndPlaceDescription pick_and_place;
+  /// type "glove": the world's tools are the virtual hand's fingertips.
+  bool has_glove_palpation = false;
+  GlovePalpationDescription glove_palpation;
 };
 
 /// A teleoperation scene (000): master arm → slave arm with a parallel gripper → ball → sheet.

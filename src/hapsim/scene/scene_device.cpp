@@ -4,6 +4,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/device/device_profile.h"
 #include "hapsim/device/trajectory.h"
+#include "hapsim/kinematics/hand_model.h"
 
 #include <algorithm>
 #include <cmath>
@@ -181,6 +182,166 @@ PalpationPlan make_scene_palpation(const World& world, const PalpationScriptDesc
   return make_palpation_plan(targets, params);
 }
 
+namespace {
+
+// Glove angles (abduction, MCP, PIP) putting finger f's tip at `goal_hand` (hand frame): damped
+// Gauss–Newton on the three angles with the DIP coupled, from a slightly curled start.
+std::array<double, kGloveAnglesPerFinger> reach_with_finger(const HandModel& hand, int f,
+                                                            const Vec3& goal_hand,
+                                                            double* residual_m) {
+  std::array<double, kGloveAnglesPerFinger> a{0.0, 0.35, 0.45};
+  const auto tip = [&](const std::array<double, kGloveAnglesPerFinger>& angles) {
+    return hand.finger(f).forward(hand.finger_joints(f, angles)).translation();
+  };
+  for (int it = 0; it < 60; ++it) {
+    const Vec3 e = goal_hand - tip(a);
+    if (e.norm() < 1e-7) {
+      break;
+    }
+    Eigen::Matrix3d J;
+    for (int k = 0; k < 3; ++k) {
+      auto b = a;
+      b[static_cast<std::size_t>(k)] += 1e-6;
+      J.col(k) = (tip(b) - tip(a)) / 1e-6;
+    }
+    const Vec3 step =
+        (J.transpose() * J + 1e-6 * Eigen::Matrix3d::Identity()).ldlt().solve(J.transpose() * e);
+    for (int k = 0; k < 3; ++k) {
+      a[static_cast<std::size_t>(k)] += std::clamp(step[k], -0.2, 0.2);
+    }
+    a = [&] {  // stay inside the joint limits the hand applies
+      const auto q = hand.finger_joints(f, a);
+      return std::array<double, kGloveAnglesPerFinger>{q[0], q[1], q[2]};
+    }();
+  }
+  *residual_m = (goal_hand - tip(a)).norm();
+  return a;
+}
+
+}  // namespace
+
+Trajectory make_scene_glove_palpation(const World& world, const GlovePalpationDescription& g) {
+  const char* where = "glove palpation";
+  const WorldDescription& wd = world.description();
+  const HandModel hand(wd.hand);
+  const Vec3 from = g.from_world.normalized();
+  // 1. Where each chosen fingertip's centre must be when pressed.
+  std::vector<Vec3> goals;
+  for (const GloveFingerTarget& t : g.fingers) {
+    PalpationTargetDescription aim_at;
+    aim_at.body = t.body;
+    aim_at.segment = t.segment;
+    aim_at.from_world = from;
+    const Vec3 surface = aim_palpation_target(world, aim_at).surface_world;
+    double radius = 0.0;
+    for (const ToolDescription& tool : wd.tools) {
+      if (tool.finger == t.finger) {
+        radius = tool.radius_m;
+      }
+    }
+    goals.push_back(surface + from * (radius - g.depth_m));
+  }
+  // 2. Hand orientation: back of the hand towards `from`, spread along the first two targets
+  // (the finger nearer the thumb on the hand's +y side).
+  const Vec3 z = from;
+  Vec3 y = z.unitOrthogonal();
+  if (goals.size() >= 2) {
+    const bool first_is_thumbward = g.fingers[0].finger < g.fingers[1].finger;
+    Vec3 d = first_is_thumbward ? Vec3(goals[0] - goals[1]) : Vec3(goals[1] - goals[0]);
+    d -= d.dot(z) * z;
+    if (d.norm() > 1e-6) {
+      y = d.normalized();
+    }
+  }
+  Mat3 R;
+  R.col(0) = y.cross(z);
+  R.col(1) = y;
+  R.col(2) = z;
+  // 3. Hand position: the chosen fingertips' centroid (slightly curled) on the goals' centroid.
+  Vec3 tips_local = Vec3::Zero();
+  Vec3 goals_centroid = Vec3::Zero();
+  for (std::size_t i = 0; i < g.fingers.size(); ++i) {
+    const int f = g.fingers[i].finger;
+    tips_local += hand.finger(f).forward(hand.finger_joints(f, {0.0, 0.35, 0.45})).translation();
+    goals_centroid += goals[i];
+  }
+  tips_local /= static_cast<double>(g.fingers.size());
+  goals_centroid /= static_cast<double>(g.fingers.size());
+  Vec3 p_press = goals_centroid - R * tips_local;
+  // 4. Each chosen finger's angles to its goal, the hand shifted by the fingers' mean miss and
+  // the angles solved again (a few rounds); the other fingers curled out of the way.
+  std::array<std::array<double, kGloveAnglesPerFinger>, kHandFingers> angles{};
+  for (int f = 0; f < kHandFingers; ++f) {
+    angles[static_cast<std::size_t>(f)] = {0.0, 1.4, 1.7};
+  }
+  double worst = kInf;
+  std::size_t worst_finger = 0;
+  for (int round = 0; round < 20 && worst > 1e-4; ++round) {
+    Iso3 X_press = Iso3::Identity();
+    X_press.linear() = R;
+    X_press.translation() = p_press;
+    Vec3 miss = Vec3::Zero();
+    worst = 0.0;
+    for (std::size_t i = 0; i < g.fingers.size(); ++i) {
+      const int f = g.fingers[i].finger;
+      double residual = 0.0;
+      angles[static_cast<std::size_t>(f)] =
+          reach_with_finger(hand, f, X_press.inverse() * goals[i], &residual);
+      const Vec3 tip =
+          X_press * hand.finger(f)
+                        .forward(hand.finger_joints(f, angles[static_cast<std::size_t>(f)]))
+                        .translation();
+      miss += goals[i] - tip;
+      if (residual > worst) {
+        worst = residual;
+        worst_finger = i;
+      }
+    }
+    p_press += miss / static_cast<double>(g.fingers.size());
+  }
+  if (worst > 1e-3) {
+    throw Error(where, "finger " + std::to_string(g.fingers[worst_finger].finger) +
+                           " cannot reach segment '" + g.fingers[worst_finger].segment +
+                           "' from a common hand pose (off by " + std::to_string(worst * 1e3) +
+                           " mm); press fewer or nearer segments");
+  }
+  // 5. In along −from, press, hold, back out.
+  const Vec3 out_standoff = from * (g.standoff_m + g.depth_m);
+  const Vec3 p_far = p_press + out_standoff + from * 0.05;
+  const Vec3 p_stand = p_press + out_standoff;
+  std::vector<DeviceInput> samples;
+  const auto push = [&](double t, const Vec3& p) {
+    DeviceInput in;
+    in.time_s = t;
+    in.p_world = p;
+    in.q_world = Quat(R);
+    in.joint_count = kHandFingers * kGloveAnglesPerFinger;
+    for (int f = 0; f < kHandFingers; ++f) {
+      for (int k = 0; k < kGloveAnglesPerFinger; ++k) {
+        in.joint_rad[static_cast<std::size_t>(f * kGloveAnglesPerFinger + k)] =
+            angles[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)];
+      }
+    }
+    samples.push_back(in);
+  };
+  double t = 0.0;
+  push(t, p_far);
+  const auto ramp = [&](const Vec3& a, const Vec3& b, double duration) {
+    const int n = std::max(1, static_cast<int>(std::ceil(duration / 0.001)));
+    for (int k = 1; k <= n; ++k) {
+      push(t + duration * k / n, a + (b - a) * minimum_jerk(static_cast<double>(k) / n));
+    }
+    t += duration;
+  };
+  ramp(p_far, p_stand, g.move_s);
+  ramp(p_stand, p_press, g.press_s);
+  if (g.hold_s > 0.0) {
+    ramp(p_press, p_press, g.hold_s);
+  }
+  ramp(p_press, p_stand, g.release_s);
+  return make_trajectory(std::move(samples), 0, kHandFingers * kGloveAnglesPerFinger, where);
+}
+
 std::unique_ptr<SimulatedDevice> make_scene_device(
     const SceneDescription& scene, const World& world,
     const std::optional<std::filesystem::path>& trajectory_override) {
@@ -195,6 +356,10 @@ std::unique_ptr<SimulatedDevice> make_scene_device(
   if (scene.device.has_palpation) {
     return std::make_unique<SimulatedDevice>(
         profile, make_scene_palpation(world, scene.device.palpation).trajectory);
+  }
+  if (scene.device.has_glove_palpation) {
+    return std::make_unique<SimulatedDevice>(
+        profile, make_scene_glove_palpation(world, scene.device.glove_palpation));
   }
   throw Error(scene.file.string() + ": /device",
               "expected a 'trajectory' file or a 'palpation' script for the simulated device");

@@ -28,6 +28,15 @@ struct PalpationAim {
 [[nodiscard]] PalpationPlan make_scene_palpation(const World& world,
                                                  const PalpationScriptDescription& script);
 
+/// The scripted glove palpation of a scene: the hand's orientation puts its back towards `from`
+/// and its finger spread along the line between the first two targets; its position and each
+/// chosen finger's angles (abduction, MCP, PIP; DIP coupled) are solved so every chosen
+/// fingertip sphere presses `depth_m` into its own segment's aimed surface point, the other
+/// fingers curled away. The hand comes in along −from, presses, holds and backs off. Throws
+/// hapsim::Error ("glove palpation") when a finger cannot reach its target from that hand pose.
+[[nodiscard]] Trajectory make_scene_glove_palpation(const World& world,
+                                                    const GlovePalpationDescription& script);
+
 /// The device of the scene: `trajectory_override` (a CSV file) if given, else the scene's
 /// trajectory file, else its palpation script. Throws hapsim::Error if the scene has none.
 [[nodiscard]] std::unique_ptr<SimulatedDevice> make_scene_device(

@@ -261,6 +261,7 @@ class Parser {
   void parse_teleop(const Json& j, const std::string& ptr, TeleopSceneDescription& t);
   void parse_teleop_device(const Json& j, const std::string& ptr, SceneDescription& scene);
   void parse_run(const Json& root, SceneDescription& scene) const;
+  void parse_glove_palpation(const Json& j, const std::string& ptr, SceneDescription& scene) const;
   std::uint32_t material_ref(const Json& j, const std::string& ptr) const;
 
   std::filesystem::path file_;
@@ -760,10 +761,32 @@ ToolDescription Parser::parse_tool(const Json& j, const std::string& ptr) const 
 
 void Parser::parse_device(const Json& j, const std::string& ptr, SceneDescription& scene) {
   object(j, ptr, "the device");
-  allow_keys(j, ptr, {"type", "profile", "trajectory", "palpation"});
+  allow_keys(j, ptr, {"type", "profile", "trajectory", "palpation", "hand", "glove_palpation"});
   DeviceDescription& d = scene.device;
   if (j.contains("type")) {
-    d.type = one_of(j["type"], at(ptr, "type"), {"simulated"});
+    d.type = one_of(j["type"], at(ptr, "type"), {"simulated", "glove"});
+  }
+  const bool glove = d.type == "glove";
+  if (!glove && (j.contains("hand") || j.contains("glove_palpation"))) {
+    fail(ptr, "'hand' and 'glove_palpation' need \"type\": \"glove\"");
+  }
+  if (glove) {
+    scene.world.has_hand = true;
+    if (j.contains("hand")) {
+      const std::string hp = at(ptr, "hand");
+      const Json& h = object(j["hand"], hp, "hand settings");
+      allow_keys(h, hp, {"dip_per_pip"});
+      scene.world.hand.dip_per_pip = number_in(h, hp, "dip_per_pip", 2.0 / 3.0, 0.0, 2.0, "");
+    }
+    for (std::size_t i = 0; i < scene.world.tools.size(); ++i) {
+      if (scene.world.tools[i].finger < 0) {
+        fail(at(at("/tools", i), "finger"),
+             "a glove drives the tools: expected a finger 0 (thumb) .. 4 (little)");
+      }
+    }
+    if (j.contains("palpation")) {
+      fail(at(ptr, "palpation"), "a glove is scripted by 'glove_palpation'");
+    }
   }
   if (j.contains("profile")) {
     d.profile = nonempty_string(j["profile"], at(ptr, "profile"), "a device profile name");
@@ -784,14 +807,20 @@ void Parser::parse_device(const Json& j, const std::string& ptr, SceneDescriptio
                                    std::to_string(t.finger));
     }
   }
-  if (j.contains("trajectory") == j.contains("palpation")) {
-    fail(ptr, "expected exactly one of 'trajectory' (a CSV file) or 'palpation' (a script)");
+  const char* script = glove ? "glove_palpation" : "palpation";
+  if (j.contains("trajectory") == j.contains(script)) {
+    fail(ptr, std::string("expected exactly one of 'trajectory' (a CSV file) or '") + script +
+                  "' (a script)");
   }
   if (j.contains("trajectory")) {
     d.trajectory_file = path(j["trajectory"], at(ptr, "trajectory"), "a trajectory CSV path");
     if (!std::filesystem::is_regular_file(d.trajectory_file)) {
       fail(at(ptr, "trajectory"), "no such file: " + d.trajectory_file.string());
     }
+    return;
+  }
+  if (glove) {
+    parse_glove_palpation(j["glove_palpation"], at(ptr, "glove_palpation"), scene);
     return;
   }
   const std::string pp = at(ptr, "palpation");
@@ -835,6 +864,65 @@ void Parser::parse_device(const Json& j, const std::string& ptr, SceneDescriptio
     target.depth_m = number_in(t, ip, "depth_m", target.depth_m, 0.0, 0.1, "m");
     target.hold_s = number_in(t, ip, "hold_s", target.hold_s, 0.0, 60.0, "seconds");
     s.targets.push_back(target);
+  }
+}
+
+void Parser::parse_glove_palpation(const Json& j, const std::string& ptr,
+                                   SceneDescription& scene) const {
+  object(j, ptr, "a glove palpation script");
+  allow_keys(
+      j, ptr,
+      {"fingers", "from", "depth_m", "standoff_m", "move_s", "press_s", "hold_s", "release_s"});
+  DeviceDescription& d = scene.device;
+  d.has_glove_palpation = true;
+  GlovePalpationDescription& g = d.glove_palpation;
+  g.from_world = vec3(required(j, ptr, "from"), at(ptr, "from"), "");
+  if (!(g.from_world.norm() > 1e-9)) {
+    fail(at(ptr, "from"), "expected a non-zero direction (from the body towards the hand)");
+  }
+  g.from_world.normalize();
+  g.depth_m = number_in(j, ptr, "depth_m", g.depth_m, 0.0, 0.1, "m");
+  g.standoff_m = number_in(j, ptr, "standoff_m", g.standoff_m, 0.0, 1.0, "m");
+  g.move_s = number_in(j, ptr, "move_s", g.move_s, 0.0, 60.0, "seconds", true);
+  g.press_s = number_in(j, ptr, "press_s", g.press_s, 0.0, 60.0, "seconds", true);
+  g.hold_s = number_in(j, ptr, "hold_s", g.hold_s, 0.0, 60.0, "seconds");
+  g.release_s = number_in(j, ptr, "release_s", g.release_s, 0.0, 60.0, "seconds", true);
+  const std::string fp = at(ptr, "fingers");
+  const Json& fingers = array(required(j, ptr, "fingers"), fp, "the pressing fingers");
+  if (fingers.empty()) {
+    fail(fp, "expected at least one finger");
+  }
+  std::set<int> seen;
+  for (std::size_t i = 0; i < fingers.size(); ++i) {
+    const std::string ip = at(fp, i);
+    const Json& f = object(fingers[i], ip, "a finger target {finger, body, segment}");
+    allow_keys(f, ip, {"finger", "body", "segment"});
+    GloveFingerTarget t;
+    const Json& n = required(f, ip, "finger");
+    if (!n.is_number_integer() || n.get<int>() < 0 || n.get<int>() >= kHandFingers) {
+      fail(at(ip, "finger"), "expected a finger 0 (thumb) .. 4 (little), got " + shown(n));
+    }
+    t.finger = n.get<int>();
+    if (!seen.insert(t.finger).second) {
+      fail(at(ip, "finger"), "finger " + std::to_string(t.finger) + " is listed twice");
+    }
+    if (std::none_of(scene.world.tools.begin(), scene.world.tools.end(),
+                     [&](const ToolDescription& tool) { return tool.finger == t.finger; })) {
+      fail(at(ip, "finger"), "no tool in /tools sits on finger " + std::to_string(t.finger));
+    }
+    t.body = nonempty_string(required(f, ip, "body"), at(ip, "body"), "a body name");
+    t.segment = nonempty_string(required(f, ip, "segment"), at(ip, "segment"), "a segment name");
+    const auto body = std::find_if(scene.world.bodies.begin(), scene.world.bodies.end(),
+                                   [&](const BodyDescription& b) { return b.name == t.body; });
+    if (body == scene.world.bodies.end()) {
+      fail(at(ip, "body"), "expected the name of a body in /bodies, got '" + t.body + "'");
+    }
+    if (std::none_of(body->segments.begin(), body->segments.end(),
+                     [&](const SegmentDescription& s) { return s.name == t.segment; })) {
+      fail(at(ip, "segment"),
+           "expected a segment of body '" + t.body + "', got '" + t.segment + "'");
+    }
+    g.fingers.push_back(t);
   }
 }
 

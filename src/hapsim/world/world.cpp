@@ -112,6 +112,15 @@ class Fnv64 {
 World::World(WorldDescription description, WorldOptions options)
     : description_(std::move(description)), options_(options) {
   const Stopwatch watch;
+  if (description_.has_hand) {
+    hand_ = std::make_unique<HandModel>(description_.hand);
+    for (const ToolDescription& t : description_.tools) {
+      if (t.finger < 0 || t.finger >= kHandFingers) {
+        throw Error("tool '" + t.name + "'",
+                    "a glove drives the tools: expected a finger 0 (thumb) .. 4 (little)");
+      }
+    }
+  }
   const std::size_t tool_count = description_.tools.size();
   double max_tool_radius_m = 0.0;
   for (const ToolDescription& t : description_.tools) {
@@ -383,8 +392,18 @@ const StepResult& World::step(const DeviceInput& input, double dt_s) {
   DeviceCommand command;
   if (usable) {
     const Quat q = input.q_world.normalized();
+    std::array<Vec3, kHandFingers> tips{};
+    if (hand_) {
+      Iso3 X_world_hand = Iso3::Identity();
+      X_world_hand.linear() = q.toRotationMatrix();
+      X_world_hand.translation() = input.p_world;
+      tips = hand_->fingertips_world(glove_reading(
+          X_world_hand, {input.joint_rad.data(), static_cast<std::size_t>(std::clamp(
+                                                     input.joint_count, 0, kMaxDeviceJoints))}));
+    }
     for (std::size_t t = 0; t < tools_.size(); ++t) {
-      const Vec3 p_world = input.p_world + q * description_.tools[t].offset_device;
+      const Vec3 p_world = hand_ ? tips[static_cast<std::size_t>(description_.tools[t].finger)]
+                                 : Vec3(input.p_world + q * description_.tools[t].offset_device);
       if (!tools_placed_) {
         tools_[t]->proxy.reset(p_world);
       }
@@ -488,6 +507,7 @@ std::string World::content_hash() const {
     h.number(t.finger);
   }
   h.number(description_.passivity_damping_factor);
+  h.number(description_.has_hand ? description_.hand.dip_per_pip : -1.0);
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(h.value()));
   return buffer;

@@ -123,6 +123,7 @@ class World {
   void add_contact(const WorldContact& contact);
 
   WorldDescription description_;
+  std::unique_ptr<HandModel> hand_;  // when a glove drives the tools
   WorldOptions options_;
   std::vector<std::unique_ptr<Segment>> segments_;  // flat over bodies
   std::vector<std::size_t> body_first_segment_;

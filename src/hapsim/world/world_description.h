@@ -8,6 +8,7 @@
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/force/contact_material.h"
 #include "hapsim/geometry/triangle_mesh.h"
+#include "hapsim/kinematics/hand_model.h"
 
 #include <cstdint>
 #include <string>
@@ -86,6 +87,11 @@ struct WorldDescription {
   std::vector<MaterialDescription> materials;
   std::vector<BodyDescription> bodies;
   std::vector<ToolDescription> tools;
+  /// A glove drives the tools (knee paper §3.1): each tool with a finger index f sits at the
+  /// virtual hand's fingertip f, from the device pose (the tracker) and joint_rad[3f..3f+2]
+  /// (MCP abduction, MCP flexion, PIP; DIP coupled), instead of at a fixed device offset.
+  bool has_hand = false;
+  HandGeometry hand;
   /// Floor on the normal damping of every contact: b ≥ factor · k · dt. Sampling a spring at
   /// period T makes it active (Colgate & Schenkel); b > k·T/2 restores passivity, 1 gives margin.
   double passivity_damping_factor = 1.0;
