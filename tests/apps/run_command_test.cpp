@@ -83,6 +83,44 @@ TEST(RunCommand, KneeHandPressesTwoSegmentsWithTwoFingers) {
   EXPECT_EQ(j.at("max_force_limit_violations").get<std::size_t>(), 0u);
 }
 
+// The simulated glove plays a recorded file: tracker pose plus j0..j14 (three angles per finger).
+// The hand hovers in front of the knee, fingers across it, and only the index curls in (its MCP
+// from 0 to 1.5 rad over 1 s): only the index tool may touch.
+TEST(RunCommand, GlovePlaysARecordedFile) {
+  std::string csv = "t,x,y,z,qw,qx,qy,qz";
+  for (int j = 0; j < 15; ++j) {
+    csv += ",j" + std::to_string(j);
+  }
+  csv += "\n";
+  for (int k = 0; k <= 10; ++k) {
+    const double t = 0.1 * k;
+    // Back of the hand towards +y (hand z = +y, a −90° turn about x), fingers along +x.
+    csv += std::to_string(t) + ",-0.08,0.10,0.02,0.7071067811865476,-0.7071067811865476,0,0";
+    for (int j = 0; j < 15; ++j) {
+      const bool index_mcp = j == 4;
+      csv += "," + std::to_string(index_mcp ? 0.15 * k : 0.0);
+    }
+    csv += "\n";
+  }
+  const auto traj = write_file("glove.csv", csv);
+  const auto json_path = temp_path("glove_run.json");
+  const RunResult r = run_hapsim("run " + std::string(HAPSIM_SCENES_DIR) + "/knee_hand.json -q " +
+                                 "--device sim:" + traj.string() + " --json " + json_path.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("steps").get<std::size_t>(), 1000u);
+  EXPECT_EQ(j.at("pop_throughs").get<std::size_t>(), 0u);
+  std::map<std::string, double> tool_peak;
+  for (const auto& t : j.at("tools")) {
+    tool_peak[t.at("name").get<std::string>()] = t.at("peak_force_n").get<double>();
+  }
+  EXPECT_GT(tool_peak.at("index"), 0.5);
+  EXPECT_EQ(tool_peak.at("thumb"), 0.0);
+  EXPECT_EQ(tool_peak.at("middle"), 0.0);
+  EXPECT_EQ(tool_peak.at("ring"), 0.0);
+}
+
 TEST(RunCommand, RecordingReplaysBitForBit) {
   const auto rec = temp_path("knee.rec");
   const RunResult a = run_hapsim("run " + kKnee + " --duration 2 -q --record " + rec.string());
