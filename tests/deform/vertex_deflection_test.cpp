@@ -313,7 +313,9 @@ TEST(VertexDeflection, RecoversExponentiallyWithoutOvershoot) {
 TEST(VertexDeflection, RecoversAtCappedSpeed) {
   const double speed = 0.01, dt = 1e-3;  // 10 µm per step
   VertexDeflectionOptions options;
-  options.segments = {{.recovery_time_constant_s = 0.0, .max_recovery_speed_m_per_s = speed}};
+  options.segments = {{.recovery_time_constant_s = 0.0,
+                       .max_recovery_speed_m_per_s = speed,
+                       .rest_tolerance_m = 1e-7}};
   VertexDeflection deflection(flat_patch(), options);
   const std::uint32_t centre = 50 * 101 + 50;
   const DeflectionContact c{deflection.rest_positions()[centre], 0.00105, 0.004, 0};
