@@ -13,6 +13,9 @@ HAPSIM_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   # product libraries
   libeigen3-dev libassimp-dev liburdfdom-dev nlohmann-json3-dev libcli11-dev libspdlog-dev
+  # viewer and headless rendering: GLFW + OpenGL + Dear ImGui, EGL surfaceless on Mesa's software
+  # rasterizer, stb for PNG, libspnav for a 3D mouse; Xvfb + xauth for the viewer's smoke test
+  libglfw3-dev libgl-dev libegl-dev libgl1-mesa-dri libimgui-dev libstb-dev libspnav-dev xvfb xauth
   # tests and benchmarks; CGAL, FCL, Embree and orocos-kdl are reference oracles only
   libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev
 )

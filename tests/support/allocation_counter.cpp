@@ -9,10 +9,12 @@
 
 namespace {
 std::atomic<long> g_allocations{0};
+thread_local long t_allocations = 0;
 }  // namespace
 
 void* operator new(std::size_t size) {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
+  ++t_allocations;
   if (void* p = std::malloc(size == 0 ? 1 : size)) {
     return p;
   }
@@ -29,6 +31,14 @@ namespace hapsim::test {
 
 long allocation_count() {
   return g_allocations.load(std::memory_order_relaxed);
+}
+
+}  // namespace hapsim::test
+
+namespace hapsim::test {
+
+long thread_allocation_count() {
+  return t_allocations;
 }
 
 }  // namespace hapsim::test

@@ -6,5 +6,8 @@ namespace hapsim::test {
 
 /// Allocations through operator new since the program started.
 long allocation_count();
+/// Allocations through operator new made by the calling thread (a haptic thread proves its own
+/// cycles allocate nothing while other threads go on as they like).
+long thread_allocation_count();
 
 }  // namespace hapsim::test

@@ -150,15 +150,18 @@ DeviceCommand ForceWatchdog::update(double now_s, const DeviceCommand* fresh_com
     last_good_time_s_ = now_s;
     have_good_ = true;
     ramping_ = false;
+    gain_ = 1.0;
     return last_good_;
   }
   if (!have_good_) {
+    gain_ = 0.0;
     DeviceCommand zero;
     zero.finger_count = last_good_.finger_count;
     return zero;
   }
   const double since_good_s = now_s - last_good_time_s_;
-  ramping_ = ramp_gain(since_good_s, device_healthy, params_) < 1.0;
+  gain_ = ramp_gain(since_good_s, device_healthy, params_);
+  ramping_ = gain_ < 1.0;
   ramp_cycles_ += ramping_ ? 1 : 0;
   return ramp_down(last_good_, since_good_s, device_healthy, params_);
 }

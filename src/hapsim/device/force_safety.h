@@ -79,6 +79,8 @@ class ForceWatchdog {
 
   /// True while the output is below the last good command because of a stall or health loss.
   [[nodiscard]] bool ramping() const noexcept { return ramping_; }
+  /// The factor the last update() applied to the last good command (1 for a fresh one).
+  [[nodiscard]] double output_gain() const noexcept { return gain_; }
   [[nodiscard]] std::uint64_t nonfinite_count() const noexcept { return nonfinite_count_; }
   [[nodiscard]] std::uint64_t clamped_cycles() const noexcept { return clamped_cycles_; }
   [[nodiscard]] std::uint64_t ramp_cycles() const noexcept { return ramp_cycles_; }
@@ -90,6 +92,7 @@ class ForceWatchdog {
   double last_good_time_s_ = 0.0;
   bool have_good_ = false;
   bool ramping_ = false;
+  double gain_ = 1.0;
   std::uint64_t nonfinite_count_ = 0;
   std::uint64_t clamped_cycles_ = 0;
   std::uint64_t ramp_cycles_ = 0;

@@ -3,6 +3,7 @@
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/core/error.h"
 #include "hapsim/device/force_safety.h"
+#include "hapsim/runtime/world_haptic_client.h"
 
 #include <algorithm>
 #include <chrono>
@@ -11,6 +12,7 @@
 #include <ctime>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 namespace hapsim {
 namespace {
@@ -47,48 +49,6 @@ std::vector<ProxyCheck> make_proxy_checks(const World& world) {
     }
   }
   return checks;
-}
-
-void sleep_until(const timespec& deadline) {
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) != 0) {
-    // EINTR: sleep again to the same absolute deadline.
-  }
-}
-
-timespec add_ns(timespec t, long long ns) {
-  constexpr long long kNsPerS = 1'000'000'000LL;
-  long long total = static_cast<long long>(t.tv_nsec) + ns;
-  t.tv_sec += static_cast<time_t>(total / kNsPerS);
-  total %= kNsPerS;
-  t.tv_nsec = static_cast<long>(total);
-  return t;
-}
-
-double to_s(const timespec& t) {
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-RecordedFrame make_frame(std::uint64_t cycle, const DeviceInput& input,
-                         const DeviceCommand& command, const StepResult& result) {
-  RecordedFrame frame;
-  frame.cycle_index = cycle;
-  frame.input = input;
-  frame.command = command;
-  const std::size_t n =
-      std::min<std::size_t>(result.contacts.size(), static_cast<std::size_t>(kMaxRecordedContacts));
-  frame.contact_count = static_cast<std::int32_t>(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const WorldContact& c = result.contacts[i];
-    RecordedContact& r = frame.contacts[i];
-    r.tool_index = c.tool;
-    r.body_index = c.body;
-    r.segment_index = c.segment;
-    r.point_world = c.point_world;
-    r.normal_world = c.normal_world;
-    r.depth_m = c.depth_m;
-    r.force_n = c.force_n;
-  }
-  return frame;
 }
 
 // Force a tool renders: its finger actuator's magnitude, or the tip force.
@@ -141,6 +101,237 @@ StepTimingUs step_timing(std::vector<double>& samples_us) {
   return t;
 }
 
+namespace {
+
+// The run's figures, from one cycle record at a time: the same code for an inline run and for
+// the real-time loop's records (consumed off the haptic thread).
+class SessionAccountant {
+ public:
+  SessionAccountant(const World& world, const DeviceProfile& profile, const SessionOptions& options,
+                    std::size_t steps)
+      : world_(world), profile_(profile), options_(options) {
+    const WorldDescription& desc = world.description();
+    summary_.tools.resize(desc.tools.size());
+    force_sum_.assign(desc.tools.size(), 0.0);
+    for (std::size_t t = 0; t < desc.tools.size(); ++t) {
+      summary_.tools[t].name = desc.tools[t].name;
+    }
+    summary_.segments.resize(world.flat_segment_count());
+    for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
+      for (std::size_t s = 0; s < desc.bodies[b].segments.size(); ++s) {
+        SegmentSummary& seg = summary_.segments[world.flat_segment(b, s)];
+        seg.body = desc.bodies[b].name;
+        seg.name = desc.bodies[b].segments[s].name;
+      }
+    }
+    if (options.check_pop_through) {
+      checks_ = make_proxy_checks(world);
+    }
+    cost_us_.reserve(steps);
+    touched_.assign(summary_.segments.size() * desc.tools.size(), 0);
+  }
+
+  void account(const CycleRecord& r) {
+    const WorldDescription& desc = world_.description();
+    cost_us_.push_back(r.cost_us);
+    const DeviceCommand& out = r.output;
+    if (exceeds_limits(out, profile_)) {
+      ++summary_.max_force_limit_violations;
+    }
+    summary_.peak_command_force_n = std::max(summary_.peak_command_force_n, command_peak_n(out));
+    summary_.dropped_contacts += static_cast<std::size_t>(std::max(0, r.dropped_contacts));
+    std::fill(touched_.begin(), touched_.end(), std::uint8_t{0});
+    for (std::int32_t i = 0; i < r.contact_count; ++i) {
+      const WorldContact& c = r.contacts[static_cast<std::size_t>(i)];
+      const std::size_t flat = world_.flat_segment(static_cast<std::size_t>(c.body),
+                                                   static_cast<std::size_t>(c.segment));
+      SegmentSummary& seg = summary_.segments[flat];
+      seg.peak_force_n = std::max(seg.peak_force_n, c.force_n);
+      std::uint8_t& flag = touched_[flat * desc.tools.size() + static_cast<std::size_t>(c.tool)];
+      if (flag == 0) {
+        flag = 1;
+        ++seg.contacts;
+      }
+    }
+    // What the device renders of the tools' summed tip force (the safety layer may scale it).
+    const double tip_n = r.world_command.force_world_n.norm();
+    const double tip_scale = tip_n > 0.0 ? out.force_world_n.norm() / tip_n : 0.0;
+    const std::size_t tools =
+        std::min<std::size_t>(static_cast<std::size_t>(r.tool_count), summary_.tools.size());
+    for (std::size_t t = 0; t < tools; ++t) {
+      const ToolState& tool = r.tools[t];
+      ToolSummary& ts = summary_.tools[t];
+      const int finger = desc.tools[t].finger;
+      const double f = finger >= 0 && finger < out.finger_count
+                           ? out.finger_force_n[static_cast<std::size_t>(finger)]
+                           : tool.force_world_n.norm() * tip_scale;
+      ts.peak_force_n = std::max(ts.peak_force_n, f);
+      if (tool.contact_count > 0) {
+        ++ts.contact_steps;
+        force_sum_[t] += f;
+      }
+      for (const ProxyCheck& c : checks_) {
+        const Vec3 p_body = c.X_body_world * tool.proxy_world;
+        const double radius = desc.tools[t].radius_m;
+        if (c.bounds_body.exteriorDistance(p_body) > radius) {
+          continue;
+        }
+        const SurfacePoint sp = c.bvh->closest_point(p_body);
+        summary_.max_proxy_penetration_m =
+            std::max(summary_.max_proxy_penetration_m, radius - sp.signed_distance);
+        if (sp.signed_distance < 0.0) {
+          ++summary_.pop_throughs;
+        }
+      }
+    }
+    if (options_.recorder != nullptr) {
+      if (!options_.recorder->record(to_recorded_frame(r))) {
+        ++summary_.recording_dropped_frames;
+      } else {
+        ++summary_.recorded_frames;
+      }
+      // The disk is touched here, between cycles (inline) or off the haptic thread (real time).
+      if (options_.recorder->frames_buffered() >= options_.recorder->capacity_frames()) {
+        options_.recorder->flush();
+      }
+    }
+    ++summary_.steps;
+  }
+
+  void note_deflection(std::size_t flat_segment, double deflection_m) {
+    SegmentSummary& seg = summary_.segments[flat_segment];
+    seg.max_deflection_m = std::max(seg.max_deflection_m, deflection_m);
+  }
+
+  SessionSummary finish(double dt_s, double wall_s) {
+    if (options_.recorder != nullptr) {
+      options_.recorder->flush();
+    }
+    summary_.wall_s = wall_s;
+    summary_.simulated_s = static_cast<double>(summary_.steps) * dt_s;
+    for (std::size_t t = 0; t < summary_.tools.size(); ++t) {
+      ToolSummary& ts = summary_.tools[t];
+      ts.mean_force_n =
+          ts.contact_steps > 0 ? force_sum_[t] / static_cast<double>(ts.contact_steps) : 0.0;
+    }
+    summary_.step_us = step_timing(cost_us_);
+    return std::move(summary_);
+  }
+
+ private:
+  const World& world_;
+  const DeviceProfile& profile_;
+  const SessionOptions& options_;
+  SessionSummary summary_;
+  std::vector<double> force_sum_;
+  std::vector<ProxyCheck> checks_;
+  std::vector<double> cost_us_;
+  // Per-segment touch flags of one step, so a tool-step counts once per segment.
+  std::vector<std::uint8_t> touched_;
+};
+
+SessionSummary run_inline(World& world, Device& device, const SessionOptions& options,
+                          std::size_t steps) {
+  const WorldDescription& desc = world.description();
+  SessionAccountant accountant(world, device.profile(), options, steps);
+  ForceWatchdog watchdog(device.profile());
+  CycleRecord record;
+  const auto wall_start = std::chrono::steady_clock::now();
+  const std::size_t progress_every = std::max<std::size_t>(1, steps / 100);
+  for (std::size_t i = 0; i < steps; ++i) {
+    const double t_s = static_cast<double>(i) * options.dt_s;
+    // The timed haptic cycle: read, step (collision, force, deformation), safety, write.
+    const auto c0 = std::chrono::steady_clock::now();
+    const DeviceInput input = device.read(t_s);
+    const StepResult& result = world.step(input, options.dt_s);
+    const bool healthy = input.healthy && device.status().health == DeviceHealth::kConnected;
+    const DeviceCommand out = watchdog.update(t_s, &result.command, healthy);
+    device.write(out);
+    const auto c1 = std::chrono::steady_clock::now();
+    // Bookkeeping (outside the timed cycle).
+    fill_cycle_record(record, i, input, result, out,
+                      std::chrono::duration<double, std::micro>(c1 - c0).count());
+    accountant.account(record);
+    for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
+      if (desc.bodies[b].kind != BodyKind::kDeformable) {
+        continue;
+      }
+      for (std::size_t s = 0; s < desc.bodies[b].segments.size(); ++s) {
+        accountant.note_deflection(world.flat_segment(b, s), world.current_deflection_m(b, s));
+      }
+    }
+    if ((i + 1) % progress_every == 0 || i + 1 == steps) {
+      report_progress(options.progress, "run",
+                      static_cast<double>(i + 1) / static_cast<double>(steps));
+    }
+  }
+  SessionSummary summary = accountant.finish(
+      options.dt_s,
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count());
+  summary.clamped_cycles = watchdog.clamped_cycles();
+  summary.nonfinite_commands = watchdog.nonfinite_count();
+  return summary;
+}
+
+SessionSummary run_realtime(World& world, Device& device, const SessionOptions& options,
+                            std::size_t steps) {
+  SessionAccountant accountant(world, device.profile(), options, steps);
+  WorldHapticClientOptions client_options;
+  client_options.publish_snapshots = false;
+  client_options.record_capacity = 4096;  // 4 s of slack for the bookkeeping below
+  WorldHapticClient client(world, client_options);
+  HapticLoopOptions loop_options = options.loop;
+  loop_options.period_s = options.dt_s;
+  loop_options.max_cycles = steps;
+  loop_options.missed_period_s = 2.0 * options.dt_s;
+  HapticLoop loop(device, client, loop_options);
+  SpscRing<CycleRecord>& records = *client.records();
+  const std::size_t progress_every = std::max<std::size_t>(1, steps / 100);
+  std::size_t accounted = 0;
+  const auto wall_start = std::chrono::steady_clock::now();
+  loop.start();
+  for (;;) {
+    const bool running = loop.running();  // read before draining: nothing is left behind
+    while (const CycleRecord* r = records.front()) {
+      accountant.account(*r);
+      records.pop();
+      ++accounted;
+      if (accounted % progress_every == 0) {
+        report_progress(options.progress, "run (real time)",
+                        static_cast<double>(accounted) / static_cast<double>(steps));
+      }
+    }
+    if (!running) {
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  loop.wait();
+  const double wall_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  for (std::size_t flat = 0; flat < world.flat_segment_count(); ++flat) {
+    accountant.note_deflection(flat, client.max_deflection_m()[flat]);
+  }
+  SessionSummary summary = accountant.finish(options.dt_s, wall_s);
+  const HapticLoopStatus st = loop.status();
+  summary.clamped_cycles = st.clamped_cycles;
+  summary.nonfinite_commands = st.nonfinite_commands;
+  summary.missed_deadlines = st.missed_deadlines;
+  RealtimeSummary rt;
+  rt.rate_hz = st.rate_hz;
+  rt.period_jitter_us = st.period_jitter_us;
+  rt.missed_deadlines = st.missed_deadlines;
+  rt.realtime_priority = st.realtime_priority;
+  rt.stall_events = st.stall_events;
+  rt.ramp_cycles = st.ramp_cycles;
+  rt.failed_steps = st.failed_steps;
+  rt.dropped_records = client.dropped_records();
+  summary.realtime = rt;
+  return summary;
+}
+
+}  // namespace
+
 SessionSummary run_session(World& world, Device& device, const SessionOptions& options) {
   if (!(options.duration_s > 0.0) || !std::isfinite(options.duration_s)) {
     throw Error("session", "duration must be a finite number of seconds > 0, got " +
@@ -150,150 +341,8 @@ SessionSummary run_session(World& world, Device& device, const SessionOptions& o
     throw Error("session", "dt must be in (0, 0.1] s, got " + std::to_string(options.dt_s));
   }
   const auto steps = static_cast<std::size_t>(std::llround(options.duration_s / options.dt_s));
-  const WorldDescription& desc = world.description();
-
-  SessionSummary summary;
-  summary.tools.resize(desc.tools.size());
-  std::vector<double> force_sum(desc.tools.size(), 0.0);
-  for (std::size_t t = 0; t < desc.tools.size(); ++t) {
-    summary.tools[t].name = desc.tools[t].name;
-  }
-  summary.segments.resize(world.flat_segment_count());
-  for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
-    for (std::size_t s = 0; s < desc.bodies[b].segments.size(); ++s) {
-      SegmentSummary& seg = summary.segments[world.flat_segment(b, s)];
-      seg.body = desc.bodies[b].name;
-      seg.name = desc.bodies[b].segments[s].name;
-    }
-  }
-  const std::vector<ProxyCheck> checks =
-      options.check_pop_through ? make_proxy_checks(world) : std::vector<ProxyCheck>{};
-
-  ForceWatchdog watchdog(device.profile());
-  std::vector<double> cost_us;
-  cost_us.reserve(steps);
-  // Per-segment touch flags of one step, so a tool-step counts once per segment.
-  std::vector<std::uint8_t> touched(summary.segments.size() * desc.tools.size(), 0);
-
-  const auto wall_start = std::chrono::steady_clock::now();
-  timespec deadline{};
-  clock_gettime(CLOCK_MONOTONIC, &deadline);
-  const long long period_ns = std::llround(options.dt_s * 1e9);
-  const std::size_t progress_every = std::max<std::size_t>(1, steps / 100);
-
-  for (std::size_t i = 0; i < steps; ++i) {
-    const double t_s = static_cast<double>(i) * options.dt_s;
-    if (options.realtime) {
-      deadline = add_ns(deadline, period_ns);
-      sleep_until(deadline);
-    }
-    // The timed haptic cycle: read, step (collision, force, deformation), safety, write.
-    const auto c0 = std::chrono::steady_clock::now();
-    const DeviceInput input = device.read(t_s);
-    const StepResult& result = world.step(input, options.dt_s);
-    const bool healthy = input.healthy && device.status().health == DeviceHealth::kConnected;
-    const DeviceCommand out = watchdog.update(t_s, &result.command, healthy);
-    device.write(out);
-    const auto c1 = std::chrono::steady_clock::now();
-    cost_us.push_back(std::chrono::duration<double, std::micro>(c1 - c0).count());
-
-    if (options.realtime) {
-      timespec now{};
-      clock_gettime(CLOCK_MONOTONIC, &now);
-      if (to_s(now) - to_s(deadline) > options.dt_s) {
-        ++summary.missed_deadlines;
-        deadline = now;  // do not try to catch up with a burst of cycles
-      }
-    }
-
-    // Bookkeeping (outside the timed cycle).
-    if (exceeds_limits(out, device.profile())) {
-      ++summary.max_force_limit_violations;
-    }
-    summary.peak_command_force_n = std::max(summary.peak_command_force_n, command_peak_n(out));
-    summary.dropped_contacts += static_cast<std::size_t>(std::max(0, result.dropped_contacts));
-    std::fill(touched.begin(), touched.end(), std::uint8_t{0});
-    for (const WorldContact& c : result.contacts) {
-      const std::size_t flat =
-          world.flat_segment(static_cast<std::size_t>(c.body), static_cast<std::size_t>(c.segment));
-      SegmentSummary& seg = summary.segments[flat];
-      seg.peak_force_n = std::max(seg.peak_force_n, c.force_n);
-      std::uint8_t& flag = touched[flat * desc.tools.size() + static_cast<std::size_t>(c.tool)];
-      if (flag == 0) {
-        flag = 1;
-        ++seg.contacts;
-      }
-    }
-    // What the device renders of the tools' summed tip force (the safety layer may scale it).
-    const double tip_n = result.command.force_world_n.norm();
-    const double tip_scale = tip_n > 0.0 ? out.force_world_n.norm() / tip_n : 0.0;
-    for (std::size_t t = 0; t < result.tools.size() && t < summary.tools.size(); ++t) {
-      const ToolState& tool = result.tools[t];
-      ToolSummary& ts = summary.tools[t];
-      const int finger = desc.tools[t].finger;
-      const double f = finger >= 0 && finger < out.finger_count
-                           ? out.finger_force_n[static_cast<std::size_t>(finger)]
-                           : tool.force_world_n.norm() * tip_scale;
-      ts.peak_force_n = std::max(ts.peak_force_n, f);
-      if (tool.contact_count > 0) {
-        ++ts.contact_steps;
-        force_sum[t] += f;
-      }
-      for (const ProxyCheck& c : checks) {
-        const Vec3 p_body = c.X_body_world * tool.proxy_world;
-        const double r = desc.tools[t].radius_m;
-        if (c.bounds_body.exteriorDistance(p_body) > r) {
-          continue;
-        }
-        const SurfacePoint sp = c.bvh->closest_point(p_body);
-        summary.max_proxy_penetration_m =
-            std::max(summary.max_proxy_penetration_m, r - sp.signed_distance);
-        if (sp.signed_distance < 0.0) {
-          ++summary.pop_throughs;
-        }
-      }
-    }
-    for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
-      if (desc.bodies[b].kind != BodyKind::kDeformable) {
-        continue;
-      }
-      for (std::size_t s = 0; s < desc.bodies[b].segments.size(); ++s) {
-        SegmentSummary& seg = summary.segments[world.flat_segment(b, s)];
-        seg.max_deflection_m = std::max(seg.max_deflection_m, world.current_deflection_m(b, s));
-      }
-    }
-    if (options.recorder != nullptr) {
-      if (!options.recorder->record(make_frame(i, input, out, result))) {
-        ++summary.recording_dropped_frames;
-      } else {
-        ++summary.recorded_frames;
-      }
-      if (!options.realtime &&
-          options.recorder->frames_buffered() >= options.recorder->capacity_frames()) {
-        options.recorder->flush();  // offline: the disk may be touched between cycles
-      }
-    }
-    if ((i + 1) % progress_every == 0 || i + 1 == steps) {
-      report_progress(options.progress, "run",
-                      static_cast<double>(i + 1) / static_cast<double>(steps));
-    }
-  }
-  if (options.recorder != nullptr) {
-    options.recorder->flush();
-  }
-  summary.wall_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  summary.steps = steps;
-  summary.simulated_s = static_cast<double>(steps) * options.dt_s;
-  for (std::size_t t = 0; t < summary.tools.size(); ++t) {
-    ToolSummary& ts = summary.tools[t];
-    ts.mean_force_n =
-        ts.contact_steps > 0 ? force_sum[t] / static_cast<double>(ts.contact_steps) : 0.0;
-  }
-  summary.clamped_cycles = watchdog.clamped_cycles();
-  summary.nonfinite_commands = watchdog.nonfinite_count();
-  summary.step_us = step_timing(cost_us);
-  return summary;
+  return options.realtime ? run_realtime(world, device, options, steps)
+                          : run_inline(world, device, options, steps);
 }
 
 std::string format_session_summary(const SessionSummary& s) {
@@ -340,8 +389,19 @@ std::string format_session_summary(const SessionSummary& s) {
     out << "recorded frames: " << s.recorded_frames << " (dropped " << s.recording_dropped_frames
         << ")\n";
   }
-  if (s.missed_deadlines > 0) {
-    out << "missed real-time deadlines: " << s.missed_deadlines << "\n";
+  if (s.realtime) {
+    const RealtimeSummary& rt = *s.realtime;
+    std::snprintf(line, sizeof line,
+                  "real time: %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f us; "
+                  "missed deadlines (period > 2x): %zu; stalls ramped: %zu\n",
+                  rt.rate_hz, rt.realtime_priority ? "SCHED_FIFO" : "normal scheduling",
+                  rt.period_jitter_us.p50, rt.period_jitter_us.p99, rt.period_jitter_us.max,
+                  rt.missed_deadlines, rt.stall_events);
+    out << line;
+    if (rt.dropped_records > 0 || rt.failed_steps > 0) {
+      out << "real time: " << rt.dropped_records << " cycle record(s) not accounted (bookkeeping "
+          << "fell behind), " << rt.failed_steps << " failed step(s)\n";
+    }
   }
   return out.str();
 }

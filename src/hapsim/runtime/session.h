@@ -8,9 +8,11 @@
 #include "hapsim/core/progress.h"
 #include "hapsim/device/device.h"
 #include "hapsim/device/recording.h"
+#include "hapsim/runtime/haptic_loop.h"
 #include "hapsim/world/world.h"
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,8 +22,12 @@ struct SessionOptions {
   /// Simulated seconds to run (> 0).
   double duration_s = 10.0;
   double dt_s = 0.001;
-  /// Sleep to an absolute deadline every dt (clock_nanosleep, TIMER_ABSTIME).
+  /// Run on the real-time haptic thread (haptic_loop.h): an absolute 1 kHz deadline, SCHED_FIFO
+  /// when permitted, the supervisor's stall ramp; the bookkeeping below runs on this thread from
+  /// a lock-free ring of cycle records. Otherwise the cycles run inline as fast as they go.
   bool realtime = false;
+  /// Real-time loop settings (period and cycle count are set from dt_s and duration_s).
+  HapticLoopOptions loop;
   /// Check every step, outside the timed step, that no tool's proxy centre entered a closed
   /// proxy segment, against an exact query built independently of the world's method.
   bool check_pop_through = true;
@@ -57,6 +63,21 @@ struct SegmentSummary {
   double max_deflection_m = 0.0;
 };
 
+/// How the real-time loop kept time (SessionOptions::realtime).
+struct RealtimeSummary {
+  double rate_hz = 0.0;
+  /// |period − dt|, microseconds.
+  LatencyPercentilesUs period_jitter_us;
+  /// Periods longer than 2·dt.
+  std::size_t missed_deadlines = 0;
+  bool realtime_priority = false;
+  std::size_t stall_events = 0;
+  std::size_t ramp_cycles = 0;
+  std::size_t failed_steps = 0;
+  /// Cycle records the bookkeeping could not keep up with (not accounted, not recorded).
+  std::size_t dropped_records = 0;
+};
+
 struct SessionSummary {
   std::size_t steps = 0;
   double simulated_s = 0.0;
@@ -77,8 +98,9 @@ struct SessionSummary {
   std::size_t dropped_contacts = 0;
   std::size_t recorded_frames = 0;
   std::size_t recording_dropped_frames = 0;
-  /// Realtime only: deadlines missed by more than one period.
+  /// Realtime only: periods longer than two nominal periods.
   std::size_t missed_deadlines = 0;
+  std::optional<RealtimeSummary> realtime;
 };
 
 /// Runs `world` with `device` for options.duration_s. Throws hapsim::Error on bad options.

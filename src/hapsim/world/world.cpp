@@ -256,6 +256,10 @@ const ProximityQuery& World::deformed_query(std::size_t body, std::size_t segmen
   return *seg.deformed_bvh;
 }
 
+const VertexDeflection* World::deflection(std::size_t body, std::size_t segment) const {
+  return segments_.at(flat_segment(body, segment))->deflection.get();
+}
+
 double World::current_deflection_m(std::size_t body, std::size_t segment) const {
   const Segment& seg = *segments_.at(flat_segment(body, segment));
   return seg.deflection ? seg.deflection->max_deflection_m() : 0.0;

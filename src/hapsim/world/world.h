@@ -102,6 +102,10 @@ class World {
   /// Exact query on the current (deformed) surface, refitted if it moved since the last call.
   /// Not on the haptic path (the refit is O(segment size)); for display, picking and checks.
   [[nodiscard]] const ProximityQuery& deformed_query(std::size_t body, std::size_t segment);
+  /// The segment's deflection state (rest positions, inward directions, vertices moved by the last
+  /// step), or null when the body is not deformable. For publishing the deformation to other
+  /// threads: only the thread that steps may read it while the world runs.
+  [[nodiscard]] const VertexDeflection* deflection(std::size_t body, std::size_t segment) const;
   /// Largest deflection of a segment right now, metres (0 if not deformable).
   [[nodiscard]] double current_deflection_m(std::size_t body, std::size_t segment) const;
   /// The material a step actually uses (stiffness clamped, damping floor applied for `dt_s`).

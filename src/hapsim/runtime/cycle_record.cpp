@@ -1,0 +1,47 @@
+#include "hapsim/runtime/cycle_record.h"
+
+#include <algorithm>
+
+namespace hapsim {
+
+void fill_cycle_record(CycleRecord& record, std::uint64_t cycle, const DeviceInput& input,
+                       const StepResult& result, const DeviceCommand& output,
+                       double cost_us) noexcept {
+  record.cycle = cycle;
+  record.time_s = input.time_s;
+  record.input = input;
+  record.world_command = result.command;
+  record.output = output;
+  const std::size_t tools = std::min<std::size_t>(result.tools.size(), kMaxCycleTools);
+  std::copy_n(result.tools.begin(), tools, record.tools.begin());
+  record.tool_count = static_cast<std::int32_t>(tools);
+  const std::size_t contacts = std::min<std::size_t>(result.contacts.size(), kMaxCycleContacts);
+  std::copy_n(result.contacts.begin(), contacts, record.contacts.begin());
+  record.contact_count = static_cast<std::int32_t>(contacts);
+  record.dropped_contacts = std::max(0, result.dropped_contacts) +
+                            static_cast<std::int32_t>(result.contacts.size() - contacts);
+  record.cost_us = cost_us;
+}
+
+RecordedFrame to_recorded_frame(const CycleRecord& record) noexcept {
+  RecordedFrame frame;
+  frame.cycle_index = record.cycle;
+  frame.input = record.input;
+  frame.command = record.output;
+  const int n = std::min(record.contact_count, kMaxRecordedContacts);
+  frame.contact_count = n;
+  for (int i = 0; i < n; ++i) {
+    const WorldContact& c = record.contacts[static_cast<std::size_t>(i)];
+    RecordedContact& r = frame.contacts[static_cast<std::size_t>(i)];
+    r.tool_index = c.tool;
+    r.body_index = c.body;
+    r.segment_index = c.segment;
+    r.point_world = c.point_world;
+    r.normal_world = c.normal_world;
+    r.depth_m = c.depth_m;
+    r.force_n = c.force_n;
+  }
+  return frame;
+}
+
+}  // namespace hapsim

@@ -1,0 +1,42 @@
+// Everything one haptic cycle of a World produced that the run's bookkeeping and the recorder
+// need, as fixed-size data: the haptic thread copies it into an SPSC ring (no allocation) and
+// the main thread accounts for it (run_session) and records it, at its own pace.
+#pragma once
+
+#include "hapsim/device/recording.h"
+#include "hapsim/world/world.h"
+
+#include <array>
+#include <cstdint>
+
+namespace hapsim {
+
+inline constexpr int kMaxCycleTools = 8;
+inline constexpr int kMaxCycleContacts = 64;
+
+struct CycleRecord {
+  std::uint64_t cycle = 0;
+  double time_s = 0.0;
+  DeviceInput input;
+  /// The world's command, before the safety layer.
+  DeviceCommand world_command;
+  /// What was written to the device (after clamp and ramp).
+  DeviceCommand output;
+  std::array<ToolState, kMaxCycleTools> tools{};
+  std::int32_t tool_count = 0;
+  std::array<WorldContact, kMaxCycleContacts> contacts{};
+  std::int32_t contact_count = 0;
+  /// Contacts the world could not report plus those beyond kMaxCycleContacts.
+  std::int32_t dropped_contacts = 0;
+  double cost_us = 0.0;
+};
+
+/// haptic path: fills `record` from a step's result (no allocation).
+void fill_cycle_record(CycleRecord& record, std::uint64_t cycle, const DeviceInput& input,
+                       const StepResult& result, const DeviceCommand& output,
+                       double cost_us) noexcept;
+
+/// The recorder's frame of a cycle (its first kMaxRecordedContacts contacts).
+[[nodiscard]] RecordedFrame to_recorded_frame(const CycleRecord& record) noexcept;
+
+}  // namespace hapsim

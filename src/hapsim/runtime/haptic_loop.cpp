@@ -1,0 +1,314 @@
+#include "hapsim/runtime/haptic_loop.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/runtime/deadline_clock.h"
+#include "hapsim/runtime/triple_buffer.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace hapsim {
+
+DeviceCommand scaled_command(const DeviceCommand& command, double gain) noexcept {
+  const double g = std::isfinite(gain) ? std::clamp(gain, 0.0, 1.0) : 0.0;
+  DeviceCommand out = command;
+  out.force_world_n *= g;
+  for (double& f : out.finger_force_n) {
+    f *= g;
+  }
+  for (double& t : out.joint_torque_nm) {
+    t *= g;
+  }
+  return out;
+}
+
+struct HapticLoop::Shared {
+  explicit Shared(const DeviceProfile& profile, const ForceRampParams& ramp)
+      : watchdog(profile, ramp), last_written(DeviceCommand{}) {}
+
+  ForceWatchdog watchdog;                    // haptic thread only
+  TripleBuffer<DeviceCommand> last_written;  // haptic thread -> supervisor: the ramp's base
+  std::atomic_flag output_busy = ATOMIC_FLAG_INIT;
+  std::atomic<std::int64_t> start_ns{0};
+  std::atomic<std::int64_t> end_ns{0};
+  std::atomic<std::int64_t> heartbeat_ns{0};  // end of the last completed cycle
+  std::atomic<double> supervisor_gain{1.0};   // lowest gain the supervisor wrote, unseen
+  std::atomic<bool> device_healthy{true};
+  std::atomic<bool> realtime_priority{false};
+  std::atomic<std::uint64_t> cycles{0};
+  std::atomic<std::uint64_t> missed{0};
+  std::atomic<std::uint64_t> stall_events{0};
+  std::atomic<std::uint64_t> ramp_cycles{0};
+  std::atomic<std::uint64_t> health_losses{0};
+  std::atomic<std::uint64_t> failed_steps{0};
+  std::atomic<double> last_output_force_n{0.0};
+};
+
+namespace {
+
+double command_magnitude_n(const DeviceCommand& c) {
+  double m = c.force_world_n.norm();
+  for (int f = 0; f < c.finger_count && f < kMaxFingers; ++f) {
+    m = std::max(m, c.finger_force_n[static_cast<std::size_t>(f)]);
+  }
+  return m;
+}
+
+// Single-writer counter increment (no read-modify-write needed with one writer).
+void bump(std::atomic<std::uint64_t>& counter) noexcept {
+  counter.store(counter.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+}
+
+}  // namespace
+
+HapticLoop::HapticLoop(Device& device, HapticClient& client, HapticLoopOptions options)
+    : device_(device), client_(client), options_(options) {
+  if (!(options_.period_s > 0.0) || !(options_.period_s <= 0.1)) {
+    throw Error("haptic loop",
+                "period must be in (0, 0.1] s, got " + std::to_string(options_.period_s));
+  }
+  if (!(options_.supervisor_period_s > 0.0) || !(options_.supervisor_period_s <= 0.1)) {
+    throw Error("haptic loop", "supervisor period must be in (0, 0.1] s");
+  }
+  if (!(options_.ramp.stale_timeout_s >= 0.0) || !(options_.ramp.ramp_duration_s >= 0.0) ||
+      !std::isfinite(options_.ramp.zero_by_s())) {
+    throw Error("haptic loop", "ramp times must be finite and >= 0");
+  }
+  shared_ = std::make_unique<Shared>(device_.profile(), options_.ramp);
+}
+
+HapticLoop::~HapticLoop() {
+  stop();
+}
+
+void HapticLoop::start() {
+  if (started_) {
+    throw Error("haptic loop", "already started (a loop runs once)");
+  }
+  started_ = true;
+  stop_requested_.store(false);
+  shared_->start_ns.store(monotonic_ns());
+  shared_->heartbeat_ns.store(shared_->start_ns.load());
+  running_.store(true, std::memory_order_release);
+  haptic_thread_ = std::thread([this] { haptic_thread_main(); });
+  supervisor_thread_ = std::thread([this] { supervisor_thread_main(); });
+}
+
+void HapticLoop::request_stop() noexcept {
+  stop_requested_.store(true, std::memory_order_release);
+}
+
+void HapticLoop::stop() {
+  request_stop();
+  wait();
+}
+
+void HapticLoop::wait() {
+  if (haptic_thread_.joinable()) {
+    haptic_thread_.join();
+  }
+  if (supervisor_thread_.joinable()) {
+    supervisor_thread_.join();
+  }
+  if (started_) {
+    // Leave the device pushing nothing.
+    DeviceCommand zero;
+    zero.finger_count = device_.profile().finger_count;
+    device_.write(zero);
+    shared_->last_output_force_n.store(0.0);
+  }
+}
+
+bool HapticLoop::try_write(const DeviceCommand& command) noexcept {
+  if (shared_->output_busy.test_and_set(std::memory_order_acquire)) {
+    return false;  // the other thread is writing: its value stands for this cycle
+  }
+  device_.write(command);
+  shared_->output_busy.clear(std::memory_order_release);
+  shared_->last_output_force_n.store(command_magnitude_n(command), std::memory_order_relaxed);
+  return true;
+}
+
+// haptic path (the loop body): no allocation, no lock, no I/O.
+void HapticLoop::haptic_thread_main() noexcept {
+  Shared& s = *shared_;
+  const bool realtime =
+      options_.realtime_priority && try_set_realtime_priority(options_.fifo_priority);
+  s.realtime_priority.store(realtime);
+  const auto period_ns = static_cast<std::int64_t>(std::llround(options_.period_s * 1e9));
+  DeadlineClock clock(
+      period_ns, realtime ? static_cast<std::int64_t>(std::llround(options_.spin_s * 1e9)) : 0);
+  const double nominal_us = options_.period_s * 1e6;
+  const double missed_us = options_.missed_period_s * 1e6;
+  const double resume_per_cycle =
+      options_.ramp.ramp_duration_s > 0.0 ? options_.period_s / options_.ramp.ramp_duration_s : 1.0;
+  double resume_limit = 1.0;  // ceiling on the output while force comes back after a ramp
+  bool was_healthy = true;
+  std::int64_t previous_wake_ns = 0;
+  const std::int64_t start_ns = s.start_ns.load();
+  clock.start();
+
+  for (std::uint64_t i = 0; !stop_requested_.load(std::memory_order_acquire) &&
+                            (options_.max_cycles == 0 || i < options_.max_cycles);
+       ++i) {
+    const std::int64_t wake_ns = clock.wait_next();
+    double period_us = 0.0;
+    if (i > 0) {
+      period_us = 1e-3 * static_cast<double>(wake_ns - previous_wake_ns);
+      jitter_us_.record_us(std::abs(period_us - nominal_us));
+      if (period_us > missed_us) {
+        bump(s.missed);
+      }
+    }
+    previous_wake_ns = wake_ns;
+    const double t_s = static_cast<double>(i) * options_.period_s;
+
+    // The timed cycle: read, step, safety, write.
+    const std::int64_t c0 = monotonic_ns();
+    const DeviceInput input = device_.read(t_s);
+    const bool healthy = input.healthy && device_.status().health == DeviceHealth::kConnected;
+    const DeviceCommand* fresh = nullptr;
+    try {
+      fresh = &client_.step(input, options_.period_s);
+    } catch (...) {
+      bump(s.failed_steps);  // no fresh force this cycle: the watchdog holds, then ramps
+    }
+    const double now_s = 1e-9 * static_cast<double>(c0 - start_ns);
+    DeviceCommand out = s.watchdog.update(now_s, fresh, healthy);
+    // Force comes back gradually after any ramp (the supervisor's or the watchdog's own).
+    resume_limit = std::min(1.0, resume_limit + resume_per_cycle);
+    resume_limit = std::min(resume_limit, s.supervisor_gain.exchange(1.0));
+    if (s.watchdog.ramping()) {
+      resume_limit = std::min(resume_limit, s.watchdog.output_gain());
+      bump(s.ramp_cycles);
+    } else if (resume_limit < 1.0) {
+      out = scaled_command(out, resume_limit);
+      bump(s.ramp_cycles);
+    }
+    if (healthy != was_healthy) {
+      if (!healthy) {
+        bump(s.health_losses);
+      }
+      s.device_healthy.store(healthy, std::memory_order_relaxed);
+      was_healthy = healthy;
+    }
+    s.heartbeat_ns.store(monotonic_ns(), std::memory_order_release);
+    if (try_write(out)) {
+      s.last_written.write_slot() = out;
+      s.last_written.publish();
+    }
+    const std::int64_t c1 = monotonic_ns();
+    const double cost_us = 1e-3 * static_cast<double>(c1 - c0);
+    cost_us_.record_us(cost_us);
+    s.cycles.store(i + 1, std::memory_order_release);
+
+    HapticCycle cycle;
+    cycle.index = i;
+    cycle.time_s = t_s;
+    cycle.input = &input;
+    cycle.fresh = fresh;
+    cycle.output = &out;
+    cycle.cost_us = cost_us;
+    cycle.period_us = period_us;
+    cycle.healthy = healthy;
+    client_.after_cycle(cycle);
+  }
+  s.end_ns.store(monotonic_ns());
+  running_.store(false, std::memory_order_release);
+}
+
+// Not on the haptic path: may log (and so allocate) when something happens.
+void HapticLoop::supervisor_thread_main() noexcept {
+  Shared& s = *shared_;
+  const auto period_ns =
+      static_cast<std::int64_t>(std::llround(options_.supervisor_period_s * 1e9));
+  DeviceCommand base;  // the last command the haptic thread wrote
+  bool stalled = false;
+  std::int64_t stall_start_ns = 0;
+  bool healthy_seen = true;
+  std::int64_t next_ns = monotonic_ns();
+  while (running_.load(std::memory_order_acquire)) {
+    next_ns += period_ns;
+    sleep_until_ns(next_ns);
+    const std::int64_t now_ns = monotonic_ns();
+    next_ns = std::max(next_ns, now_ns - period_ns);  // after a long preemption, no burst
+    const std::int64_t heartbeat = s.heartbeat_ns.load(std::memory_order_acquire);
+    const double since_s = 1e-9 * static_cast<double>(now_ns - heartbeat);
+    if (since_s > options_.ramp.stale_timeout_s && running_.load(std::memory_order_acquire)) {
+      if (!stalled) {
+        stalled = true;
+        stall_start_ns = heartbeat;
+        bump(s.stall_events);
+        try {
+          spdlog::warn(
+              "haptic loop: no cycle for {:.1f} ms (the step overran or stalled): ramping the "
+              "force to zero within {:.0f} ms",
+              since_s * 1e3, options_.ramp.zero_by_s() * 1e3);
+        } catch (...) {
+        }
+      }
+      if (s.last_written.update()) {
+        base = s.last_written.read_slot();
+      }
+      // Evaluated one supervisor period ahead, so zero is reached by zero_by_s() at the latest.
+      const double gain = ramp_gain(since_s + options_.supervisor_period_s, true, options_.ramp);
+      if (try_write(scaled_command(base, gain))) {
+        s.supervisor_gain.store(std::min(gain, s.supervisor_gain.load()));
+      }
+    } else if (stalled && since_s <= options_.ramp.stale_timeout_s) {
+      stalled = false;
+      try {
+        spdlog::info(
+            "haptic loop: cycles resumed after a {:.1f} ms stall; force comes back over "
+            "{:.0f} ms",
+            1e-6 * static_cast<double>(heartbeat - stall_start_ns),
+            options_.ramp.ramp_duration_s * 1e3);
+      } catch (...) {
+      }
+    }
+    const bool healthy = s.device_healthy.load(std::memory_order_relaxed);
+    if (healthy != healthy_seen) {
+      healthy_seen = healthy;
+      try {
+        if (!healthy) {
+          spdlog::warn(
+              "haptic loop: the device reports itself unhealthy (stale or lost): force "
+              "ramped to zero");
+        } else {
+          spdlog::info("haptic loop: the device is healthy again");
+        }
+      } catch (...) {
+      }
+    }
+  }
+}
+
+HapticLoopStatus HapticLoop::status() const noexcept {
+  const Shared& s = *shared_;
+  HapticLoopStatus st;
+  st.running = running();
+  st.realtime_priority = s.realtime_priority.load();
+  st.cycles = s.cycles.load(std::memory_order_acquire);
+  const std::int64_t start = s.start_ns.load();
+  const std::int64_t end = st.running || s.end_ns.load() == 0 ? monotonic_ns() : s.end_ns.load();
+  st.elapsed_s = start > 0 ? 1e-9 * static_cast<double>(end - start) : 0.0;
+  st.rate_hz = st.elapsed_s > 0.0 ? static_cast<double>(st.cycles) / st.elapsed_s : 0.0;
+  st.period_jitter_us = jitter_us_.summary();
+  st.cycle_cost_us = cost_us_.summary();
+  st.missed_deadlines = s.missed.load();
+  st.stall_events = s.stall_events.load();
+  st.ramp_cycles = s.ramp_cycles.load();
+  st.device_health_losses = s.health_losses.load();
+  st.failed_steps = s.failed_steps.load();
+  st.last_output_force_n = s.last_output_force_n.load();
+  if (!st.running) {
+    // The watchdog is the haptic thread's; read it only when that thread is done.
+    st.clamped_cycles = s.watchdog.clamped_cycles();
+    st.nonfinite_commands = s.watchdog.nonfinite_count();
+  }
+  return st;
+}
+
+}  // namespace hapsim

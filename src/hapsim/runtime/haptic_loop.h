@@ -1,0 +1,160 @@
+// The real-time haptic loop (SPEC §7, issue 5): a thread that runs one haptic cycle every period
+// (1 ms) on an absolute-deadline clock — read the device, step the simulation, make the command
+// safe, write the device, publish — plus a supervisor thread that takes over the device output
+// when a cycle stalls.
+//
+// The haptic path allocates nothing, takes no lock and does no I/O: the simulation is a
+// HapticClient whose step() is allocation-free (World::step), metrics go to fixed histograms
+// and atomics, and the client publishes its snapshots through lock-free buffers
+// (triple_buffer.h, spsc_ring.h) in after_cycle().
+//
+// Safety (SPEC §3): every command goes through ForceWatchdog (clamped to the device profile, NaN
+// -> zero, ramp to zero when the device reports itself unhealthy). When no cycle completes for
+// ramp.stale_timeout_s (the step overran, stalled, or the device read hung) the supervisor ramps
+// the last good command to zero so that the output is zero by ramp.zero_by_s() (10 ms by
+// default) after the last good cycle, and logs the event. When cycles resume, the force comes
+// back over ramp.ramp_duration_s instead of jumping (no kick in the user's hand).
+#pragma once
+
+#include "hapsim/device/device.h"
+#include "hapsim/device/force_safety.h"
+#include "hapsim/runtime/latency_histogram.h"
+
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+
+namespace hapsim {
+
+struct HapticLoopOptions {
+  double period_s = 0.001;
+  /// Stop by itself after this many cycles (0: run until stop()).
+  std::uint64_t max_cycles = 0;
+  /// Ask for SCHED_FIFO (falls back quietly to normal scheduling when not permitted).
+  bool realtime_priority = true;
+  int fifo_priority = 80;
+  /// With real-time priority: wake this long before each deadline and spin to it.
+  double spin_s = 200e-6;
+  /// A period longer than this counts as a missed deadline.
+  double missed_period_s = 0.002;
+  ForceRampParams ramp;
+  /// How often the supervisor looks at the haptic thread's heartbeat.
+  double supervisor_period_s = 0.001;
+};
+
+/// What one cycle did, handed to HapticClient::after_cycle on the haptic thread.
+struct HapticCycle {
+  std::uint64_t index = 0;
+  /// Simulation time of the cycle: index · period (the clock of a scripted device).
+  double time_s = 0.0;
+  const DeviceInput* input = nullptr;
+  /// The simulation's command (before safety), null when the step failed.
+  const DeviceCommand* fresh = nullptr;
+  /// What was written to the device (after clamp, ramp and resume).
+  const DeviceCommand* output = nullptr;
+  /// read + step + safety + write, microseconds.
+  double cost_us = 0.0;
+  /// Time since the previous cycle started, microseconds (0 for the first).
+  double period_us = 0.0;
+  bool healthy = true;
+};
+
+/// The simulation side of the loop (a World, a TeleopWorld, a test double).
+class HapticClient {
+ public:
+  virtual ~HapticClient() = default;
+  /// haptic path: one step with this cycle's input; the command before safety. Must not
+  /// allocate or block; an exception counts as a failed step (zero fresh command this cycle).
+  virtual const DeviceCommand& step(const DeviceInput& input, double dt_s) = 0;
+  /// haptic path, after the device write (outside the timed cost): publish snapshots.
+  virtual void after_cycle(const HapticCycle& /*cycle*/) noexcept {}
+
+ protected:
+  HapticClient() = default;
+  HapticClient(const HapticClient&) = default;
+  HapticClient& operator=(const HapticClient&) = default;
+  HapticClient(HapticClient&&) = default;
+  HapticClient& operator=(HapticClient&&) = default;
+};
+
+/// Live figures, readable from any thread while the loop runs (a consistent-enough copy: each
+/// field is read atomically on its own).
+struct HapticLoopStatus {
+  bool running = false;
+  bool realtime_priority = false;
+  std::uint64_t cycles = 0;
+  double elapsed_s = 0.0;
+  /// cycles / elapsed wall time.
+  double rate_hz = 0.0;
+  /// |period − nominal period|, microseconds.
+  LatencyPercentilesUs period_jitter_us;
+  /// read + step + safety + write, microseconds.
+  LatencyPercentilesUs cycle_cost_us;
+  /// Periods longer than missed_period_s.
+  std::uint64_t missed_deadlines = 0;
+  /// Times the supervisor found the haptic thread stalled and ramped the force down.
+  std::uint64_t stall_events = 0;
+  /// Cycles in which the output was below the simulation's command because of a ramp.
+  std::uint64_t ramp_cycles = 0;
+  /// Transitions of the device from healthy to not.
+  std::uint64_t device_health_losses = 0;
+  /// Steps that threw (each yields zero fresh force).
+  std::uint64_t failed_steps = 0;
+  std::uint64_t clamped_cycles = 0;
+  std::uint64_t nonfinite_commands = 0;
+  double last_output_force_n = 0.0;
+};
+
+class HapticLoop {
+ public:
+  /// `device` and `client` must outlive the loop. Throws hapsim::Error on bad options.
+  HapticLoop(Device& device, HapticClient& client, HapticLoopOptions options = {});
+  ~HapticLoop();
+  HapticLoop(const HapticLoop&) = delete;
+  HapticLoop& operator=(const HapticLoop&) = delete;
+  HapticLoop(HapticLoop&&) = delete;
+  HapticLoop& operator=(HapticLoop&&) = delete;
+
+  /// Starts the haptic and supervisor threads. Throws if already started.
+  void start();
+  /// Asks the haptic thread to stop after its current cycle (any thread, non-blocking).
+  void request_stop() noexcept;
+  /// Stops, joins both threads and writes a zero command to the device. Idempotent.
+  void stop();
+  /// Blocks until the loop stops by itself (max_cycles) or stop() is called elsewhere, then
+  /// joins as stop() does.
+  void wait();
+
+  [[nodiscard]] bool running() const noexcept { return running_.load(std::memory_order_acquire); }
+  [[nodiscard]] HapticLoopStatus status() const noexcept;
+  [[nodiscard]] const LatencyHistogram& period_jitter_histogram() const { return jitter_us_; }
+  [[nodiscard]] const LatencyHistogram& cycle_cost_histogram() const { return cost_us_; }
+  [[nodiscard]] const HapticLoopOptions& options() const { return options_; }
+
+ private:
+  struct Shared;
+  void haptic_thread_main() noexcept;
+  void supervisor_thread_main() noexcept;
+  /// Writes `command` unless the other thread is writing right now (never waits); true if
+  /// written.
+  bool try_write(const DeviceCommand& command) noexcept;
+
+  Device& device_;
+  HapticClient& client_;
+  HapticLoopOptions options_;
+  std::unique_ptr<Shared> shared_;
+  LatencyHistogram jitter_us_;
+  LatencyHistogram cost_us_;
+  std::atomic<bool> running_{false};
+  std::atomic<bool> stop_requested_{false};
+  std::thread haptic_thread_;
+  std::thread supervisor_thread_;
+  bool started_ = false;
+};
+
+/// Scales every force and torque of `command` by `gain` in [0, 1]. haptic path
+[[nodiscard]] DeviceCommand scaled_command(const DeviceCommand& command, double gain) noexcept;
+
+}  // namespace hapsim

@@ -1,0 +1,146 @@
+#include "hapsim/runtime/world_haptic_client.h"
+
+#include "hapsim/deform/vertex_deflection.h"
+
+#include <algorithm>
+
+namespace hapsim {
+
+WorldHapticClient::WorldHapticClient(World& world, WorldHapticClientOptions options)
+    : world_(world), options_(options) {
+  const WorldDescription& d = world_.description();
+  max_deflection_m_.assign(world_.flat_segment_count(), 0.0);
+  for (std::size_t b = 0; b < d.bodies.size(); ++b) {
+    for (std::size_t s = 0; s < d.bodies[b].segments.size(); ++s) {
+      const VertexDeflection* deflection = world_.deflection(b, s);
+      if (deflection == nullptr) {
+        continue;
+      }
+      DeformableSegment seg;
+      seg.flat = world_.flat_segment(b, s);
+      seg.deflection = deflection;
+      const std::size_t n = deflection->mesh().vertices.size();
+      for (int k = 0; k < 3; ++k) {
+        seg.pending[static_cast<std::size_t>(k)].reserve(n);
+        seg.is_pending[static_cast<std::size_t>(k)].assign(n, 0);
+      }
+      deformable_.push_back(std::move(seg));
+    }
+  }
+  if (options_.publish_snapshots) {
+    snapshots_ = std::make_unique<TripleBuffer<WorldSnapshot>>(make_world_snapshot(world_));
+  }
+  if (options_.record_capacity > 0) {
+    records_ = std::make_unique<SpscRing<CycleRecord>>(options_.record_capacity);
+  }
+  zero_command_.finger_count = 0;
+}
+
+// haptic path
+const DeviceCommand& WorldHapticClient::step(const DeviceInput& input, double dt_s) {
+  if (reset_requested_.exchange(false, std::memory_order_acquire)) {
+    world_.reset();
+    // Every vertex may have moved back to rest (a rare O(vertices) cycle, asked for by a user).
+    for (DeformableSegment& seg : deformable_) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        seg.pending[k].clear();
+        for (std::uint32_t v = 0; v < seg.is_pending[k].size(); ++v) {
+          seg.is_pending[k][v] = 1;
+          seg.pending[k].push_back(v);
+        }
+      }
+      ++seg.changes;
+    }
+  }
+  stepped_ = false;
+  if (paused_.load(std::memory_order_relaxed)) {
+    last_result_ = &world_.last_result();
+    return zero_command_;
+  }
+  last_result_ = &world_.step(input, dt_s);
+  stepped_ = true;
+  return last_result_->command;
+}
+
+// haptic path
+void WorldHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
+  // Every vertex that moved this step is owed to each of the three snapshot slots.
+  for (DeformableSegment& seg : deformable_) {
+    // moved_vertices() is the last step's: nothing new moved in a cycle that did not step.
+    const auto moved =
+        stepped_ ? seg.deflection->moved_vertices() : std::span<const std::uint32_t>{};
+    seg.changes += moved.empty() ? 0 : 1;
+    for (std::size_t k = 0; k < 3; ++k) {
+      std::vector<std::uint32_t>& pending = seg.pending[k];
+      std::vector<std::uint8_t>& flag = seg.is_pending[k];
+      for (const std::uint32_t v : moved) {
+        if (flag[v] == 0) {
+          flag[v] = 1;
+          pending.push_back(v);  // capacity = vertex count: never reallocates
+        }
+      }
+    }
+    double& peak = max_deflection_m_[seg.flat];
+    peak = std::max(peak, seg.deflection->max_deflection_m());
+  }
+  if (snapshots_) {
+    publish_snapshot(cycle);
+  }
+  if (records_ && last_result_ != nullptr) {
+    fill_cycle_record(scratch_record_, cycle.index, *cycle.input, *last_result_, *cycle.output,
+                      cycle.cost_us);
+    if (!records_->push(scratch_record_)) {
+      dropped_records_.store(dropped_records_.load(std::memory_order_relaxed) + 1,
+                             std::memory_order_relaxed);
+    }
+  }
+}
+
+// haptic path
+void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
+  WorldSnapshot& s = snapshots_->write_slot();
+  const auto slot = static_cast<std::size_t>(snapshots_->write_index());
+  s.cycle = cycle.index;
+  s.time_s = cycle.time_s;
+  s.input = *cycle.input;
+  s.output = *cycle.output;
+  const WorldDescription& d = world_.description();
+  if (last_result_ != nullptr) {
+    const StepResult& r = *last_result_;
+    const std::size_t tools = std::min(r.tools.size(), s.tools.size());
+    std::copy_n(r.tools.begin(), tools, s.tools.begin());
+    const std::size_t contacts = std::min(r.contacts.size(), s.contacts.size());
+    std::copy_n(r.contacts.begin(), contacts, s.contacts.begin());
+    s.contact_count = contacts;
+    // The force each tool renders: its finger actuator, or its share of the (clamped) tip force.
+    const double tip_n = r.command.force_world_n.norm();
+    const double tip_scale = tip_n > 0.0 ? cycle.output->force_world_n.norm() / tip_n : 0.0;
+    for (std::size_t t = 0; t < tools; ++t) {
+      const int finger = d.tools[t].finger;
+      s.tool_force_n[t] = finger >= 0 && finger < cycle.output->finger_count
+                              ? cycle.output->finger_force_n[static_cast<std::size_t>(finger)]
+                              : r.tools[t].force_world_n.norm() * tip_scale;
+    }
+  }
+  for (DeformableSegment& seg : deformable_) {
+    std::vector<std::uint32_t>& pending = seg.pending[slot];
+    std::vector<std::uint8_t>& flag = seg.is_pending[slot];
+    s.deflection_m[seg.flat] = seg.deflection->max_deflection_m();
+    if (pending.empty()) {
+      continue;
+    }
+    const std::vector<Vec3>& vertices = seg.deflection->mesh().vertices;
+    float* xyz = s.positions_body[seg.flat].data();
+    for (const std::uint32_t v : pending) {
+      xyz[3 * v + 0] = static_cast<float>(vertices[v].x());
+      xyz[3 * v + 1] = static_cast<float>(vertices[v].y());
+      xyz[3 * v + 2] = static_cast<float>(vertices[v].z());
+      flag[v] = 0;
+    }
+    pending.clear();
+    s.positions_version[seg.flat] = seg.changes;
+  }
+  snapshots_->publish();
+}
+
+}  // namespace hapsim

@@ -1,0 +1,84 @@
+// The haptic loop's client for a World (SPEC §7): each cycle steps the world, then publishes
+// - the newest snapshot for the viewer through a triple buffer (deformed vertices copied by
+//   delta: only the ones that moved since that slot was last written, so the copy costs about
+//   what the step's own deformation update did), and
+// - every cycle's record through an SPSC ring to the run's bookkeeping and the recorder.
+// All buffers are sized at construction: after_cycle() allocates nothing (haptic path).
+#pragma once
+
+#include "hapsim/runtime/cycle_record.h"
+#include "hapsim/runtime/haptic_loop.h"
+#include "hapsim/runtime/spsc_ring.h"
+#include "hapsim/runtime/triple_buffer.h"
+#include "hapsim/runtime/world_snapshot.h"
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace hapsim {
+
+struct WorldHapticClientOptions {
+  /// Publish a viewer snapshot every cycle (true) or not at all (a headless run).
+  bool publish_snapshots = true;
+  /// Capacity of the record ring in cycles (0: no records). 2048 gives the consumer 2 s of slack.
+  std::size_t record_capacity = 0;
+};
+
+class WorldHapticClient final : public HapticClient {
+ public:
+  /// `world` must outlive the client; its description gives every size.
+  explicit WorldHapticClient(World& world, WorldHapticClientOptions options = {});
+
+  /// haptic path
+  const DeviceCommand& step(const DeviceInput& input, double dt_s) override;
+  /// haptic path
+  void after_cycle(const HapticCycle& cycle) noexcept override;
+
+  /// Reader side of the snapshots (one reader thread), null when not publishing.
+  [[nodiscard]] TripleBuffer<WorldSnapshot>* snapshots() { return snapshots_.get(); }
+  /// Consumer side of the records (one consumer thread), null when not recording.
+  [[nodiscard]] SpscRing<CycleRecord>* records() { return records_.get(); }
+  /// Records that did not fit in the ring (the consumer fell behind).
+  [[nodiscard]] std::uint64_t dropped_records() const {
+    return dropped_records_.load(std::memory_order_relaxed);
+  }
+  /// Per flat segment: the largest deflection seen in any cycle. Read after the loop stopped.
+  [[nodiscard]] const std::vector<double>& max_deflection_m() const { return max_deflection_m_; }
+
+  /// Any thread: stop stepping the world (tools hold still, zero force) or go on.
+  void set_paused(bool paused) { paused_.store(paused, std::memory_order_relaxed); }
+  [[nodiscard]] bool paused() const { return paused_.load(std::memory_order_relaxed); }
+  /// Any thread: the haptic thread resets the world at its next cycle.
+  void request_reset() { reset_requested_.store(true, std::memory_order_release); }
+
+ private:
+  struct DeformableSegment {
+    std::size_t flat = 0;
+    const VertexDeflection* deflection = nullptr;
+    // Per triple-buffer slot: vertices moved since that slot was last written, and flags.
+    std::array<std::vector<std::uint32_t>, 3> pending;
+    std::array<std::vector<std::uint8_t>, 3> is_pending;
+    std::uint64_t changes = 0;  // steps that moved a vertex: the published version
+  };
+
+  void publish_snapshot(const HapticCycle& cycle) noexcept;
+
+  World& world_;
+  WorldHapticClientOptions options_;
+  const StepResult* last_result_ = nullptr;
+  bool stepped_ = false;  // this cycle stepped the world (not paused)
+  DeviceCommand zero_command_;
+  std::unique_ptr<TripleBuffer<WorldSnapshot>> snapshots_;
+  std::unique_ptr<SpscRing<CycleRecord>> records_;
+  CycleRecord scratch_record_;
+  std::vector<DeformableSegment> deformable_;
+  std::vector<double> max_deflection_m_;
+  std::atomic<std::uint64_t> dropped_records_{0};
+  std::atomic<bool> paused_{false};
+  std::atomic<bool> reset_requested_{false};
+};
+
+}  // namespace hapsim

@@ -1,0 +1,39 @@
+// What the viewer (and later the network) sees of a running World: the newest cycle's tools,
+// contacts, forces and the deformed surfaces, published by the haptic thread through a triple
+// buffer (world_haptic_client.h). Sized once for a world, so publishing never allocates.
+#pragma once
+
+#include "hapsim/world/world.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace hapsim {
+
+struct WorldSnapshot {
+  std::uint64_t cycle = 0;
+  double time_s = 0.0;
+  DeviceInput input;
+  /// What the device was sent (after safety).
+  DeviceCommand output;
+  /// One per tool.
+  std::vector<ToolState> tools;
+  /// Force each tool renders on the device, newtons (its finger actuator or its share of the
+  /// tip force, after safety).
+  std::vector<double> tool_force_n;
+  /// This cycle's contacts: the first contact_count entries.
+  std::vector<WorldContact> contacts;
+  std::size_t contact_count = 0;
+  /// Per flat segment (World::flat_segment): the deformed vertex positions in the body frame,
+  /// x,y,z per vertex as float (what a renderer uploads); empty for rigid segments.
+  std::vector<std::vector<float>> positions_body;
+  /// Per flat segment: largest deflection right now, metres.
+  std::vector<double> deflection_m;
+  /// Per flat segment: bumped whenever positions_body changed, so a reader re-uploads only then.
+  std::vector<std::uint64_t> positions_version;
+};
+
+/// A snapshot sized for `world`, holding its current state (rest surfaces at start).
+[[nodiscard]] WorldSnapshot make_world_snapshot(const World& world);
+
+}  // namespace hapsim

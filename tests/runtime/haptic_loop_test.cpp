@@ -1,0 +1,346 @@
+// The real-time haptic loop: cycles run on their own thread without allocating, a stalled step
+// or a device that stops answering makes the output ramp to zero along the bounded profile
+// (force_safety.h) and come back gradually, NaN never reaches the device, forces stay within the
+// profile. Timing is asserted only through the loop's own timestamps (the ramp as a function of
+// the time since the last good cycle), never as wall-clock bounds on this shared machine.
+#include "hapsim/runtime/haptic_loop.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/device/device_profile.h"
+#include "hapsim/runtime/deadline_clock.h"
+#include "support/allocation_counter.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <thread>
+#include <vector>
+
+namespace hapsim {
+namespace {
+
+// A device that logs every write with its time (the loop serialises writes; the index is atomic
+// anyway) and can be told to stop answering: report itself unhealthy, or hang inside read().
+class LoggingDevice final : public Device {
+ public:
+  struct Write {
+    std::int64_t t_ns = 0;
+    double force_n = 0.0;
+    bool finite = true;
+  };
+
+  explicit LoggingDevice(DeviceProfile profile) : profile_(std::move(profile)) {
+    writes_.resize(200'000);
+  }
+
+  DeviceInput read(double time_s) noexcept override {
+    const std::uint64_t n = reads_.fetch_add(1);
+    if (hang_at_read_ >= 0 && n == static_cast<std::uint64_t>(hang_at_read_)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(hang_ms_));
+    }
+    DeviceInput in;
+    in.time_s = time_s;
+    in.healthy =
+        !(unhealthy_from_read_ >= 0 && n >= static_cast<std::uint64_t>(unhealthy_from_read_));
+    return in;
+  }
+  void write(const DeviceCommand& command) noexcept override {
+    const std::size_t i = count_.fetch_add(1);
+    if (i < writes_.size()) {
+      const double f = command.force_world_n.norm();
+      writes_[i] = {monotonic_ns(), f, std::isfinite(f)};
+    }
+  }
+  const DeviceProfile& profile() const noexcept override { return profile_; }
+  DeviceStatus status() const noexcept override { return {}; }
+
+  void hang_at(int read_index, int ms) {
+    hang_at_read_ = read_index;
+    hang_ms_ = ms;
+  }
+  void unhealthy_from(int read_index) { unhealthy_from_read_ = read_index; }
+  [[nodiscard]] std::vector<Write> writes() const {
+    return {writes_.begin(),
+            writes_.begin() + static_cast<std::ptrdiff_t>(std::min(count_.load(), writes_.size()))};
+  }
+
+ private:
+  DeviceProfile profile_;
+  std::vector<Write> writes_;
+  std::atomic<std::size_t> count_{0};
+  std::atomic<std::uint64_t> reads_{0};
+  int hang_at_read_ = -1;
+  int hang_ms_ = 0;
+  int unhealthy_from_read_ = -1;
+};
+
+// A simulation that always asks for the same force, can stall in one step, can return NaN, and
+// counts the haptic thread's allocations from its first to its last step.
+class ConstantForceClient final : public HapticClient {
+ public:
+  explicit ConstantForceClient(Vec3 force_n) { command_.force_world_n = force_n; }
+
+  const DeviceCommand& step(const DeviceInput& /*input*/, double /*dt_s*/) override {
+    const std::uint64_t n = steps_++;
+    if (n == 5) {
+      allocations_at_start_ = test::thread_allocation_count();
+    }
+    allocations_at_last_ = test::thread_allocation_count();
+    if (stall_at_ >= 0 && n == static_cast<std::uint64_t>(stall_at_)) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(stall_ms_));
+    }
+    if (nan_at_ >= 0 && n == static_cast<std::uint64_t>(nan_at_)) {
+      nan_command_ = command_;
+      nan_command_.force_world_n.x() = std::numeric_limits<double>::quiet_NaN();
+      return nan_command_;
+    }
+    return command_;
+  }
+  void after_cycle(const HapticCycle& cycle) noexcept override { last_cost_us_ = cycle.cost_us; }
+
+  void stall_at(int step, int ms) {
+    stall_at_ = step;
+    stall_ms_ = ms;
+  }
+  void nan_at(int step) { nan_at_ = step; }
+  [[nodiscard]] long allocations_during_run() const {
+    return allocations_at_last_ - allocations_at_start_;
+  }
+
+ private:
+  DeviceCommand command_;
+  DeviceCommand nan_command_;
+  std::uint64_t steps_ = 0;
+  int stall_at_ = -1;
+  int stall_ms_ = 0;
+  int nan_at_ = -1;
+  long allocations_at_start_ = 0;
+  long allocations_at_last_ = 0;
+  double last_cost_us_ = 0.0;
+};
+
+HapticLoopOptions quick_options(std::uint64_t cycles) {
+  HapticLoopOptions o;
+  o.max_cycles = cycles;
+  return o;
+}
+
+// Every write after the last full-force write before `from_ns` must lie under the ramp profile
+// measured from that write's time: force <= F0 · ramp_gain(t - t_good).
+void expect_under_ramp_profile(const std::vector<LoggingDevice::Write>& writes, double f0_n,
+                               std::size_t first_low, const ForceRampParams& ramp,
+                               std::int64_t t_good_ns, std::size_t end) {
+  for (std::size_t i = first_low; i < end; ++i) {
+    const double since_s = 1e-9 * static_cast<double>(writes[i].t_ns - t_good_ns);
+    const double bound = f0_n * ramp_gain(since_s, true, ramp) + 1e-9;
+    EXPECT_LE(writes[i].force_n, bound) << "write " << i << " at " << since_s * 1e3 << " ms";
+  }
+}
+
+TEST(HapticLoop, RunsTheCyclesAndMeasuresThem) {
+  LoggingDevice device(device_profile("omega3"));
+  ConstantForceClient client(Vec3(0, 0, 2.0));
+  HapticLoop loop(device, client, quick_options(300));
+  loop.start();
+  EXPECT_THROW(loop.start(), Error);
+  loop.wait();
+  const HapticLoopStatus st = loop.status();
+  EXPECT_FALSE(st.running);
+  EXPECT_EQ(st.cycles, 300u);
+  EXPECT_EQ(st.cycle_cost_us.count, 300u);
+  EXPECT_EQ(st.period_jitter_us.count, 299u);  // a period needs two cycles
+  EXPECT_LE(st.period_jitter_us.p50, st.period_jitter_us.p99);
+  EXPECT_LE(st.period_jitter_us.p99, st.period_jitter_us.max);
+  EXPECT_GT(st.rate_hz, 0.0);
+  EXPECT_EQ(st.failed_steps, 0u);
+  const auto writes = device.writes();
+  ASSERT_GE(writes.size(), 301u);  // 300 cycles and the final zero (the supervisor may add some)
+  EXPECT_EQ(writes.back().force_n, 0.0);  // stopping leaves the device pushing nothing
+  EXPECT_NEAR(writes[writes.size() - 2].force_n, 2.0, 1e-12);
+  for (std::size_t i = 1; i < writes.size(); ++i) {
+    EXPECT_GE(writes[i].t_ns, writes[i - 1].t_ns);
+  }
+}
+
+TEST(HapticLoop, HapticThreadAllocatesNothing) {
+  LoggingDevice device(device_profile("omega3"));
+  ConstantForceClient client(Vec3(0, 0, 1.0));
+  HapticLoop loop(device, client, quick_options(400));
+  loop.start();
+  // Other threads may allocate meanwhile (this one reads the live status, as the viewer does).
+  for (int i = 0; i < 20 && loop.running(); ++i) {
+    (void)loop.status();
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  loop.wait();
+  EXPECT_EQ(client.allocations_during_run(), 0);
+  EXPECT_EQ(loop.status().cycles, 400u);
+}
+
+TEST(HapticLoop, StalledStepRampsForceToZeroThenComesBackGradually) {
+  LoggingDevice device(device_profile("omega3"));
+  const double f0 = 4.0;
+  ConstantForceClient client(Vec3(f0, 0, 0));
+  client.stall_at(200, 60);  // one step takes 60 ms
+  const HapticLoopOptions options = quick_options(400);
+  HapticLoop loop(device, client, options);
+  loop.start();
+  loop.wait();
+  const auto w = device.writes();
+  // The last full-force write before the stall, then the supervisor's writes.
+  std::size_t first_low = 0;
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    if (w[i].force_n < f0 - 1e-9 && w[i - 1].force_n >= f0 - 1e-9) {
+      first_low = i;
+      break;
+    }
+  }
+  ASSERT_GT(first_low, 150u) << "no ramp found";
+  const std::int64_t t_good = w[first_low - 1].t_ns;
+  // The stall lasts 60 ms: the supervisor reaches zero and writes zeros until cycles resume.
+  std::size_t first_zero = 0;
+  for (std::size_t i = first_low; i < w.size(); ++i) {
+    if (w[i].force_n == 0.0) {
+      first_zero = i;
+      break;
+    }
+  }
+  ASSERT_GT(first_zero, 0u) << "the force never reached zero during a 60 ms stall";
+  // The ramp is monotone and never above the bounded profile (zero by zero_by_s() = 10 ms).
+  std::size_t resume = first_zero;
+  while (resume < w.size() && w[resume].force_n == 0.0) {
+    ++resume;
+  }
+  for (std::size_t i = first_low; i <= first_zero; ++i) {
+    EXPECT_LE(w[i].force_n, w[i - 1].force_n + 1e-12);
+  }
+  expect_under_ramp_profile(w, f0, first_low, options.ramp, t_good, first_zero + 1);
+  const double zero_after_ms = 1e-6 * static_cast<double>(w[first_zero].t_ns - t_good);
+  EXPECT_GT(zero_after_ms, 1e3 * options.ramp.stale_timeout_s);  // not before the grace
+  // Back again: no jump to full force, a ramp up over ramp_duration_s.
+  ASSERT_LT(resume + 3, w.size());
+  EXPECT_LT(w[resume].force_n, 0.5 * f0) << "force jumped back after the stall";
+  EXPECT_LT(w[resume].force_n, w[resume + 3].force_n);
+  EXPECT_NEAR(w[w.size() - 2].force_n, f0, 1e-9);  // and it does come back fully
+  const HapticLoopStatus st = loop.status();
+  EXPECT_EQ(st.stall_events, 1u);
+  EXPECT_GE(st.missed_deadlines, 1u);  // the 60 ms period
+  EXPECT_GT(st.ramp_cycles, 0u);
+  EXPECT_GE(st.period_jitter_us.max, 50'000.0);
+}
+
+TEST(HapticLoop, DeviceThatHangsInReadIsRampedBySupervisor) {
+  LoggingDevice device(device_profile("omega3"));
+  const double f0 = 3.0;
+  ConstantForceClient client(Vec3(0, f0, 0));
+  device.hang_at(150, 50);
+  const HapticLoopOptions options = quick_options(300);
+  HapticLoop loop(device, client, options);
+  loop.start();
+  loop.wait();
+  const auto w = device.writes();
+  std::size_t first_low = 0;
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    if (w[i].force_n < f0 - 1e-9 && w[i - 1].force_n >= f0 - 1e-9) {
+      first_low = i;
+      break;
+    }
+  }
+  ASSERT_GT(first_low, 100u);
+  std::size_t first_zero = first_low;
+  while (first_zero < w.size() && w[first_zero].force_n > 0.0) {
+    ++first_zero;
+  }
+  ASSERT_LT(first_zero, w.size() - 1);
+  expect_under_ramp_profile(w, f0, first_low, options.ramp, w[first_low - 1].t_ns, first_zero + 1);
+  EXPECT_EQ(loop.status().stall_events, 1u);
+}
+
+TEST(HapticLoop, DeviceReportingItselfUnhealthyRampsToZeroAndStays) {
+  LoggingDevice device(device_profile("omega3"));
+  const double f0 = 5.0;
+  ConstantForceClient client(Vec3(0, 0, -f0));
+  device.unhealthy_from(100);
+  ForceRampParams ramp;
+  HapticLoop loop(device, client, quick_options(200));
+  loop.start();
+  loop.wait();
+  const auto w = device.writes();
+  // Cycle 99 was the last healthy one: from 100 on the watchdog ramps with no grace period.
+  ASSERT_GE(w.size(), 200u);
+  std::size_t last_good = 0;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    if (w[i].force_n >= f0 - 1e-9) {
+      last_good = i;
+    }
+  }
+  ASSERT_GE(last_good, 98u);
+  std::size_t first_zero = last_good + 1;
+  while (first_zero < w.size() && w[first_zero].force_n > 0.0) {
+    ++first_zero;
+  }
+  ASSERT_LT(first_zero, w.size());
+  for (std::size_t i = last_good + 1; i < w.size(); ++i) {
+    const double since_s = 1e-9 * static_cast<double>(w[i].t_ns - w[last_good].t_ns);
+    // Unhealthy: no grace, linear over ramp_duration_s (one cycle of slack for the watchdog
+    // measuring from the cycle's start rather than the write).
+    const double bound = f0 * std::max(0.0, 1.0 - (since_s - 0.001) / ramp.ramp_duration_s);
+    EXPECT_LE(w[i].force_n, bound + 1e-9) << "write " << i;
+    EXPECT_LE(w[i].force_n, w[i - 1].force_n + 1e-12);
+  }
+  EXPECT_EQ(w.back().force_n, 0.0);
+  EXPECT_EQ(loop.status().device_health_losses, 1u);
+}
+
+TEST(HapticLoop, NanCommandNeverReachesTheDeviceAndForceIsClamped) {
+  const DeviceProfile& omega = device_profile("omega3");
+  LoggingDevice device(omega);
+  ConstantForceClient client(Vec3(0, 0, 10.0 * omega.max_force_n));
+  client.nan_at(50);
+  HapticLoop loop(device, client, quick_options(100));
+  loop.start();
+  loop.wait();
+  const auto w = device.writes();
+  ASSERT_GE(w.size(), 100u);
+  for (const auto& write : w) {
+    EXPECT_TRUE(write.finite);
+    EXPECT_LE(write.force_n, omega.max_force_n + 1e-9);
+  }
+  EXPECT_NEAR(w[10].force_n, omega.max_force_n, 1e-9);
+  const HapticLoopStatus st = loop.status();
+  EXPECT_GE(st.nonfinite_commands, 1u);
+  EXPECT_GE(st.clamped_cycles, 99u);
+}
+
+TEST(HapticLoop, StopRequestEndsAnEndlessLoop) {
+  LoggingDevice device(device_profile("touch"));
+  ConstantForceClient client(Vec3(1, 0, 0));
+  HapticLoop loop(device, client);  // max_cycles = 0: until stopped
+  loop.start();
+  while (loop.status().cycles < 20) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  loop.stop();
+  EXPECT_FALSE(loop.running());
+  EXPECT_GE(loop.status().cycles, 20u);
+  EXPECT_EQ(device.writes().back().force_n, 0.0);
+  loop.stop();  // idempotent
+}
+
+TEST(HapticLoop, BadOptionsAreErrors) {
+  LoggingDevice device(device_profile("touch"));
+  ConstantForceClient client(Vec3::Zero());
+  HapticLoopOptions o;
+  o.period_s = 0.0;
+  EXPECT_THROW(HapticLoop bad(device, client, o), Error);
+  o = HapticLoopOptions{};
+  o.ramp.ramp_duration_s = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(HapticLoop bad(device, client, o), Error);
+}
+
+}  // namespace
+}  // namespace hapsim

@@ -1,0 +1,234 @@
+// The World on the real-time loop: the snapshot a viewer reads is the world's state exactly
+// (deformed vertices copied by delta match the world's surface bit for bit as floats, tools match
+// the device input), a reader thread never sees a torn snapshot, the haptic thread allocates
+// nothing with a real World, and a real-time session reports the same contacts as an inline one.
+#include "hapsim/runtime/world_haptic_client.h"
+
+#include "hapsim/deform/vertex_deflection.h"
+#include "hapsim/device/device_profile.h"
+#include "hapsim/device/simulated_device.h"
+#include "hapsim/geometry/procedural.h"
+#include "hapsim/runtime/session.h"
+#include "support/allocation_counter.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <thread>
+
+namespace hapsim {
+namespace {
+
+// A soft deformable sphere (penalty) on a stiff block (proxy), one tool.
+WorldDescription soft_ball_world() {
+  WorldDescription w;
+  w.name = "client-test";
+  MaterialDescription bone;
+  bone.name = "bone";
+  bone.response = ContactResponse::kProxy;
+  bone.contact.stiffness_n_per_m = 2000.0;
+  bone.contact.max_force_n = 20.0;
+  MaterialDescription muscle;
+  muscle.name = "muscle";
+  muscle.response = ContactResponse::kPenalty;
+  muscle.contact.stiffness_n_per_m = 300.0;
+  muscle.contact.max_penetration_m = 0.02;
+  muscle.contact.max_force_n = 3.0;
+  w.materials = {bone, muscle};
+  BodyDescription block;
+  block.name = "block";
+  block.X_world_body = Iso3(Eigen::Translation3d(0, 0, -0.02));
+  SegmentDescription box;
+  box.name = "box";
+  box.material = 0;
+  box.mesh = make_box(Vec3(0.05, 0.05, 0.02));
+  block.segments.push_back(std::move(box));
+  w.bodies.push_back(std::move(block));
+  BodyDescription soft;
+  soft.name = "soft";
+  soft.kind = BodyKind::kDeformable;
+  soft.X_world_body = Iso3(Eigen::Translation3d(0.2, 0, -0.03));
+  SegmentDescription ball;
+  ball.name = "ball";
+  ball.material = 1;
+  ball.mesh = make_uv_sphere(0.03, 48, 24);
+  soft.segments.push_back(std::move(ball));
+  w.bodies.push_back(std::move(soft));
+  ToolDescription tip;
+  tip.name = "tip";
+  tip.radius_m = 0.004;
+  w.tools.push_back(tip);
+  return w;
+}
+
+// Presses the soft ball 6 mm deep in a 0.4 s sine, then lifts away (the dent recovers).
+DeviceInput press_ball(double t) {
+  DeviceInput in;
+  in.time_s = t;
+  const double depth = t < 0.4 ? 0.006 * std::sin(3.141592653589793 * t / 0.4) : -0.01;
+  in.p_world = Vec3(0.2, 0.0, 0.004 - depth);
+  return in;
+}
+
+TEST(WorldHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
+  World world(soft_ball_world());
+  SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);
+  WorldHapticClient client(world);
+  HapticLoopOptions o;
+  o.max_cycles = 250;  // stop mid-press: a dent is there
+  HapticLoop loop(device, client, o);
+  loop.start();
+  loop.wait();
+  TripleBuffer<WorldSnapshot>& buffer = *client.snapshots();
+  ASSERT_TRUE(buffer.update());
+  const WorldSnapshot& s = buffer.read_slot();
+  EXPECT_EQ(s.cycle, 249u);
+  const std::size_t flat = world.flat_segment(1, 0);
+  const TriangleMesh& surface = world.surface(1, 0);
+  ASSERT_EQ(s.positions_body[flat].size(), 3 * surface.vertices.size());
+  std::size_t moved = 0;
+  const auto rest = world.deflection(1, 0)->rest_positions();
+  for (std::size_t v = 0; v < surface.vertices.size(); ++v) {
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(s.positions_body[flat][3 * v + static_cast<std::size_t>(k)],
+                static_cast<float>(surface.vertices[v][k]))
+          << "vertex " << v;
+    }
+    moved += surface.vertices[v] != rest[v] ? 1 : 0;
+  }
+  EXPECT_GT(moved, 10u);  // the dent is in the snapshot, not just the rest shape
+  EXPECT_GT(s.positions_version[flat], 0u);
+  EXPECT_TRUE(s.positions_body[world.flat_segment(0, 0)].empty());  // rigid: nothing to copy
+  EXPECT_NEAR(s.deflection_m[flat], world.current_deflection_m(1, 0), 0.0);
+  EXPECT_GT(s.contact_count, 0u);
+  EXPECT_GT(s.tool_force_n[0], 0.0);
+  EXPECT_EQ(s.tools[0].p_world, press_ball(0.249).p_world);
+}
+
+TEST(WorldHapticClient, ReaderThreadSeesConsistentSnapshotsAndHapticThreadDoesNotAllocate) {
+  World world(soft_ball_world());
+  SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);
+  WorldHapticClientOptions co;
+  co.record_capacity = 1024;
+  WorldHapticClient client(world, co);
+
+  // Counts the haptic thread's allocations around the real client.
+  struct Counting final : HapticClient {
+    explicit Counting(WorldHapticClient& c) : inner(c) {}
+    const DeviceCommand& step(const DeviceInput& input, double dt_s) override {
+      if (steps++ == 5) {
+        first = test::thread_allocation_count();
+      }
+      last = test::thread_allocation_count();
+      return inner.step(input, dt_s);
+    }
+    void after_cycle(const HapticCycle& c) noexcept override { inner.after_cycle(c); }
+    WorldHapticClient& inner;
+    long first = 0;
+    long last = 0;
+    int steps = 0;
+  } counting(client);
+
+  HapticLoopOptions o;
+  o.max_cycles = 700;  // the press and part of the recovery
+  HapticLoop loop(device, counting, o);
+  std::atomic<int> inconsistent{0};
+  std::atomic<int> snapshots{0};
+  std::uint64_t last_cycle = 0;
+  loop.start();
+  std::thread viewer([&] {
+    while (loop.running()) {
+      if (client.snapshots()->update()) {
+        const WorldSnapshot& s = client.snapshots()->read_slot();
+        // One cycle's data: the tool sits where that cycle's input put it.
+        if (s.tools[0].p_world != s.input.p_world || s.cycle < last_cycle) {
+          inconsistent.fetch_add(1);
+        }
+        last_cycle = s.cycle;
+        snapshots.fetch_add(1);
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(300));
+    }
+  });
+  std::size_t records = 0;
+  while (loop.running() || client.records()->front() != nullptr) {
+    while (const CycleRecord* r = client.records()->front()) {
+      EXPECT_EQ(r->cycle, records);
+      client.records()->pop();
+      ++records;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  viewer.join();
+  loop.wait();
+  EXPECT_EQ(counting.last - counting.first, 0) << "the haptic thread allocated";
+  EXPECT_EQ(inconsistent.load(), 0);
+  EXPECT_GT(snapshots.load(), 50);
+  EXPECT_EQ(records + client.dropped_records(), 700u);
+}
+
+TEST(WorldHapticClient, ResetAndPauseReachTheSnapshot) {
+  World world(soft_ball_world());
+  SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);
+  WorldHapticClient client(world);
+  HapticLoopOptions o;
+  o.max_cycles = 200;
+  {
+    HapticLoop loop(device, client, o);
+    loop.start();
+    loop.wait();
+  }
+  ASSERT_GT(world.current_deflection_m(1, 0), 0.0);
+  client.request_reset();
+  client.set_paused(true);
+  HapticLoop again(device, client, o);
+  again.start();
+  again.wait();
+  ASSERT_TRUE(client.snapshots()->update());
+  const WorldSnapshot& s = client.snapshots()->read_slot();
+  const std::size_t flat = world.flat_segment(1, 0);
+  const auto rest = world.deflection(1, 0)->rest_positions();
+  for (std::size_t v = 0; v < rest.size(); ++v) {
+    ASSERT_EQ(s.positions_body[flat][3 * v + 2], static_cast<float>(rest[v].z()));
+  }
+  EXPECT_EQ(s.output.force_world_n.norm(), 0.0);  // paused: no force
+}
+
+TEST(Session, RealtimeRunAccountsTheSameContactsAsAnInlineRun) {
+  const DeviceProfile& omega = device_profile("omega3");
+  SessionOptions options;
+  options.duration_s = 0.8;
+  SessionSummary inline_run;
+  {
+    World world(soft_ball_world());
+    SimulatedDevice device(omega, press_ball, 1.0);
+    inline_run = run_session(world, device, options);
+  }
+  World world(soft_ball_world());
+  SimulatedDevice device(omega, press_ball, 1.0);
+  options.realtime = true;
+  const SessionSummary rt = run_session(world, device, options);
+  ASSERT_TRUE(rt.realtime.has_value());
+  EXPECT_FALSE(inline_run.realtime.has_value());
+  EXPECT_EQ(rt.steps + rt.realtime->dropped_records, 800u);
+  EXPECT_EQ(rt.realtime->dropped_records, 0u);
+  EXPECT_GT(rt.realtime->rate_hz, 0.0);
+  ASSERT_EQ(rt.segments.size(), inline_run.segments.size());
+  // The simulated device plays by simulation time: the same inputs, the same world, the same
+  // contacts and deflection, whatever the thread's timing.
+  for (std::size_t i = 0; i < rt.segments.size(); ++i) {
+    EXPECT_EQ(rt.segments[i].contacts, inline_run.segments[i].contacts);
+    EXPECT_EQ(rt.segments[i].peak_force_n, inline_run.segments[i].peak_force_n);
+    EXPECT_EQ(rt.segments[i].max_deflection_m, inline_run.segments[i].max_deflection_m);
+  }
+  EXPECT_EQ(rt.pop_throughs, 0u);
+  if (rt.realtime->ramp_cycles == 0) {  // a stall on a loaded machine would scale the output
+    EXPECT_EQ(rt.tools[0].peak_force_n, inline_run.tools[0].peak_force_n);
+  }
+  const std::string text = format_session_summary(rt);
+  EXPECT_NE(text.find("real time:"), std::string::npos) << text;
+}
+
+}  // namespace
+}  // namespace hapsim
