@@ -2,7 +2,7 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/runtime/deadline_clock.h"
-#include "hapsim/runtime/triple_buffer.h"
+#include "hapsim/core/triple_buffer.h"
 
 #include <spdlog/spdlog.h>
 

@@ -8,8 +8,8 @@
 
 #include "hapsim/runtime/cycle_record.h"
 #include "hapsim/runtime/haptic_loop.h"
-#include "hapsim/runtime/spsc_ring.h"
-#include "hapsim/runtime/triple_buffer.h"
+#include "hapsim/core/spsc_ring.h"
+#include "hapsim/core/triple_buffer.h"
 #include "hapsim/runtime/world_snapshot.h"
 
 #include <array>

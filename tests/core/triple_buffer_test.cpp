@@ -1,7 +1,7 @@
 // The lock-free hand-over buffers under two real threads: a triple buffer never shows a torn
 // snapshot and never goes back in time; a ring delivers every accepted item once, in order.
-#include "hapsim/runtime/triple_buffer.h"
-#include "hapsim/runtime/spsc_ring.h"
+#include "hapsim/core/triple_buffer.h"
+#include "hapsim/core/spsc_ring.h"
 
 #include <gtest/gtest.h>
 

@@ -1,0 +1,45 @@
+// A device driven by another thread of the same program (SPEC §6): the viewer's mouse and
+// keyboard probe, a 3D mouse's reader thread, a script in a notebook. That thread sets the input
+// whenever it likes; the haptic thread's read() takes the newest one, and the command the loop
+// wrote is handed back so the viewer can show the force the device would render. Both hand-overs
+// are lock-free triple buffers: the haptic path never waits for the UI.
+#pragma once
+
+#include "hapsim/core/triple_buffer.h"
+#include "hapsim/device/device.h"
+
+#include <atomic>
+#include <string>
+
+namespace hapsim {
+
+class InteractiveDevice final : public Device {
+ public:
+  explicit InteractiveDevice(DeviceProfile profile, DeviceInput initial = {});
+
+  // --- the driving thread (one) ---
+
+  /// The input from now on (time_s is overwritten by read()).
+  void set_input(const DeviceInput& input) noexcept;
+  /// The newest command the loop wrote (after safety), as the user's hand would feel it.
+  [[nodiscard]] const DeviceCommand& last_command() noexcept;
+  /// Marks the link lost (the driver went away) or back; read() then reports it.
+  void set_connected(bool connected) noexcept;
+
+  // --- the haptic thread ---
+
+  /// haptic path
+  [[nodiscard]] DeviceInput read(double time_s) noexcept override;
+  /// haptic path
+  void write(const DeviceCommand& command) noexcept override;
+  [[nodiscard]] const DeviceProfile& profile() const noexcept override { return profile_; }
+  [[nodiscard]] DeviceStatus status() const noexcept override;
+
+ private:
+  DeviceProfile profile_;
+  TripleBuffer<DeviceInput> input_;
+  TripleBuffer<DeviceCommand> command_;
+  std::atomic<bool> connected_{true};
+};
+
+}  // namespace hapsim

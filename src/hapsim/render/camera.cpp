@@ -1,0 +1,114 @@
+#include "hapsim/render/camera.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace hapsim {
+
+Vec3 OrbitCamera::eye_W() const {
+  return target_W - distance_m * forward_W();
+}
+
+Vec3 OrbitCamera::forward_W() const {
+  return -Vec3(std::cos(pitch_rad) * std::cos(yaw_rad), std::cos(pitch_rad) * std::sin(yaw_rad),
+               std::sin(pitch_rad));
+}
+
+// forward × Z, normalised; horizontal because the eye never looks straight up or down.
+Vec3 OrbitCamera::right_W() const {
+  return Vec3(-std::sin(yaw_rad), std::cos(yaw_rad), 0.0);
+}
+
+Vec3 OrbitCamera::up_W() const {
+  return right_W().cross(forward_W());
+}
+
+Eigen::Matrix4d OrbitCamera::view_matrix() const {
+  Eigen::Matrix3d R_CW;
+  R_CW.row(0) = right_W().transpose();
+  R_CW.row(1) = up_W().transpose();
+  R_CW.row(2) = -forward_W().transpose();
+  Eigen::Matrix4d X_CW = Eigen::Matrix4d::Identity();
+  X_CW.topLeftCorner<3, 3>() = R_CW;
+  X_CW.topRightCorner<3, 1>() = -R_CW * eye_W();
+  return X_CW;
+}
+
+Eigen::Matrix4d OrbitCamera::projection(double aspect) const {
+  const double f = 1.0 / std::tan(0.5 * fov_y_rad);
+  const double n = near_m();
+  const double far = far_m();
+  Eigen::Matrix4d P = Eigen::Matrix4d::Zero();
+  P(0, 0) = f / aspect;
+  P(1, 1) = f;
+  P(2, 2) = (far + n) / (n - far);
+  P(2, 3) = 2.0 * far * n / (n - far);
+  P(3, 2) = -1.0;
+  return P;
+}
+
+void OrbitCamera::rotate(double dx_px, double dy_px, double rad_per_px) {
+  // d(eye)/d(yaw) points along `right`, so the eye moves left for a drag to the right.
+  yaw_rad = std::remainder(yaw_rad - dx_px * rad_per_px, 2.0 * std::numbers::pi);
+  pitch_rad = std::clamp(pitch_rad + dy_px * rad_per_px, -kMaxPitch, kMaxPitch);
+}
+
+void OrbitCamera::pan(double dx_px, double dy_px, int viewport_height_px) {
+  // Size of one pixel in the plane through the target, facing the camera.
+  const double m_per_px =
+      2.0 * distance_m * std::tan(0.5 * fov_y_rad) / std::max(viewport_height_px, 1);
+  target_W += m_per_px * (-dx_px * right_W() + dy_px * up_W());
+}
+
+void OrbitCamera::zoom(double wheel_steps, double factor_per_step) {
+  distance_m =
+      std::clamp(distance_m * std::pow(factor_per_step, -wheel_steps), kMinDistance, kMaxDistance);
+}
+
+void OrbitCamera::frame(const Box3& bounds_W, double aspect, double margin) {
+  if (bounds_W.isEmpty()) {
+    return;
+  }
+  target_W = bounds_W.center();
+  const double radius = 0.5 * bounds_W.diagonal().norm();
+  if (radius <= 0.0) {
+    return;
+  }
+  // The narrower of the two half-angles decides; a sphere inside that cone fits the viewport.
+  const double half_y = 0.5 * fov_y_rad;
+  const double half_x = std::atan(aspect * std::tan(half_y));
+  const double half = std::min(half_x, half_y);
+  distance_m =
+      std::clamp(std::max(margin, 1.0) * radius / std::sin(half), kMinDistance, kMaxDistance);
+}
+
+Vec3 OrbitCamera::project(const Vec3& p_W, int width_px, int height_px) const {
+  const double aspect = static_cast<double>(width_px) / height_px;
+  const Eigen::Vector4d clip = projection(aspect) * view_matrix() * p_W.homogeneous();
+  if (clip.w() <= 0.0) {
+    return Vec3::Constant(kInf);
+  }
+  const Vec3 ndc = clip.head<3>() / clip.w();
+  return Vec3(0.5 * (ndc.x() + 1.0) * width_px, 0.5 * (1.0 - ndc.y()) * height_px,
+              0.5 * (ndc.z() + 1.0));
+}
+
+Vec3 OrbitCamera::unproject(const Vec3& pixel_depth, int width_px, int height_px) const {
+  const double aspect = static_cast<double>(width_px) / height_px;
+  const Eigen::Vector4d ndc(2.0 * pixel_depth.x() / width_px - 1.0,
+                            1.0 - 2.0 * pixel_depth.y() / height_px, 2.0 * pixel_depth.z() - 1.0,
+                            1.0);
+  const Eigen::Vector4d p = (projection(aspect) * view_matrix()).inverse() * ndc;
+  return p.head<3>() / p.w();
+}
+
+Ray3 OrbitCamera::ray_through(double x_px, double y_px, int width_px, int height_px) const {
+  Ray3 ray;
+  ray.origin_W = eye_W();
+  ray.direction_W =
+      (unproject(Vec3(x_px, y_px, 0.5), width_px, height_px) - ray.origin_W).normalized();
+  return ray;
+}
+
+}  // namespace hapsim

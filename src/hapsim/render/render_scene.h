@@ -1,0 +1,169 @@
+// What the renderer draws, as plain data with no GL types: meshes (registered once, positions
+// updatable for deforming bodies), spheres (tools, proxies, bounding spheres), line segments
+// (robot links, force arrows), shadow marks (an 'x' on the floor under the tool, for depth
+// perception), a floor, lights and the display style. The app fills it from a world snapshot
+// each frame; the renderer keeps GPU copies of meshes and re-uploads only what changed.
+#pragma once
+
+#include "hapsim/core/types.h"
+#include "hapsim/geometry/triangle_mesh.h"
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace hapsim {
+
+/// How meshes are rasterised: vertices only, edges only, or filled triangles.
+enum class DisplayMode { kPoints, kLines, kFaces };
+
+/// Where mesh colours come from.
+enum class ColourMode {
+  kMeshColour,     ///< RenderMesh::colour, ignoring per-vertex colours.
+  kVertexColours,  ///< Per-vertex colours where a mesh has them, else its colour.
+  kPalette,        ///< palette_colour(mesh id): every mesh (segment) a distinct colour.
+};
+
+/// A distinct, well-separated colour for group/segment `i` (≥ 0): a 10-colour qualitative table,
+/// then golden-angle hues for larger indices. RGB in [0, 1].
+Vec3f palette_colour(int i);
+
+using MeshId = std::uint32_t;
+
+class RenderMesh {
+ public:
+  /// Appearance: change freely, no re-upload needed.
+  Vec3f colour = Vec3f(0.8f, 0.8f, 0.8f);
+  /// World-from-mesh pose.
+  Iso3 X_WM = Iso3::Identity();
+  bool visible = true;
+  std::string name;
+
+  /// Positions (mesh frame, metres), triangles and vertex normals (kept current).
+  [[nodiscard]] const TriangleMesh& geometry() const { return geometry_; }
+  /// Per-vertex RGB colours, empty or one per vertex.
+  [[nodiscard]] const std::vector<Vec3f>& vertex_colours() const { return vertex_colours_; }
+  /// Unique stamps of the current triangles and of the current positions/normals/colours; the
+  /// renderer re-uploads a mesh whose stamps differ from the ones it uploaded.
+  [[nodiscard]] std::uint64_t topology_stamp() const { return topology_stamp_; }
+  [[nodiscard]] std::uint64_t vertex_stamp() const { return vertex_stamp_; }
+
+ private:
+  friend class RenderScene;
+  TriangleMesh geometry_;
+  std::vector<Vec3f> vertex_colours_;
+  std::uint64_t topology_stamp_ = 0;
+  std::uint64_t vertex_stamp_ = 0;
+};
+
+struct RenderSphere {
+  Vec3 centre_W = Vec3::Zero();
+  double radius_m = 0.01;
+  Vec3f colour = Vec3f(0.9f, 0.3f, 0.2f);
+  /// Edges only (e.g. bounding-sphere display) instead of a filled, lit sphere.
+  bool wireframe = false;
+};
+
+/// A straight line from `a_W` to `b_W`, unlit, drawn RenderStyle::line_width_px wide.
+struct RenderSegment {
+  Vec3 a_W = Vec3::Zero();
+  Vec3 b_W = Vec3::Zero();
+  Vec3f colour = Vec3f(1.0f, 1.0f, 0.0f);
+};
+
+/// An 'x' on the floor plane directly below (or above) `point_W`: two crossed bars, each
+/// 2·arm_m long and width_m wide, in the floor plane.
+struct ShadowMark {
+  Vec3 point_W = Vec3::Zero();
+  double arm_m = 0.01;
+  double width_m = 0.002;
+  Vec3f colour = Vec3f(0.1f, 0.1f, 0.1f);
+};
+
+/// A checkerboard square in the plane z = height_m, unlit.
+struct RenderFloor {
+  bool visible = true;
+  double height_m = 0.0;
+  /// Centre (x, y) of the square and its half side, metres.
+  double centre_x_m = 0.0;
+  double centre_y_m = 0.0;
+  double half_extent_m = 0.5;
+  /// Checker cell side, metres.
+  double cell_m = 0.05;
+  Vec3f colour_a = Vec3f(0.72f, 0.72f, 0.74f);
+  Vec3f colour_b = Vec3f(0.62f, 0.62f, 0.65f);
+};
+
+/// Which frame a light's direction is given in: fixed in the world, or moving with the camera
+/// (a "headlight" rig: the lit side stays the side you look at while orbiting).
+enum class LightFrame { kWorld, kCamera };
+
+struct DirectionalLight {
+  /// Unit vector from the surface towards the light, in `frame` (camera frame: x right, y up,
+  /// z towards the viewer).
+  Vec3 direction_to_light = Vec3::UnitZ();
+  Vec3f colour = Vec3f(1.0f, 1.0f, 1.0f);
+  LightFrame frame = LightFrame::kCamera;
+};
+
+struct Lighting {
+  /// At most kMaxLights are used. Default: a key light from upper left-front, a dimmer fill
+  /// from lower right, both camera-fixed.
+  std::vector<DirectionalLight> lights = {
+      {Vec3(-0.4, 0.6, 0.7).normalized(), Vec3f(0.75f, 0.75f, 0.72f), LightFrame::kCamera},
+      {Vec3(0.6, -0.3, 0.5).normalized(), Vec3f(0.3f, 0.3f, 0.33f), LightFrame::kCamera}};
+  Vec3f ambient = Vec3f(0.18f, 0.18f, 0.2f);
+  /// Blinn-Phong specular weight and exponent (white highlights).
+  float specular = 0.2f;
+  float shininess = 32.0f;
+
+  static constexpr int kMaxLights = 4;
+};
+
+struct RenderStyle {
+  DisplayMode display_mode = DisplayMode::kFaces;
+  ColourMode colour_mode = ColourMode::kVertexColours;
+  Vec3f background = Vec3f(0.16f, 0.17f, 0.2f);
+  /// Vertex size in DisplayMode::kPoints.
+  float point_size_px = 3.0f;
+  /// Width of segments and of mesh edges in kLines (clamped to what the driver supports).
+  float line_width_px = 1.0f;
+};
+
+class RenderScene {
+ public:
+  /// Registers a mesh (copied) and returns its id (ids are 0, 1, 2, … in order of adding).
+  /// Vertex normals are computed here if `mesh` has none.
+  MeshId add_mesh(const TriangleMesh& mesh_M, const Vec3f& colour,
+                  const Iso3& X_WM = Iso3::Identity());
+  MeshId add_mesh(std::span<const Vec3> positions_M, std::span<const TriangleIndices> triangles,
+                  const Vec3f& colour, const Iso3& X_WM = Iso3::Identity());
+  /// New positions for a deforming mesh (same vertex count and order); recomputes its vertex
+  /// normals. Allocation-free after the first call. Throws hapsim::Error on a size mismatch.
+  void update_positions(MeshId id, std::span<const Vec3> positions_M);
+  /// Per-vertex colours (one per vertex), or an empty span to go back to the mesh colour.
+  void set_vertex_colours(MeshId id, std::span<const Vec3f> colours);
+
+  [[nodiscard]] RenderMesh& mesh(MeshId id);
+  [[nodiscard]] const RenderMesh& mesh(MeshId id) const;
+  [[nodiscard]] std::size_t mesh_count() const { return meshes_.size(); }
+
+  /// World bounds of the visible meshes and spheres (for OrbitCamera::frame); empty if none.
+  [[nodiscard]] Box3 bounds_W() const;
+
+  /// Per-frame content: cleared and refilled by the app (vectors keep their capacity).
+  std::vector<RenderSphere> spheres;
+  std::vector<RenderSegment> segments;
+  std::vector<ShadowMark> shadow_marks;
+
+  RenderFloor floor;
+  Lighting lighting;
+  RenderStyle style;
+
+ private:
+  RenderMesh& checked(MeshId id, const char* where);
+  std::vector<RenderMesh> meshes_;
+};
+
+}  // namespace hapsim

@@ -1,0 +1,142 @@
+// OrbitCamera: projections and mouse helpers checked against geometric facts (the target is at
+// the viewport centre, a full turn is the identity, panned points follow the cursor, …).
+#include "hapsim/render/camera.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace hapsim {
+namespace {
+
+constexpr int kW = 640;
+constexpr int kH = 480;
+
+OrbitCamera make_camera() {
+  OrbitCamera cam;
+  cam.target_W = Vec3(0.1, -0.2, 0.3);
+  cam.yaw_rad = 0.7;
+  cam.pitch_rad = 0.4;
+  cam.distance_m = 0.8;
+  cam.fov_y_rad = 0.6;
+  return cam;
+}
+
+TEST(OrbitCamera, TargetProjectsToViewportCentre) {
+  const OrbitCamera cam = make_camera();
+  const Vec3 p = cam.project(cam.target_W, kW, kH);
+  EXPECT_NEAR(p.x(), kW / 2.0, 1e-9);
+  EXPECT_NEAR(p.y(), kH / 2.0, 1e-9);
+  EXPECT_GT(p.z(), 0.0);
+  EXPECT_LT(p.z(), 1.0);
+  EXPECT_NEAR((cam.eye_W() - cam.target_W).norm(), cam.distance_m, 1e-12);
+}
+
+TEST(OrbitCamera, ZIsUpOnScreenAndRightHanded) {
+  OrbitCamera cam;  // yaw 0: the eye is on +X looking towards −X
+  cam.pitch_rad = 0.0;
+  const Vec3 above = cam.project(Vec3(0, 0, 0.1), kW, kH);
+  const Vec3 plus_y = cam.project(Vec3(0, 0.1, 0), kW, kH);
+  EXPECT_LT(above.y(), kH / 2.0);   // up in the world is up on screen (smaller y)
+  EXPECT_GT(plus_y.x(), kW / 2.0);  // looking along −X with Z up, +Y is to the right
+}
+
+TEST(OrbitCamera, FullTurnOfYawReturnsTheEye) {
+  OrbitCamera cam = make_camera();
+  const Vec3 eye0 = cam.eye_W();
+  const double rad_per_px = 0.005;
+  const double full_turn_px = 2.0 * std::numbers::pi / rad_per_px;
+  cam.rotate(full_turn_px / 3.0, 0.0, rad_per_px);
+  EXPECT_GT((cam.eye_W() - eye0).norm(), 0.5 * cam.distance_m);  // it did move
+  cam.rotate(2.0 * full_turn_px / 3.0, 0.0, rad_per_px);
+  EXPECT_LT((cam.eye_W() - eye0).norm(), 1e-9);
+}
+
+TEST(OrbitCamera, DragRightMovesTheEyeLeftAndPitchIsClamped) {
+  OrbitCamera cam = make_camera();
+  const Vec3 eye0 = cam.eye_W();
+  const Vec3 right0 = cam.right_W();
+  cam.rotate(10.0, 0.0);
+  EXPECT_LT((cam.eye_W() - eye0).dot(right0), 0.0);
+  cam.rotate(0.0, 1e6);
+  EXPECT_LE(cam.pitch_rad, OrbitCamera::kMaxPitch);
+  EXPECT_FALSE(cam.view_matrix().hasNaN());
+}
+
+TEST(OrbitCamera, PanKeepsThePointUnderTheCursor) {
+  OrbitCamera cam = make_camera();
+  // A point off-centre on the plane through the target facing the camera.
+  const Vec3 p_W = cam.target_W + 0.05 * cam.right_W() - 0.03 * cam.up_W();
+  const Vec3 before = cam.project(p_W, kW, kH);
+  const double dx = 37.0;
+  const double dy = -21.0;
+  cam.pan(dx, dy, kH);
+  const Vec3 after = cam.project(p_W, kW, kH);
+  EXPECT_NEAR(after.x() - before.x(), dx, 1e-6);
+  EXPECT_NEAR(after.y() - before.y(), dy, 1e-6);
+}
+
+TEST(OrbitCamera, ZoomMultipliesTheDistance) {
+  OrbitCamera cam = make_camera();
+  const double d0 = cam.distance_m;
+  cam.zoom(3.0, 1.25);
+  EXPECT_NEAR(cam.distance_m, d0 / std::pow(1.25, 3.0), 1e-12);
+  cam.zoom(-3.0, 1.25);
+  EXPECT_NEAR(cam.distance_m, d0, 1e-12);
+  const Vec3 target = cam.target_W;
+  cam.zoom(1.0);
+  EXPECT_TRUE(cam.target_W.isApprox(target));  // zoom moves the eye, not the target
+}
+
+TEST(OrbitCamera, FrameFitsAllBoxCorners) {
+  for (const double aspect : {0.5, 1.0, 16.0 / 9.0}) {
+    const int w = static_cast<int>(480 * aspect);
+    const int h = 480;
+    OrbitCamera cam = make_camera();
+    cam.distance_m = 100.0;  // far off first, so frame() must move in
+    const Box3 box(Vec3(1.0, 2.0, -0.5), Vec3(1.3, 2.8, 0.1));
+    cam.frame(box, static_cast<double>(w) / h);
+    EXPECT_TRUE(cam.target_W.isApprox(box.center()));
+    double min_x = kInf, max_x = -kInf;
+    for (int i = 0; i < 8; ++i) {
+      const Vec3 corner = box.corner(static_cast<Box3::CornerType>(i));
+      const Vec3 p = cam.project(corner, w, h);
+      EXPECT_GT(p.x(), 0.0) << "aspect " << aspect << " corner " << i;
+      EXPECT_LT(p.x(), w) << "aspect " << aspect << " corner " << i;
+      EXPECT_GT(p.y(), 0.0) << "aspect " << aspect << " corner " << i;
+      EXPECT_LT(p.y(), h) << "aspect " << aspect << " corner " << i;
+      EXPECT_GT(p.z(), 0.0);
+      EXPECT_LT(p.z(), 1.0);
+      min_x = std::min(min_x, p.x());
+      max_x = std::max(max_x, p.x());
+    }
+    // …and does not leave it tiny: the box spans a good part of the viewport.
+    EXPECT_GT(max_x - min_x, 0.2 * std::min(w, h));
+  }
+}
+
+TEST(OrbitCamera, UnprojectInvertsProjectAndRaysPassThroughPixels) {
+  const OrbitCamera cam = make_camera();
+  const Vec3 p_W(0.15, -0.1, 0.35);
+  const Vec3 pix = cam.project(p_W, kW, kH);
+  EXPECT_TRUE(cam.unproject(pix, kW, kH).isApprox(p_W, 1e-6));
+
+  const Ray3 ray = cam.ray_through(pix.x(), pix.y(), kW, kH);
+  EXPECT_TRUE(ray.origin_W.isApprox(cam.eye_W()));
+  EXPECT_NEAR(ray.direction_W.norm(), 1.0, 1e-12);
+  const Vec3 to_p = p_W - ray.origin_W;
+  EXPECT_LT((to_p - to_p.dot(ray.direction_W) * ray.direction_W).norm(), 1e-6);
+
+  const Ray3 centre = cam.ray_through(kW / 2.0, kH / 2.0, kW, kH);
+  EXPECT_TRUE(centre.direction_W.isApprox(cam.forward_W(), 1e-9));
+}
+
+TEST(OrbitCamera, PointsBehindTheEyeDoNotProject) {
+  const OrbitCamera cam = make_camera();
+  const Vec3 behind = cam.eye_W() - cam.forward_W();
+  EXPECT_FALSE(std::isfinite(cam.project(behind, kW, kH).x()));
+}
+
+}  // namespace
+}  // namespace hapsim
