@@ -8,6 +8,8 @@
 #include "hapsim/core/error.h"
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/device/recording.h"
+#include "hapsim/render/snapshot_writer.h"
+#include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
@@ -24,7 +26,9 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
+#include <utility>
 
 namespace hapsim::app {
 namespace {
@@ -40,6 +44,77 @@ struct RunArgs {
   std::string data_dir;
   bool realtime = false;
   bool quiet = false;
+  // Headless pictures.
+  std::string snapshot_path;
+  std::size_t snapshot_every = 0;
+  std::string display_mode = "faces";
+  std::string colours = "tissue";
+  std::string size = "1280x720";
+  int sphere_tree_level = -1;
+};
+
+SegmentColouring parse_colouring(const std::string& name) {
+  if (name == "segments") {
+    return SegmentColouring::kSegments;
+  }
+  if (name == "groups") {
+    return SegmentColouring::kGroups;
+  }
+  return SegmentColouring::kTissue;  // CLI11 has checked the name
+}
+
+std::pair<int, int> parse_size(const std::string& text) {
+  int w = 0;
+  int h = 0;
+  char x = 0;
+  std::istringstream in(text);
+  if (!(in >> w >> x >> h) || x != 'x' || !in.eof() || w < 16 || h < 16 || w > 8192 || h > 8192) {
+    throw CommandError("--size " + text + ": expected WIDTHxHEIGHT in pixels, e.g. 1280x720");
+  }
+  return {w, h};
+}
+
+// Headless pictures of a World run: the same scene the viewer shows, drawn offscreen.
+class WorldSnapshots {
+ public:
+  WorldSnapshots(const World& world, const RunArgs& args)
+      : path_(args.snapshot_path), every_(args.snapshot_every) {
+    const auto [w, h] = parse_size(args.size);
+    writer_ = std::make_unique<SnapshotWriter>(w, h);
+    WorldSceneOptions o;
+    o.colouring = parse_colouring(args.colours);
+    o.sphere_tree_level = args.sphere_tree_level;
+    scene_ = std::make_unique<WorldScene>(world, o);
+    scene_->scene().style.display_mode = parse_display_mode(args.display_mode);
+    camera_ = framed_camera(scene_->rest_bounds_W(), static_cast<double>(w) / h, kDefaultYaw,
+                            kDefaultPitch);
+  }
+
+  void after_cycle(const World& world, std::size_t cycle) {
+    if (every_ > 0 && (cycle + 1) % every_ == 0) {
+      write(world, numbered_path(path_, cycle + 1));
+    }
+  }
+  void final(const World& world) { write(world, path_); }
+  [[nodiscard]] std::size_t written() const { return written_; }
+
+  // From the front (+Y) and a little medial (−X), slightly above: the patella faces the camera.
+  static constexpr double kDefaultYaw = 1.95;
+  static constexpr double kDefaultPitch = 0.3;
+
+ private:
+  void write(const World& world, const std::string& path) {
+    scene_->update_from_world(world);
+    writer_->write_png(scene_->scene(), camera_, path);
+    ++written_;
+  }
+
+  std::string path_;
+  std::size_t every_;
+  std::unique_ptr<SnapshotWriter> writer_;
+  std::unique_ptr<WorldScene> scene_;
+  OrbitCamera camera_;
+  std::size_t written_ = 0;
 };
 
 ContactMethod parse_method(const std::string& name) {
@@ -243,8 +318,21 @@ void run(const RunArgs& args) {
     recorder = std::make_unique<SessionRecorder>(record_path, world.content_hash(), 8192);
   }
 
+  std::unique_ptr<WorldSnapshots> snapshots;
+  if (!args.snapshot_path.empty()) {
+    if (args.realtime && args.snapshot_every > 0) {
+      throw CommandError(
+          "--snapshot-every: not with --realtime (the haptic thread owns the world "
+          "while it runs; the final snapshot is written after the run)");
+    }
+    snapshots = std::make_unique<WorldSnapshots>(world, args);
+  }
+
   SessionOptions options;
   options.duration_s = duration_s;
+  if (snapshots && args.snapshot_every > 0) {
+    options.after_cycle = [&](std::size_t cycle) { snapshots->after_cycle(world, cycle); };
+  }
   options.dt_s = scene.run.dt_s;
   options.realtime = args.realtime;
   options.recorder = recorder.get();
@@ -254,6 +342,15 @@ void run(const RunArgs& args) {
     recorder->close();
   }
   std::cout << format_session_summary(summary);
+  if (snapshots) {
+    snapshots->final(world);
+    std::printf(
+        "snapshot     %s (%s, %s%s)\n", args.snapshot_path.c_str(), args.size.c_str(),
+        args.display_mode.c_str(),
+        args.snapshot_every > 0
+            ? (", and " + std::to_string(snapshots->written() - 1) + " numbered ones").c_str()
+            : "");
+  }
 
   bool failed = false;
   nlohmann::json j = summary_json(scene, world, summary, device_name);
@@ -328,6 +425,21 @@ void add_run_command(CLI::App& app) {
                 "permitted), stall watchdog; the summary adds rate, period jitter and missed "
                 "deadlines");
   cmd->add_flag("-q,--quiet", args->quiet, "No progress lines");
+  cmd->add_option("--snapshot", args->snapshot_path,
+                  "Write a picture of the final state to FILE.png (offscreen: no display needed)");
+  cmd->add_option("--snapshot-every", args->snapshot_every,
+                  "Also write FILE_NNNNNN.png every N cycles (not with --realtime)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--display-mode", args->display_mode, "Snapshot display mode")
+      ->check(CLI::IsMember({"points", "lines", "faces"}));
+  cmd->add_option("--colours", args->colours,
+                  "Snapshot colouring: tissue (by material), segments, or groups (knee method's "
+                  "vertex groups)")
+      ->check(CLI::IsMember({"tissue", "segments", "groups"}));
+  cmd->add_option("--size", args->size, "Snapshot size WIDTHxHEIGHT (default 1280x720)");
+  cmd->add_option("--sphere-tree-level", args->sphere_tree_level,
+                  "Draw the sphere tree's spheres at this level in the snapshot (root = 0)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([args] { run(*args); });
 }
 

@@ -260,6 +260,9 @@ SessionSummary run_inline(World& world, Device& device, const SessionOptions& op
         accountant.note_deflection(world.flat_segment(b, s), world.current_deflection_m(b, s));
       }
     }
+    if (options.after_cycle) {
+      options.after_cycle(i);
+    }
     if ((i + 1) % progress_every == 0 || i + 1 == steps) {
       report_progress(options.progress, "run",
                       static_cast<double>(i + 1) / static_cast<double>(steps));

@@ -12,6 +12,7 @@
 #include "hapsim/world/world.h"
 
 #include <cstddef>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +35,9 @@ struct SessionOptions {
   /// Receives every cycle (input, command after safety, contacts). Not owned; may be null.
   SessionRecorder* recorder = nullptr;
   ProgressFn progress;
+  /// Inline runs only: called after every cycle's bookkeeping with the cycle index (between
+  /// cycles, on the stepping thread: may read the world, e.g. to render a snapshot).
+  std::function<void(std::size_t cycle)> after_cycle;
 };
 
 struct StepTimingUs {

@@ -1,0 +1,91 @@
+#include "hapsim/render/snapshot_writer.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/render/offscreen_context.h"
+#include "hapsim/render/png_image.h"
+#include "hapsim/render/renderer.h"
+
+#include <cstdio>
+#include <filesystem>
+
+namespace hapsim {
+
+SnapshotWriter::SnapshotWriter(int width_px, int height_px, int samples)
+    : width_px_(width_px), height_px_(height_px) {
+  if (width_px < 16 || height_px < 16 || width_px > 8192 || height_px > 8192) {
+    throw Error("snapshot", "size must be between 16x16 and 8192x8192 pixels, got " +
+                                std::to_string(width_px) + "x" + std::to_string(height_px));
+  }
+  context_ = std::make_unique<OffscreenContext>(width_px, height_px, samples);
+  renderer_ = std::make_unique<Renderer>();
+}
+
+SnapshotWriter::~SnapshotWriter() {
+  if (context_) {
+    context_->make_current();  // the renderer frees its GL objects in its own context
+  }
+  renderer_.reset();
+  context_.reset();
+}
+
+const std::vector<std::uint8_t>& SnapshotWriter::render(const RenderScene& scene,
+                                                        const OrbitCamera& camera) {
+  context_->make_current();
+  renderer_->draw(scene, camera, width_px_, height_px_);
+  context_->read_rgba(rgba_);
+  return rgba_;
+}
+
+void SnapshotWriter::write_png(const RenderScene& scene, const OrbitCamera& camera,
+                               const std::string& path) {
+  hapsim::write_png(path, width_px_, height_px_, render(scene, camera));
+}
+
+std::string SnapshotWriter::renderer_name() const {
+  return context_->renderer_name();
+}
+
+OrbitCamera framed_camera(const Box3& bounds_W, double aspect, double yaw_rad, double pitch_rad,
+                          double margin) {
+  OrbitCamera camera;
+  camera.yaw_rad = yaw_rad;
+  camera.pitch_rad = pitch_rad;
+  if (!bounds_W.isEmpty()) {
+    camera.frame(bounds_W, aspect, margin);
+  }
+  return camera;
+}
+
+std::string numbered_path(const std::string& path, std::uint64_t index) {
+  const std::filesystem::path p(path);
+  char suffix[32];
+  std::snprintf(suffix, sizeof suffix, "_%06llu", static_cast<unsigned long long>(index));
+  return (p.parent_path() / (p.stem().string() + suffix + p.extension().string())).string();
+}
+
+DisplayMode parse_display_mode(const std::string& name) {
+  if (name == "points") {
+    return DisplayMode::kPoints;
+  }
+  if (name == "lines") {
+    return DisplayMode::kLines;
+  }
+  if (name == "faces") {
+    return DisplayMode::kFaces;
+  }
+  throw Error("display mode", "expected points, lines or faces, got '" + name + "'");
+}
+
+const char* to_string(DisplayMode mode) {
+  switch (mode) {
+    case DisplayMode::kPoints:
+      return "points";
+    case DisplayMode::kLines:
+      return "lines";
+    case DisplayMode::kFaces:
+      return "faces";
+  }
+  return "faces";
+}
+
+}  // namespace hapsim
