@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   add_info_command(app);
   add_query_command(app);
   add_run_command(app);
+  add_view_command(app);
   add_kinematics_commands(app);
 #ifdef HAPSIM_WITH_BENCH
   add_bench_command(app);

@@ -8,9 +8,7 @@
 #include "commands.h"
 
 #include "hapsim/core/stopwatch.h"
-#include "hapsim/device/pick_and_place_trajectory.h"
-#include "hapsim/kinematics/procedural_motoman.h"
-#include "hapsim/kinematics/urdf_chain.h"
+#include "hapsim/scene/teleop_setup.h"
 #include "hapsim/world/teleop_world.h"
 
 #include <nlohmann/json.hpp>
@@ -19,37 +17,10 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <memory>
 #include <vector>
 
 namespace hapsim::app {
 namespace {
-
-TeleopWorldDescription world_description(const SceneDescription& scene) {
-  const TeleopSceneDescription& t = scene.teleop;
-  TeleopWorldDescription d;
-  if (t.slave_urdf.empty()) {
-    d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
-  } else {
-    UrdfChainOptions o;
-    o.tip_link = t.slave_tip;
-    o.load_collision_meshes = false;  // the run needs the kinematics; meshes are for display
-    d.slave = std::make_shared<const SerialChain>(load_urdf_chain(t.slave_urdf, o));
-  }
-  d.mapping.scale = t.scale;
-  d.mapping.X_slave_master = Iso3(Eigen::Translation3d(t.offset_m));
-  d.gripper.max_force_n = t.gripper_max_force_n;
-  d.follower.gripper_max_width_m = t.gripper_max_width_m;
-  d.follower.gripper_speed_m_per_s = t.gripper_speed_m_per_s;
-  d.ball.mass_kg = t.ball_mass_kg;
-  d.ball.radius_m = t.ball_radius_m;
-  d.ball_start_world = t.ball_start_m;
-  d.sheet.nodes_per_side = t.sheet_nodes_per_side;
-  d.sheet.side_m = t.sheet_size_m;
-  d.environment.X_world_sheet = Iso3(Eigen::Translation3d(t.sheet_position_m));
-  d.environment.floor_z_m = t.floor_z_m;
-  return d;
-}
 
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) {
@@ -66,52 +37,15 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
   if (std::isfinite(options.duration_s) && !(options.duration_s > 0.0)) {
     throw CommandError("--duration: expected a positive number of seconds");
   }
-  TeleopWorldDescription d = world_description(scene);
-  const MasterArm master(d.master);
-  Trajectory trajectory;
-  bool has_target = false;
-  Vec3 target = Vec3::Zero();
-  std::string device_name;
-  if (options.trajectory || !scene.device.has_pick_and_place) {
-    const std::filesystem::path file =
-        options.trajectory ? *options.trajectory : scene.device.trajectory_file;
-    trajectory = load_trajectory_csv(file);
-    if (trajectory.joint_count < 3 || trajectory.finger_count < 2) {
-      throw CommandError(file.string() +
-                         ": a master trajectory needs joint columns j0..j2 (base, shoulder, "
-                         "elbow) and finger columns f0, f1");
-    }
-    device_name = "simulated master (trajectory " + file.string() + ")";
-  } else {
-    PickAndPlaceScript script;
-    script.pick_world = d.ball_start_world;
-    script.place_world = scene.device.pick_and_place.place_m;
-    script.clearance_m = scene.device.pick_and_place.clearance_m;
-    script.carry_s = scene.device.pick_and_place.carry_s;
-    script.pad_depth_m = d.gripper.pad_depth_m;
-    script.open_width_m = 0.9 * d.follower.gripper_max_width_m;
-    trajectory = make_pick_and_place_plan(script, master, d.mapping, d.follower.gripper_max_width_m)
-                     .trajectory;
-    has_target = true;
-    target = script.place_world;
-    device_name = "simulated master (scripted pick-and-place)";
-  }
-
-  // The slave starts where the master's first pose asks it to be (one cold IK, before the run).
-  const DeviceInput first = trajectory.sample_at(trajectory.start_time_s());
-  const Iso3 start = slave_target(
-      d.mapping,
-      master.hand_pose({first.joint_rad[0], first.joint_rad[1], first.joint_rad[2]}).translation(),
-      first.joint_rad[0]);
-  const std::vector<double> seed(static_cast<std::size_t>(d.slave->dof()), 0.0);
-  d.slave_start_rad.assign(seed.size(), 0.0);
-  if (!solve_ik(*d.slave, start, seed, d.slave_start_rad).reached) {
-    throw CommandError(scene.file.string() +
-                       ": the master's first pose puts the slave's target out of its reach");
-  }
-  const std::string slave_name =
-      scene.teleop.slave_urdf.empty() ? "procedural Motoman" : scene.teleop.slave_urdf.string();
-  TeleopWorld world(std::move(d));
+  // The world, the master's input and the slave's start (scene/teleop_setup.h); errors there
+  // are hapsim::Error naming the file, printed as one line like a CommandError.
+  TeleopSetup setup = make_teleop_setup(scene, options.trajectory, /*load_link_meshes=*/false);
+  const Trajectory& trajectory = setup.trajectory;
+  const bool has_target = setup.has_target;
+  const Vec3 target = setup.target_world;
+  const std::string& device_name = setup.device_name;
+  const std::string& slave_name = setup.slave_name;
+  TeleopWorld world(std::move(setup.description));
   std::printf(
       "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
       "sheet %dx%d\n",

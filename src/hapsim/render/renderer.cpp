@@ -406,14 +406,23 @@ std::string Renderer::gl_version() const {
 
 void Renderer::draw(const RenderScene& scene, const OrbitCamera& camera, int width_px,
                     int height_px) {
+  draw_in(scene, camera, 0, 0, width_px, height_px);
+}
+
+void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int x_px, int y_px,
+                       int width_px, int height_px) {
   Impl& s = *impl_;
   const RenderStyle& style = scene.style;
   width_px = std::max(width_px, 1);
   height_px = std::max(height_px, 1);
-  glViewport(0, 0, width_px, height_px);
+  glViewport(x_px, y_px, width_px, height_px);
+  // Clear only this viewport: a window may draw panels around it.
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(x_px, y_px, width_px, height_px);
   glClearColor(style.background.x(), style.background.y(), style.background.z(), 1.0f);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glDisable(GL_SCISSOR_TEST);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);  // open sheets and cut meshes are seen from both sides

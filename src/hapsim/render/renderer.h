@@ -28,6 +28,10 @@ class Renderer {
   /// their stamps change; otherwise per-frame work reuses buffers (no allocation once warm).
   /// One Renderer is meant to draw one scene (GPU copies are kept per mesh id).
   void draw(const RenderScene& scene, const OrbitCamera& camera, int width_px, int height_px);
+  /// The same into the viewport whose lower-left corner is (x_px, y_px) in GL window
+  /// coordinates (y up); only that rectangle is cleared (a window draws panels around it).
+  void draw_in(const RenderScene& scene, const OrbitCamera& camera, int x_px, int y_px,
+               int width_px, int height_px);
 
   /// "4.5 (Core Profile) Mesa 22.3.6" etc., for logs.
   [[nodiscard]] std::string gl_version() const;

@@ -52,6 +52,13 @@ const DeviceCommand& WorldHapticClient::step(const DeviceInput& input, double dt
       ++seg.changes;
     }
   }
+  while (const MaterialChange* change = material_changes_.front()) {
+    if (!world_.set_material_contact(change->material, change->contact)) {
+      refused_material_changes_.store(refused_material_changes_.load(std::memory_order_relaxed) + 1,
+                                      std::memory_order_relaxed);
+    }
+    material_changes_.pop();
+  }
   stepped_ = false;
   if (paused_.load(std::memory_order_relaxed)) {
     last_result_ = &world_.last_result();

@@ -6,10 +6,10 @@
 // All buffers are sized at construction: after_cycle() allocates nothing (haptic path).
 #pragma once
 
-#include "hapsim/runtime/cycle_record.h"
-#include "hapsim/runtime/haptic_loop.h"
 #include "hapsim/core/spsc_ring.h"
 #include "hapsim/core/triple_buffer.h"
+#include "hapsim/runtime/cycle_record.h"
+#include "hapsim/runtime/haptic_loop.h"
 #include "hapsim/runtime/world_snapshot.h"
 
 #include <array>
@@ -53,6 +53,15 @@ class WorldHapticClient final : public HapticClient {
   [[nodiscard]] bool paused() const { return paused_.load(std::memory_order_relaxed); }
   /// Any thread: the haptic thread resets the world at its next cycle.
   void request_reset() { reset_requested_.store(true, std::memory_order_release); }
+  /// One other thread (the viewer): new contact parameters for a material, applied by the haptic
+  /// thread before its next step (World::set_material_contact). False when the queue is full.
+  bool request_material(std::uint32_t material, const ContactMaterial& contact) {
+    return material_changes_.push({material, contact});
+  }
+  /// Material changes the world refused (bad values), counted on the haptic thread.
+  [[nodiscard]] std::uint64_t refused_material_changes() const {
+    return refused_material_changes_.load(std::memory_order_relaxed);
+  }
 
  private:
   struct DeformableSegment {
@@ -77,6 +86,12 @@ class WorldHapticClient final : public HapticClient {
   std::vector<DeformableSegment> deformable_;
   std::vector<double> max_deflection_m_;
   std::atomic<std::uint64_t> dropped_records_{0};
+  struct MaterialChange {
+    std::uint32_t material = 0;
+    ContactMaterial contact;
+  };
+  SpscRing<MaterialChange> material_changes_{64};
+  std::atomic<std::uint64_t> refused_material_changes_{0};
   std::atomic<bool> paused_{false};
   std::atomic<bool> reset_requested_{false};
 };

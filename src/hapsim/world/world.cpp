@@ -274,6 +274,20 @@ ContactMaterial World::effective_material(std::uint32_t material, double dt_s) c
   return m;
 }
 
+bool World::set_material_contact(std::uint32_t material, const ContactMaterial& c) noexcept {
+  const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
+  const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
+  if (material >= description_.materials.size() || !positive(c.stiffness_n_per_m) ||
+      !positive(c.max_penetration_m) || !positive(c.max_force_n) ||
+      !non_negative(c.damping_n_s_per_m) || !non_negative(c.static_friction) ||
+      !non_negative(c.dynamic_friction) || c.dynamic_friction > c.static_friction) {
+    return false;
+  }
+  description_.materials[material].contact = c;
+  materials_dt_s_ = -1.0;  // the next step recomputes the effective materials
+  return true;
+}
+
 void World::update_materials(double dt_s) {
   if (dt_s == materials_dt_s_) {
     return;

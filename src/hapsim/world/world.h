@@ -86,6 +86,11 @@ class World {
   const StepResult& step(const DeviceInput& input, double dt_s);
   /// Back to rest: tools re-placed at the next input, deformation cleared.
   void reset();
+  /// haptic path. New contact parameters for material `material` from the next step on (a user
+  /// tuning stiffness and limits live). Only on the thread that steps. Returns false, changing
+  /// nothing, for a bad index or values a step cannot use (non-finite, stiffness, limits ≤ 0,
+  /// negative damping or friction, dynamic above static friction).
+  bool set_material_contact(std::uint32_t material, const ContactMaterial& contact) noexcept;
 
   [[nodiscard]] const WorldDescription& description() const { return description_; }
   [[nodiscard]] const StepResult& last_result() const { return result_; }

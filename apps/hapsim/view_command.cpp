@@ -1,0 +1,93 @@
+// `hapsim view SCENE`: the interactive viewer (src/hapsim/ui/viewer.h) — palpate with the mouse,
+// watch forces and deformation. Needs a display (or xvfb-run); headless machines use
+// `hapsim run SCENE --snapshot FILE.png`.
+#include "commands.h"
+
+#include "hapsim/ui/viewer.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+
+namespace hapsim::app {
+namespace {
+
+struct ViewArgs {
+  std::string scene;
+  std::string data_dir;
+  std::string device = "mouse";
+  std::string method;
+  std::string deformation = "deflection";
+  std::string size = "1280x720";
+  bool no_vsync = false;
+  double duration_s = 0.0;
+  std::string screenshot;
+  std::string first_screenshot;
+  std::string json;
+  bool quiet = false;
+};
+
+void view(const ViewArgs& args) {
+  ViewerOptions o;
+  o.config.scene = args.scene;
+  o.config.data_dir = args.data_dir;
+  o.config.device = args.device;
+  o.config.method = args.method;
+  o.config.deformation = args.deformation;
+  char x = 0;
+  std::istringstream size(args.size);
+  if (!(size >> o.width_px >> x >> o.height_px) || x != 'x' || o.width_px < 320 ||
+      o.height_px < 240) {
+    throw CommandError("--size " + args.size + ": expected WIDTHxHEIGHT, at least 320x240");
+  }
+  o.vsync = !args.no_vsync;
+  o.duration_s = args.duration_s;
+  o.screenshot = args.screenshot;
+  o.first_screenshot = args.first_screenshot;
+  o.json = args.json;
+  o.quiet = args.quiet;
+  // The scene menu offers the scene files beside the one opened.
+  const std::filesystem::path folder = std::filesystem::path(args.scene).parent_path();
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(
+           folder.empty() ? std::filesystem::path(".") : folder, ec)) {
+    if (entry.path().extension() == ".json" &&
+        entry.path().filename().string().find("schema") == std::string::npos) {
+      o.scene_choices.push_back(entry.path());
+    }
+  }
+  std::sort(o.scene_choices.begin(), o.scene_choices.end());
+  exit_status() = run_viewer(o);
+}
+
+}  // namespace
+
+void add_view_command(CLI::App& app) {
+  auto args = std::make_shared<ViewArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "view", "Open the 3D viewer: palpate a scene with the mouse on the real-time haptic loop");
+  cmd->add_option("scene", args->scene, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--data", args->data_dir, "Real-data folder for scenes that use one");
+  cmd->add_option("--device", args->device,
+                  "mouse (the viewer's probe), sim (the scene's script), sim:FILE (a trajectory "
+                  "CSV) or spacemouse (a 3D mouse via spacenavd)");
+  cmd->add_option("--method", args->method, "Override every body's contact method")
+      ->check(CLI::IsMember({"exact", "spheretree", "knee"}));
+  cmd->add_option("--deformation", args->deformation,
+                  "deflection (vertex deflection, eq. 1) or none (every body rigid)")
+      ->check(CLI::IsMember({"deflection", "none"}));
+  cmd->add_option("--size", args->size, "Window size WIDTHxHEIGHT (default 1280x720)");
+  cmd->add_flag("--no-vsync", args->no_vsync, "Draw as fast as possible (to measure fps)");
+  cmd->add_option("--duration", args->duration_s, "Close after S seconds (default: when closed)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--screenshot", args->screenshot, "Write the last frame to FILE.png");
+  cmd->add_option("--first-screenshot", args->first_screenshot,
+                  "Write an early frame (the scene at rest) to FILE.png");
+  cmd->add_option("--json", args->json, "Write fps, haptic loop figures and forces as JSON");
+  cmd->add_flag("-q,--quiet", args->quiet, "No summary lines");
+  cmd->callback([args] { view(*args); });
+}
+
+}  // namespace hapsim::app

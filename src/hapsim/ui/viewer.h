@@ -1,0 +1,46 @@
+// `hapsim view SCENE` (SPEC §9, issue 5): a window with the 3D view (Gouraud shading, lights,
+// point/line/face modes, rotate/pan/zoom, the floor with the tool's 'x' shadow mark), a control
+// area (display, scene, device, contact and deformation method, segments, stiffness and limits,
+// pause/reset, record), a data area (tool and device coordinates in mm, force per finger, haptic
+// rate, step cost, graphics fps) and a force column graph with a scrolling force plot, while the
+// scene runs on the real-time haptic thread.
+//
+// Mouse: left-drag moves the probe in the view plane, the wheel pushes it in or pulls it out;
+// right-drag rotates the view, middle-drag (or shift+right) pans, ctrl+wheel zooms.
+// Keys: 1-5 curl fingers (glove scenes), G closes/opens the grasp, space pauses, R resets,
+// M cycles the display mode, F frames the scene, Esc quits.
+#pragma once
+
+#include "hapsim/ui/viewer_session.h"
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace hapsim {
+
+struct ViewerOptions {
+  ViewerConfig config;
+  int width_px = 1280;
+  int height_px = 720;
+  /// Sync buffer swaps to the display (off: draw as fast as possible, for measuring fps).
+  bool vsync = true;
+  /// Close after this many seconds (0: when the window is closed).
+  double duration_s = 0.0;
+  /// Write the last frame (the whole window) to this PNG when closing.
+  std::filesystem::path screenshot;
+  /// Also write the first complete frame here.
+  std::filesystem::path first_screenshot;
+  /// Write the run's figures (fps, haptic loop, forces) as JSON here.
+  std::filesystem::path json;
+  /// Scene files offered in the scene menu (the viewer adds the one it was started with).
+  std::vector<std::filesystem::path> scene_choices;
+  bool quiet = false;
+};
+
+/// Opens the window and runs until closed or duration_s. Returns the process exit status (0, or 1
+/// when a force above the device rating or a NaN was ever shown). Throws hapsim::Error when no
+/// window can be opened (no display) or the first session cannot be built.
+int run_viewer(const ViewerOptions& options);
+
+}  // namespace hapsim

@@ -1,0 +1,94 @@
+// What the viewer runs and shows (SPEC §9): one scene on the real-time haptic loop with its
+// device, a render scene kept up to date from the loop's snapshots, and the figures of the data
+// area. A knee-type World and a teleoperation world each have one; the viewer rebuilds the
+// session when the user picks another scene, device, contact method or deformation method.
+#pragma once
+
+#include "hapsim/render/render_scene.h"
+#include "hapsim/runtime/haptic_loop.h"
+#include "hapsim/world/device_io.h"
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace hapsim {
+
+class InteractiveDevice;
+
+/// The choices that need a new session (everything else changes live).
+struct ViewerConfig {
+  std::filesystem::path scene;
+  std::filesystem::path data_dir;
+  /// "mouse" (the viewer's probe), "sim" (the scene's own script), "sim:FILE" (a trajectory) or
+  /// "spacemouse" (a 3D mouse through spacenavd).
+  std::string device = "mouse";
+  /// Contact method for every body: "" (the scene's), "exact", "spheretree" or "knee".
+  std::string method;
+  /// Deformation method: "deflection" (vertex deflection, eq. 1, the scene's deformable bodies)
+  /// or "none" (every body rigid).
+  std::string deformation = "deflection";
+
+  bool operator==(const ViewerConfig&) const = default;
+};
+
+struct ToolReadout {
+  std::string name;
+  Vec3 p_world = Vec3::Zero();
+  Vec3 proxy_world = Vec3::Zero();
+  /// Force the device renders for this tool (its finger or its share of the tip force), N.
+  double force_n = 0.0;
+  int contacts = 0;
+};
+
+/// The newest state, for the data area and the force graph.
+struct SessionReadout {
+  double time_s = 0.0;
+  std::uint64_t cycle = 0;
+  std::vector<ToolReadout> tools;
+  /// Extra lines for the data area ("ball (mm)", "grasp force (N)" …).
+  std::vector<std::pair<std::string, std::string>> lines;
+  /// Bars of the force column graph: label and newtons (one per finger, or grasp and tip).
+  std::vector<std::pair<std::string, double>> bars;
+  /// Full scale of the bars: the device's rated force, N.
+  double bar_full_scale_n = 10.0;
+  double max_deflection_m = 0.0;
+  std::size_t contact_count = 0;
+};
+
+class ViewerSession {
+ public:
+  virtual ~ViewerSession() = default;
+
+  /// Takes the newest snapshot from the haptic thread and updates the render scene.
+  virtual void update() = 0;
+  [[nodiscard]] virtual RenderScene& render_scene() = 0;
+  [[nodiscard]] virtual Box3 bounds_W() const = 0;
+  [[nodiscard]] virtual const SessionReadout& readout() const = 0;
+  [[nodiscard]] virtual HapticLoopStatus loop_status() const = 0;
+  /// The probe's device when the config asked for the mouse (null otherwise).
+  [[nodiscard]] virtual InteractiveDevice* mouse_device() = 0;
+  /// Where the probe starts (in front of the scene, as seen from the default camera).
+  [[nodiscard]] virtual Vec3 probe_start_W() const = 0;
+  [[nodiscard]] virtual const std::string& device_name() const = 0;
+  [[nodiscard]] virtual const std::string& title() const = 0;
+
+  virtual void set_paused(bool paused) = 0;
+  virtual void reset() = 0;
+  /// ImGui widgets of what this session can change live (segments, materials, overlays).
+  virtual void draw_controls() = 0;
+  /// Starts writing every haptic cycle to `path` (binary recording), or stops; false with a
+  /// message in `error` when it cannot.
+  virtual bool set_recording(const std::filesystem::path* path, std::string& error) = 0;
+  [[nodiscard]] virtual bool recording() const = 0;
+
+ protected:
+  ViewerSession() = default;
+  ViewerSession(const ViewerSession&) = default;
+  ViewerSession& operator=(const ViewerSession&) = default;
+  ViewerSession(ViewerSession&&) = default;
+  ViewerSession& operator=(ViewerSession&&) = default;
+};
+
+}  // namespace hapsim
