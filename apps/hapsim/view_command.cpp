@@ -22,6 +22,8 @@ struct ViewArgs {
   std::string deformation = "deflection";
   std::string size = "1280x720";
   bool no_vsync = false;
+  bool no_panels = false;
+  int msaa = 0;
   double duration_s = 0.0;
   std::string screenshot;
   std::string first_screenshot;
@@ -43,6 +45,8 @@ void view(const ViewArgs& args) {
     throw CommandError("--size " + args.size + ": expected WIDTHxHEIGHT, at least 320x240");
   }
   o.vsync = !args.no_vsync;
+  o.panels = !args.no_panels;
+  o.msaa_samples = args.msaa;
   o.duration_s = args.duration_s;
   o.screenshot = args.screenshot;
   o.first_screenshot = args.first_screenshot;
@@ -80,6 +84,11 @@ void add_view_command(CLI::App& app) {
       ->check(CLI::IsMember({"deflection", "none"}));
   cmd->add_option("--size", args->size, "Window size WIDTHxHEIGHT (default 1280x720)");
   cmd->add_flag("--no-vsync", args->no_vsync, "Draw as fast as possible (to measure fps)");
+  cmd->add_flag("--no-panels", args->no_panels,
+                "Start with the control and data areas hidden (Tab shows them)");
+  cmd->add_option("--msaa", args->msaa,
+                  "Multisample anti-aliasing samples (default 0: costly on a software rasteriser)")
+      ->check(CLI::Range(0, 16));
   cmd->add_option("--duration", args->duration_s, "Close after S seconds (default: when closed)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--screenshot", args->screenshot, "Write the last frame to FILE.png");

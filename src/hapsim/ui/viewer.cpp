@@ -106,7 +106,8 @@ class Viewer {
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     glfwWindowHint(GLFW_DOUBLEBUFFER, GLFW_TRUE);
-    glfwWindowHint(GLFW_SAMPLES, 4);
+    // Multisampling costs ~2.6x per frame on Mesa's software rasteriser: off unless asked for.
+    glfwWindowHint(GLFW_SAMPLES, std::max(0, options.msaa_samples));
     window_ = glfwCreateWindow(options.width_px, options.height_px, "hapsim", nullptr, nullptr);
     if (window_ == nullptr) {
       glfwTerminate();
@@ -122,6 +123,7 @@ class Viewer {
     ImGui::StyleColorsDark();
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
+    panels_ = options.panels;
     renderer_ = std::make_unique<Renderer>();
     gl_version_ = renderer_->gl_version();
     scene_choices_ = options.scene_choices;
@@ -230,14 +232,17 @@ class Viewer {
     int h = 1;
   };
 
+  [[nodiscard]] float control_width() const { return panels_ ? kControlWidth : 0.0f; }
+  [[nodiscard]] float data_width() const { return panels_ ? kDataWidth : 0.0f; }
+
   Viewport view_rect(int fb_w, int fb_h) const {
     int win_w = 0;
     int win_h = 0;
     glfwGetWindowSize(window_, &win_w, &win_h);
     const double sx = win_w > 0 ? static_cast<double>(fb_w) / win_w : 1.0;
     Viewport v;
-    v.x = static_cast<int>(kControlWidth * sx);
-    v.w = std::max(1, fb_w - v.x - static_cast<int>(kDataWidth * sx));
+    v.x = static_cast<int>(control_width() * sx);
+    v.w = std::max(1, fb_w - v.x - static_cast<int>(data_width() * sx));
     v.y = 0;
     v.h = std::max(1, fb_h);
     return v;
@@ -290,7 +295,7 @@ class Viewer {
     int win_w = 0;
     int win_h = 0;
     glfwGetWindowSize(window_, &win_w, &win_h);
-    const bool in_view = x >= kControlWidth && x <= win_w - kDataWidth;
+    const bool in_view = x >= control_width() && x <= win_w - data_width();
     const bool left = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
     const bool right = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
     const bool middle = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS;
@@ -341,6 +346,10 @@ class Viewer {
             : m == DisplayMode::kLines ? DisplayMode::kPoints
                                        : DisplayMode::kFaces;
       });
+      key_edge(GLFW_KEY_TAB, [this] {
+        panels_ = !panels_;
+        frame_view();
+      });
       key_edge(GLFW_KEY_ESCAPE, [this] { glfwSetWindowShouldClose(window_, GLFW_TRUE); });
     }
     if (InteractiveDevice* mouse = session_->mouse_device()) {
@@ -370,6 +379,11 @@ class Viewer {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
+    if (!panels_) {
+      ImGui::Render();
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      return;
+    }
     int win_w = 0;
     int win_h = 0;
     glfwGetWindowSize(window_, &win_w, &win_h);
@@ -478,7 +492,8 @@ class Viewer {
       ImGui::TextWrapped(
           "Left-drag: move the probe in the view plane. Wheel: push it in / pull it out. "
           "Right-drag: rotate. Middle-drag or shift+right-drag: pan. Ctrl+wheel: zoom. "
-          "1-5: curl fingers. G: grasp. Space: pause. R: reset. M: display mode. Esc: quit.");
+          "1-5: curl fingers. G: grasp. Space: pause. R: reset. M: display mode. F: frame. "
+          "Tab: hide/show panels. Esc: quit.");
     }
   }
 
@@ -585,6 +600,8 @@ class Viewer {
       j["fps"] = fps;
       j["frame_ms"] = {{"p50", frame_p50}, {"p99", frame_p99}};
       j["window"] = {options_.width_px, options_.height_px};
+      j["msaa_samples"] = options_.msaa_samples;
+      j["panels"] = panels_;
       j["haptic"] = {{"rate_hz", st.rate_hz},
                      {"cycles", st.cycles},
                      {"scheduling", st.realtime_priority ? "SCHED_FIFO" : "normal"},
@@ -629,6 +646,7 @@ class Viewer {
   bool was_pressed_ = false;
   bool drag_in_view_ = false;
   bool paused_ = false;
+  bool panels_ = true;
   bool screenshot_requested_ = false;
   std::array<bool, 512> key_down_{};
   double peak_deflection_m_ = 0.0;

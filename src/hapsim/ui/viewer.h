@@ -8,7 +8,7 @@
 // Mouse: left-drag moves the probe in the view plane, the wheel pushes it in or pulls it out;
 // right-drag rotates the view, middle-drag (or shift+right) pans, ctrl+wheel zooms.
 // Keys: 1-5 curl fingers (glove scenes), G closes/opens the grasp, space pauses, R resets,
-// M cycles the display mode, F frames the scene, Esc quits.
+// M cycles the display mode, F frames the scene, Tab hides the panels, Esc quits.
 #pragma once
 
 #include "hapsim/ui/viewer_session.h"
@@ -25,6 +25,10 @@ struct ViewerOptions {
   int height_px = 720;
   /// Sync buffer swaps to the display (off: draw as fast as possible, for measuring fps).
   bool vsync = true;
+  /// Multisampling (GLFW_SAMPLES): 0 on a software rasteriser, 4 on a GPU.
+  int msaa_samples = 0;
+  /// Show the control and data areas (Tab toggles them): off gives the 3D view the window.
+  bool panels = true;
   /// Close after this many seconds (0: when the window is closed).
   double duration_s = 0.0;
   /// Write the last frame (the whole window) to this PNG when closing.
