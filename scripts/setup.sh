@@ -16,6 +16,8 @@ HAPSIM_PACKAGES=(
   # viewer and headless rendering: GLFW + OpenGL + Dear ImGui, EGL surfaceless on Mesa's software
   # rasterizer, stb for PNG, libspnav for a 3D mouse; Xvfb + xauth for the viewer's smoke test
   libglfw3-dev libgl-dev libegl-dev libgl1-mesa-dri libimgui-dev libstb-dev libspnav-dev xvfb xauth
+  # the viewer smoke test moves the real X pointer with xdotool
+  xdotool
   # tests and benchmarks; CGAL, FCL, Embree and orocos-kdl are reference oracles only
   libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev
 )

@@ -1,0 +1,100 @@
+// `hapsim view` for real: under Xvfb, the real X pointer (xdotool) drives the mouse probe into
+// the knee; the viewer's own frame read-back must show the deformation (the 3D view changed
+// where the probe pressed) and a non-zero force bar, and its JSON the force and the dent.
+// Skips with a message where Xvfb or xdotool is missing. Also: no display is a clear error.
+#include "hapsim_process.h"
+
+#include "hapsim/render/image_compare.h"
+#include "hapsim/render/png_image.h"
+#include "hapsim/ui/force_graph.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <fstream>
+
+namespace hapsim {
+namespace {
+
+bool have(const char* tool) {
+  return std::system((std::string("command -v ") + tool + " > /dev/null 2>&1").c_str()) == 0;
+}
+
+// Pixels of the force bar's colour inside a rectangle of an RGBA image.
+int count_colour(const RgbaImage& image, std::array<unsigned char, 4> rgba, int x0, int y0, int x1,
+                 int y1) {
+  int n = 0;
+  for (int y = std::max(0, y0); y < std::min(image.height, y1); ++y) {
+    for (int x = std::max(0, x0); x < std::min(image.width, x1); ++x) {
+      const std::uint8_t* p = &image.rgba[(static_cast<std::size_t>(y) * image.width + x) * 4];
+      n += std::abs(p[0] - rgba[0]) <= 2 && std::abs(p[1] - rgba[1]) <= 2 &&
+                   std::abs(p[2] - rgba[2]) <= 2
+               ? 1
+               : 0;
+    }
+  }
+  return n;
+}
+
+TEST(ViewCommand, MouseProbeUnderXvfbDentsTheKneeAndShowsTheForce) {
+  if (!have("xvfb-run") || !have("xdotool")) {
+    GTEST_SKIP() << "xvfb-run or xdotool missing (scripts/setup.sh installs both)";
+  }
+  const auto out = test::temp_path("viewer");
+  const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' bash ") +
+                          HAPSIM_SOURCE_DIR + "/tests/apps/viewer_smoke.sh " + HAPSIM_BIN_PATH +
+                          " " + HAPSIM_SCENES_DIR + "/knee.json " + out.string();
+  const int status = std::system(cmd.c_str());
+  std::ifstream log(out / "view.log");
+  const std::string log_text((std::istreambuf_iterator<char>(log)), {});
+  ASSERT_EQ(status, 0) << log_text;
+  std::ifstream in(out / "view.json");
+  ASSERT_TRUE(in) << log_text;
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j["ok"].get<bool>());
+  EXPECT_GT(j["frames"].get<int>(), 20);
+  EXPECT_GT(j["peak_force_n"][0].get<double>(), 0.1) << "the probe never pressed: " << log_text;
+  EXPECT_GT(j["max_deflection_m"].get<double>(), 0.001);
+  EXPECT_GT(j["haptic"]["cycles"].get<long>(), 5000);
+
+  const RgbaImage first = read_png((out / "first.png").string());
+  const RgbaImage last = read_png((out / "last.png").string());
+  ASSERT_EQ(first.width, 1280);
+  ASSERT_EQ(last.height, 720);
+  // The force bar (its own colour) stands in the force panel at the bottom right.
+  EXPECT_GT(count_colour(last, ForceGraph::kBarColour, 940, 360, 1280, 720), 50);
+  EXPECT_EQ(count_colour(first, ForceGraph::kBarColour, 940, 360, 1280, 720), 0);
+  // The 3D view (between the panels) changed: the probe moved in and the skin dented.
+  const auto crop = [](const RgbaImage& im) {
+    std::vector<std::uint8_t> c;
+    for (int y = 0; y < im.height; ++y) {
+      const auto* row = &im.rgba[(static_cast<std::size_t>(y) * im.width + 320) * 4];
+      c.insert(c.end(), row, row + 4 * 600);
+    }
+    return c;
+  };
+  const ImageDiff d = compare_images(crop(first), crop(last), 600, 720);
+  EXPECT_GT(d.differing_fraction, 0.002) << d.describe();
+}
+
+TEST(ViewCommand, NoDisplayIsAClearError) {
+  const std::string cmd = std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + HAPSIM_BIN_PATH +
+                          " view " + HAPSIM_SCENES_DIR + "/knee.json > " +
+                          test::temp_path("nodisplay.txt").string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(test::temp_path("nodisplay.txt"));
+  const std::string output((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << output;
+  EXPECT_NE(output.find("no display"), std::string::npos) << output;
+  EXPECT_NE(output.find("--snapshot"), std::string::npos) << output;
+}
+
+TEST(ViewCommand, BadScenePathIsNamed) {
+  const auto r = test::run_hapsim("view /nonexistent/scene.json");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("/nonexistent/scene.json"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace hapsim
