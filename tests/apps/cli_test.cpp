@@ -81,7 +81,7 @@ TEST(Cli, QueryAnswersMatchTheBoxAnalytically) {
   for (const std::string method : {"exact", "spheretree"}) {
     const auto pts =
         temp_file("box_points.csv", "x,y,z\n0,0,0\n0.08,0,0\n0.06,0.04,0\n0.0,0.0,0.019\n");
-    const auto out = std::filesystem::temp_directory_path() / "hapsim_cli_test" / "box_out.csv";
+    const auto out = hapsim::test::temp_path("box_out.csv");
     const RunResult r = run_hapsim("query builtin:box --method " + method + " --points " +
                                    pts.string() + " --out " + out.string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -103,7 +103,7 @@ TEST(Cli, QueryAnswersMatchTheBoxAnalytically) {
 TEST(Cli, ScaleConvertsUnitsBothWays) {
   // Same box read as millimetres: points and answers stay in mesh units.
   const auto pts = temp_file("box_points_mm.csv", "80,0,0\n");
-  const auto out = std::filesystem::temp_directory_path() / "hapsim_cli_test" / "box_mm.csv";
+  const auto out = hapsim::test::temp_path("box_mm.csv");
   const RunResult r =
       run_hapsim("query builtin:box --scale 1 --points " + pts.string() + " --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -113,7 +113,7 @@ TEST(Cli, ScaleConvertsUnitsBothWays) {
 }
 
 TEST(Cli, InfoWritesJson) {
-  const auto json = std::filesystem::temp_directory_path() / "hapsim_cli_test" / "info.json";
+  const auto json = hapsim::test::temp_path("info.json");
   const RunResult r = run_hapsim("info builtin:box --json " + json.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(json);
@@ -145,7 +145,7 @@ TEST(Cli, InfoAndQueryReadMeshFilesInMillimetres) {
   EXPECT_NE(text.find("\"validation\""), std::string::npos) << text;
 
   const auto points = temp_file("cube_points.csv", "x,y,z\n0,0,0\n0,0,25\n");
-  const auto out = std::filesystem::temp_directory_path() / "hapsim_cli_test" / "cube_out.csv";
+  const auto out = hapsim::test::temp_path("cube_out.csv");
   const RunResult q = run_hapsim("query " + obj.string() + " --scale 0.001 --points " +
                                  points.string() + " --method exact --out " + out.string());
   ASSERT_EQ(q.exit_code, 0) << q.output;

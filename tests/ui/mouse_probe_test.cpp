@@ -90,7 +90,7 @@ TEST(MouseProbe, FingerKeysCurlAndReleaseAtTheirRate) {
   EXPECT_NEAR(probe.finger_rad()[1], 1.4, 1e-12);  // capped
   const DeviceInput in = probe.input();
   EXPECT_EQ(in.joint_count, 3 * kMaxFingers);
-  EXPECT_NEAR(in.joint_rad[3 * 1 + 2], 1.4, 1e-12);  // PIP
+  EXPECT_NEAR(in.joint_rad[3 * 1 + 2], 1.4, 1e-12);        // PIP
   EXPECT_NEAR(in.joint_rad[3 * 1 + 1], 0.6 * 1.4, 1e-12);  // MCP flexion
   held[1] = false;
   for (int i = 0; i < 5; ++i) {

@@ -63,6 +63,8 @@ const TeleopStepResult& TeleopWorld::step(const DeviceInput& master, double dt_s
   // 1. Master → slave target; the slave follows (or holds still on a bad input).
   double width_command = slave_->gripper_width_m();
   if (usable) {
+    result_.master_arm_rad = arm;
+    result_.master_finger_rad = fingers;
     result_.master_hand = master_.hand_pose(arm);
     const Iso3 target =
         slave_target(description_.mapping, result_.master_hand.translation(), arm[0]);

@@ -17,6 +17,7 @@
 #include "hapsim/kinematics/slave_follower.h"
 #include "hapsim/world/device_io.h"
 
+#include <array>
 #include <memory>
 
 namespace hapsim {
@@ -42,6 +43,10 @@ struct TeleopStepResult {
   double time_s = 0.0;
   /// What the master's motors get (arm joint torques, finger torques as joints 3 and 4).
   DeviceCommand command;
+  /// The master's arm joints (base, shoulder, elbow) and fingers, radians, and its hand pose in
+  /// its base frame: from the last usable input (held through an unusable one).
+  std::array<double, 3> master_arm_rad{};
+  std::array<double, 2> master_finger_rad{};
   Iso3 master_hand = Iso3::Identity();
   Iso3 slave_tool = Iso3::Identity();
   SlaveStep slave;
@@ -67,6 +72,8 @@ class TeleopWorld {
   [[nodiscard]] const RigidBall& ball() const { return ball_; }
   [[nodiscard]] const VirtualSheet& sheet() const { return *sheet_; }
   [[nodiscard]] const ParallelGripper& gripper() const { return gripper_; }
+  /// What the last step() returned (default values before the first step).
+  [[nodiscard]] const TeleopStepResult& last_result() const { return result_; }
 
   /// The slave gripper opening for a master grip opening: the master's range mapped linearly
   /// onto the slave's.

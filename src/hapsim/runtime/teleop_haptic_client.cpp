@@ -1,0 +1,38 @@
+#include "hapsim/runtime/teleop_haptic_client.h"
+
+namespace hapsim {
+
+TeleopHapticClient::TeleopHapticClient(TeleopWorld& world, TeleopHapticClientOptions options)
+    : world_(world), options_(options) {
+  if (options_.publish_snapshots) {
+    snapshots_ = std::make_unique<TripleBuffer<TeleopSnapshot>>(make_teleop_snapshot(world_));
+  }
+}
+
+// haptic path
+const DeviceCommand& TeleopHapticClient::step(const DeviceInput& input, double dt_s) {
+  if (paused_.load(std::memory_order_relaxed)) {
+    return zero_command_;
+  }
+  const DeviceCommand& command = world_.step(input, dt_s).command;
+  steps_.store(steps_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+  return command;
+}
+
+// haptic path
+void TeleopHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
+  if (!snapshots_) {
+    return;
+  }
+  TeleopSnapshot& s = snapshots_->write_slot();
+  s.cycle = cycle.index;
+  s.time_s = cycle.time_s;
+  if (cycle.input != nullptr) {
+    s.input = *cycle.input;
+  }
+  s.output = cycle.output != nullptr ? *cycle.output : zero_command_;
+  fill_teleop_snapshot(s, world_);
+  snapshots_->publish();
+}
+
+}  // namespace hapsim

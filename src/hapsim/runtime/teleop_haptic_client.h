@@ -1,0 +1,52 @@
+// The haptic loop's client for a TeleopWorld (000 on the real-time loop): each cycle steps the
+// world with the master's input and returns the torques for the master's motors, then publishes
+// the newest TeleopSnapshot for the viewer through a triple buffer. Every buffer is sized at
+// construction: after_cycle() allocates nothing (haptic path).
+#pragma once
+
+#include "hapsim/core/triple_buffer.h"
+#include "hapsim/runtime/haptic_loop.h"
+#include "hapsim/runtime/teleop_snapshot.h"
+
+#include <atomic>
+#include <memory>
+
+namespace hapsim {
+
+struct TeleopHapticClientOptions {
+  /// Publish a viewer snapshot every cycle (true) or not at all (a headless run).
+  bool publish_snapshots = true;
+};
+
+class TeleopHapticClient final : public HapticClient {
+ public:
+  /// `world` must outlive the client; its description gives every size.
+  explicit TeleopHapticClient(TeleopWorld& world, TeleopHapticClientOptions options = {});
+
+  /// world.step(input, dt).command, or zero while paused. haptic path
+  const DeviceCommand& step(const DeviceInput& input, double dt_s) override;
+  /// Publishes the snapshot: the cycle's input, the command after safety, the world's state.
+  /// haptic path
+  void after_cycle(const HapticCycle& cycle) noexcept override;
+
+  /// Reader side of the snapshots (one reader thread), null when not publishing.
+  [[nodiscard]] TripleBuffer<TeleopSnapshot>* snapshots() { return snapshots_.get(); }
+
+  /// Any thread: stop stepping the world (the slave and the ball freeze, zero torque) or go on.
+  /// (TeleopWorld has no reset yet, so there is no request_reset() here.)
+  void set_paused(bool paused) { paused_.store(paused, std::memory_order_relaxed); }
+  [[nodiscard]] bool paused() const { return paused_.load(std::memory_order_relaxed); }
+
+  /// Cycles that stepped the world (read from any thread).
+  [[nodiscard]] std::uint64_t steps() const { return steps_.load(std::memory_order_relaxed); }
+
+ private:
+  TeleopWorld& world_;
+  TeleopHapticClientOptions options_;
+  DeviceCommand zero_command_;
+  std::unique_ptr<TripleBuffer<TeleopSnapshot>> snapshots_;
+  std::atomic<bool> paused_{false};
+  std::atomic<std::uint64_t> steps_{0};
+};
+
+}  // namespace hapsim

@@ -1,0 +1,37 @@
+#include "hapsim/runtime/teleop_snapshot.h"
+
+#include <algorithm>
+
+namespace hapsim {
+
+TeleopSnapshot make_teleop_snapshot(const TeleopWorld& world) {
+  TeleopSnapshot s;
+  s.slave_q.assign(world.slave().q().size(), 0.0);
+  s.sheet_heights_m.assign(world.sheet().surface_heights().size(), 0.0);
+  s.time_s = world.last_result().time_s;
+  fill_teleop_snapshot(s, world);
+  return s;
+}
+
+// haptic path
+void fill_teleop_snapshot(TeleopSnapshot& s, const TeleopWorld& world) noexcept {
+  const TeleopStepResult& r = world.last_result();
+  const bool stepped = r.time_s > 0.0;
+  const auto q = world.slave().q();
+  std::copy_n(q.begin(), std::min(q.size(), s.slave_q.size()), s.slave_q.begin());
+  s.X_world_tool = world.slave().tip_pose();
+  // Before the first step the gripper report is empty: the pads are where the slave holds them.
+  s.gripper_width_m = stepped ? r.gripper.width_m : world.slave().gripper_width_m();
+  s.pad_force_n = r.gripper.pad_force_n;
+  s.grasp_force_n = r.gripper.grasp_force_n();
+  s.held = r.held;
+  s.ball_p_world = world.ball().p_world();
+  const auto h = world.sheet().surface_heights();
+  std::copy_n(h.begin(), std::min(h.size(), s.sheet_heights_m.size()), s.sheet_heights_m.begin());
+  s.sheet_depth_m = world.sheet().max_depth_m();
+  s.master_joint_rad = r.master_arm_rad;
+  s.master_finger_rad = r.master_finger_rad;
+  s.X_master_hand = world.master().hand_pose(r.master_arm_rad);
+}
+
+}  // namespace hapsim

@@ -1,0 +1,94 @@
+#include "hapsim/scene/teleop_setup.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/device/pick_and_place_trajectory.h"
+#include "hapsim/kinematics/inverse_kinematics.h"
+#include "hapsim/kinematics/procedural_motoman.h"
+#include "hapsim/kinematics/urdf_chain.h"
+
+#include <memory>
+#include <utility>
+#include <vector>
+
+namespace hapsim {
+
+namespace {
+
+TeleopWorldDescription world_description(const SceneDescription& scene, bool load_link_meshes) {
+  const TeleopSceneDescription& t = scene.teleop;
+  TeleopWorldDescription d;
+  if (t.slave_urdf.empty()) {
+    d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
+  } else {
+    UrdfChainOptions o;
+    o.tip_link = t.slave_tip;
+    o.load_collision_meshes = load_link_meshes;
+    d.slave = std::make_shared<const SerialChain>(load_urdf_chain(t.slave_urdf, o));
+  }
+  d.mapping.scale = t.scale;
+  d.mapping.X_slave_master = Iso3(Eigen::Translation3d(t.offset_m));
+  d.gripper.max_force_n = t.gripper_max_force_n;
+  d.follower.gripper_max_width_m = t.gripper_max_width_m;
+  d.follower.gripper_speed_m_per_s = t.gripper_speed_m_per_s;
+  d.ball.mass_kg = t.ball_mass_kg;
+  d.ball.radius_m = t.ball_radius_m;
+  d.ball_start_world = t.ball_start_m;
+  d.sheet.nodes_per_side = t.sheet_nodes_per_side;
+  d.sheet.side_m = t.sheet_size_m;
+  d.environment.X_world_sheet = Iso3(Eigen::Translation3d(t.sheet_position_m));
+  d.environment.floor_z_m = t.floor_z_m;
+  return d;
+}
+
+}  // namespace
+
+TeleopSetup make_teleop_setup(const SceneDescription& scene,
+                              const std::optional<std::filesystem::path>& trajectory,
+                              bool load_link_meshes) {
+  TeleopSetup s;
+  s.description = world_description(scene, load_link_meshes);
+  TeleopWorldDescription& d = s.description;
+  const MasterArm master(d.master);
+  if (trajectory || !scene.device.has_pick_and_place) {
+    const std::filesystem::path file = trajectory ? *trajectory : scene.device.trajectory_file;
+    s.trajectory = load_trajectory_csv(file);
+    if (s.trajectory.joint_count < 3 || s.trajectory.finger_count < 2) {
+      throw Error(file.string(),
+                  "a master trajectory needs joint columns j0..j2 (base, shoulder, elbow) and "
+                  "finger columns f0, f1");
+    }
+    s.device_name = "simulated master (trajectory " + file.string() + ")";
+  } else {
+    PickAndPlaceScript script;
+    script.pick_world = d.ball_start_world;
+    script.place_world = scene.device.pick_and_place.place_m;
+    script.clearance_m = scene.device.pick_and_place.clearance_m;
+    script.carry_s = scene.device.pick_and_place.carry_s;
+    script.pad_depth_m = d.gripper.pad_depth_m;
+    script.open_width_m = 0.9 * d.follower.gripper_max_width_m;
+    s.trajectory =
+        make_pick_and_place_plan(script, master, d.mapping, d.follower.gripper_max_width_m)
+            .trajectory;
+    s.has_target = true;
+    s.target_world = script.place_world;
+    s.device_name = "simulated master (scripted pick-and-place)";
+  }
+
+  // The slave starts where the master's first pose asks it to be (one cold IK, before the run).
+  const DeviceInput first = s.trajectory.sample_at(s.trajectory.start_time_s());
+  const Iso3 start = slave_target(
+      d.mapping,
+      master.hand_pose({first.joint_rad[0], first.joint_rad[1], first.joint_rad[2]}).translation(),
+      first.joint_rad[0]);
+  const std::vector<double> seed(static_cast<std::size_t>(d.slave->dof()), 0.0);
+  d.slave_start_rad.assign(seed.size(), 0.0);
+  if (!solve_ik(*d.slave, start, seed, d.slave_start_rad).reached) {
+    throw Error(scene.file.string(),
+                "the master's first pose puts the slave's target out of its reach");
+  }
+  s.slave_name =
+      scene.teleop.slave_urdf.empty() ? "procedural Motoman" : scene.teleop.slave_urdf.string();
+  return s;
+}
+
+}  // namespace hapsim

@@ -1,0 +1,41 @@
+// A teleoperation scene file made runnable (000): the TeleopWorld it describes, with the slave's
+// start joints solved so the slave begins where the master's first pose puts it, and the master
+// input that drives it (the scripted pick-and-place, or a trajectory of master joints). Shared by
+// `hapsim run` and the viewer, so both build exactly the same world.
+#pragma once
+
+#include "hapsim/device/trajectory.h"
+#include "hapsim/scene/scene_description.h"
+#include "hapsim/world/teleop_world.h"
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace hapsim {
+
+struct TeleopSetup {
+  /// The world to build (slave_start_rad solved: dof() values).
+  TeleopWorldDescription description;
+  /// The master's input: joint_rad[0..2] arm joints, finger_rad[0..1] fingers.
+  Trajectory trajectory;
+  /// A pick-and-place script has a target: where the ball should come to rest (world, metres).
+  bool has_target = false;
+  Vec3 target_world = Vec3::Zero();
+  /// For summaries: "simulated master (scripted pick-and-place)" or "... (trajectory FILE)".
+  std::string device_name;
+  /// "procedural Motoman" or the slave's URDF path.
+  std::string slave_name;
+};
+
+/// Builds the setup of a teleop scene (`scene.is_teleop`). `trajectory`: a master trajectory CSV
+/// to play instead of the scene's device (--device sim:FILE). `load_link_meshes`: also load the
+/// URDF slave's collision meshes (for display; a run needs only the kinematics).
+/// Throws hapsim::Error naming the file: a URDF that does not load, a trajectory without the
+/// master's columns (j0..j2, f0, f1), a pick-and-place out of the master's reach, or a first
+/// master pose that puts the slave's target out of its reach.
+[[nodiscard]] TeleopSetup make_teleop_setup(const SceneDescription& scene,
+                                            const std::optional<std::filesystem::path>& trajectory,
+                                            bool load_link_meshes);
+
+}  // namespace hapsim

@@ -1,0 +1,73 @@
+// `hapsim run` on the real-time loop and with offscreen snapshots, through the real binary: the
+// JSON realtime block, pictures written with no display (sized as asked, not blank, numbered
+// series), and bad snapshot options as one named line with exit status 2.
+#include "hapsim_process.h"
+
+#include "hapsim/render/png_image.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+namespace hapsim {
+namespace {
+
+const std::string kKnee = std::string(HAPSIM_SCENES_DIR) + "/knee.json";
+
+TEST(RunCommand, RealtimeAddsTheLoopFiguresToTheSummary) {
+  const auto json = test::temp_path("rt.json");
+  const auto r =
+      test::run_hapsim("run " + kKnee + " -q --realtime --duration 0.5 --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("real time:"), std::string::npos) << r.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_TRUE(j.contains("realtime")) << j.dump(2);
+  const auto& rt = j["realtime"];
+  EXPECT_GT(rt["rate_hz"].get<double>(), 0.0);
+  EXPECT_LE(rt["period_jitter_us"]["p50"].get<double>(),
+            rt["period_jitter_us"]["p99"].get<double>());
+  EXPECT_LE(rt["period_jitter_us"]["p99"].get<double>(),
+            rt["period_jitter_us"]["max"].get<double>());
+  EXPECT_TRUE(rt.contains("missed_deadlines"));
+  EXPECT_EQ(j["steps"].get<int>() + rt["dropped_records"].get<int>(), 500);
+  EXPECT_EQ(j["pop_throughs"].get<int>(), 0);
+}
+
+TEST(RunCommand, SnapshotsAreWrittenWithNoDisplay) {
+  const auto png = test::temp_path("knee.png");
+  const auto r = test::run_hapsim("run " + kKnee + " -q --duration 0.6 --snapshot " + png.string() +
+                                  " --snapshot-every 200 --size 400x300 " + "--display-mode lines");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const RgbaImage image = read_png(png.string());
+  EXPECT_EQ(image.width, 400);
+  EXPECT_EQ(image.height, 300);
+  // Not a blank frame: the knee's lines differ from the background corner.
+  int differing = 0;
+  for (std::size_t i = 0; i < image.rgba.size(); i += 4) {
+    differing += image.rgba[i] != image.rgba[0] ? 1 : 0;
+  }
+  EXPECT_GT(differing, 400 * 300 / 20);
+  for (const char* n : {"knee_000200.png", "knee_000400.png", "knee_000600.png"}) {
+    EXPECT_TRUE(std::filesystem::exists(test::temp_path(n))) << n;
+  }
+}
+
+TEST(RunCommand, BadSnapshotOptionsAreNamed) {
+  auto r = test::run_hapsim("run " + kKnee + " --duration 0.1 --snapshot /tmp/x.png --size 12x");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--size"), std::string::npos) << r.output;
+  r = test::run_hapsim("run " + kKnee +
+                       " --duration 0.1 --realtime --snapshot /tmp/x.png --snapshot-every 10");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--snapshot-every"), std::string::npos) << r.output;
+  r = test::run_hapsim("run " + kKnee + " --duration 0.1 --snapshot /nonexistent/dir/x.png");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("/nonexistent/dir/x.png"), std::string::npos) << r.output;
+  r = test::run_hapsim("run " + kKnee + " --duration 0.1 --snapshot /tmp/x.png --display-mode x");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+}
+
+}  // namespace
+}  // namespace hapsim

@@ -1,0 +1,120 @@
+// Offscreen pictures of the shipped scenes in each display mode against checked-in reference
+// images, within a tolerance (Mesa's software rasteriser may move a few levels between versions).
+// The state drawn is deterministic: the scene's own scripted device stepped for a fixed number of
+// cycles. Regenerate the references after an intended change of the picture with
+//   HAPSIM_UPDATE_REFERENCES=1 build/release/tests/hapsim_render_tests
+//   --gtest_filter='SceneReference*'
+// and look at them (tests/render/reference/README.md).
+#include "hapsim/render/image_compare.h"
+#include "hapsim/render/png_image.h"
+#include "hapsim/render/snapshot_writer.h"
+#include "hapsim/render/world_scene.h"
+#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/scene_file.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+namespace hapsim {
+namespace {
+
+constexpr int kWidth = 320;
+constexpr int kHeight = 180;
+
+std::filesystem::path reference_dir() {
+  return std::filesystem::path(HAPSIM_SOURCE_DIR) / "tests" / "render" / "reference";
+}
+
+bool updating() {
+  return std::getenv("HAPSIM_UPDATE_REFERENCES") != nullptr;
+}
+
+std::unique_ptr<SnapshotWriter> make_writer() {
+  try {
+    return std::make_unique<SnapshotWriter>(kWidth, kHeight, 1);
+  } catch (const std::exception& e) {
+    return nullptr;
+  }
+}
+
+// Compares (or, when updating, writes) one reference image; returns the picture.
+std::vector<std::uint8_t> check_reference(SnapshotWriter& writer, const RenderScene& scene,
+                                          const OrbitCamera& camera, const std::string& name) {
+  const std::vector<std::uint8_t> pixels = writer.render(scene, camera);
+  const std::filesystem::path path = reference_dir() / (name + ".png");
+  if (updating()) {
+    write_png(path.string(), kWidth, kHeight, pixels);
+    return pixels;
+  }
+  const RgbaImage reference = read_png(path.string());
+  EXPECT_EQ(reference.width, kWidth);
+  EXPECT_EQ(reference.height, kHeight);
+  const ImageDiff d = compare_images(pixels, reference.rgba, kWidth, kHeight);
+  ImageTolerance tolerance;
+  tolerance.max_mean_abs_diff = 2.0;
+  tolerance.max_differing_fraction = 0.01;
+  EXPECT_TRUE(d.within(tolerance)) << name << ": " << d.describe() << " (write this run's picture "
+                                   << "with HAPSIM_UPDATE_REFERENCES=1 and compare)";
+  return pixels;
+}
+
+TEST(SceneReference, KneeInEachDisplayModeMatchesTheReferences) {
+  auto writer = make_writer();
+  if (!writer) {
+    GTEST_SKIP() << "no EGL context on this machine";
+  }
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
+  World world(scene.world);
+  auto device = make_scene_device(scene, world);
+  WorldScene view(world);
+  const OrbitCamera camera =
+      framed_camera(view.rest_bounds_W(), static_cast<double>(kWidth) / kHeight, 1.95, 0.3);
+  view.update_from_world(world);
+  const std::vector<std::uint8_t> rest = writer->render(view.scene(), camera);
+  // 3.5 s into the script the fingertip presses the skin over the patella (~10 mm dent).
+  for (int i = 0; i < 3500; ++i) {
+    world.step(device->read(i * scene.run.dt_s), scene.run.dt_s);
+  }
+  ASSERT_GT(world.current_deflection_m(0, world.segment_count(0) - 1), 0.005);
+  view.update_from_world(world);
+  std::vector<std::vector<std::uint8_t>> pictures;
+  for (const DisplayMode mode : {DisplayMode::kFaces, DisplayMode::kLines, DisplayMode::kPoints}) {
+    view.scene().style.display_mode = mode;
+    pictures.push_back(
+        check_reference(*writer, view.scene(), camera, std::string("knee_") + to_string(mode)));
+  }
+  // Independent of the references: the modes really differ, and the pressed knee is not the
+  // knee at rest (the dent and the tool).
+  EXPECT_GT(compare_images(pictures[0], pictures[1], kWidth, kHeight).differing_fraction, 0.02);
+  EXPECT_GT(compare_images(pictures[1], pictures[2], kWidth, kHeight).differing_fraction, 0.02);
+  EXPECT_GT(compare_images(pictures[0], rest, kWidth, kHeight).differing_fraction, 0.001);
+}
+
+TEST(SceneReference, KneeSegmentAndGroupColoursMatchTheReferences) {
+  auto writer = make_writer();
+  if (!writer) {
+    GTEST_SKIP() << "no EGL context on this machine";
+  }
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
+  World world(scene.world);
+  WorldSceneOptions o;
+  o.colouring = SegmentColouring::kSegments;
+  WorldScene view(world, o);
+  // The skin hides the rest: show what is under it, as the knee paper's Fig. 3 does.
+  view.set_segment_visible(world.flat_segment(0, world.segment_count(0) - 1), false);
+  const OrbitCamera camera =
+      framed_camera(view.rest_bounds_W(), static_cast<double>(kWidth) / kHeight, 1.95, 0.3);
+  view.update_from_world(world);
+  const auto segments = check_reference(*writer, view.scene(), camera, "knee_segments");
+  o.colouring = SegmentColouring::kGroups;
+  view.set_options(o);
+  const auto groups = check_reference(*writer, view.scene(), camera, "knee_groups");
+  EXPECT_GT(compare_images(segments, groups, kWidth, kHeight).differing_fraction, 0.05);
+}
+
+}  // namespace
+}  // namespace hapsim

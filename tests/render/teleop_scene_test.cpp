@@ -1,0 +1,304 @@
+// TeleopScene: what it draws checked against the world's own geometry, not stored images — after
+// a scripted pick-and-place the sheet mesh holds the world's dented heights exactly, the ball's
+// colour appears where the ball's centre projects, the pads sit (and are drawn) where the slave
+// chain's forward kinematics puts them, and URDF-style link meshes follow their chain frames.
+#include "hapsim/render/teleop_scene.h"
+
+#include "hapsim/geometry/procedural.h"
+#include "hapsim/kinematics/procedural_motoman.h"
+#include "hapsim/render/renderer.h"
+#include "hapsim/scene/scene_file.h"
+#include "hapsim/scene/teleop_setup.h"
+#include "render/gl_test_context.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <memory>
+
+namespace hapsim {
+namespace {
+
+using test::pixel_at;
+
+constexpr int kW = 320;
+constexpr int kH = 240;
+
+// The default teleop scene (procedural Motoman, ball on the floor, sheet on a frame), stepped
+// through its whole scripted pick-and-place: the ball ends resting in a dent of the sheet.
+class TeleopSceneTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    SceneDescription scene;
+    scene.is_teleop = true;
+    scene.device.has_pick_and_place = true;
+    setup_ = std::make_unique<TeleopSetup>(make_teleop_setup(scene, std::nullopt, false));
+    world_ = std::make_unique<TeleopWorld>(setup_->description);
+    const Trajectory& t = setup_->trajectory;
+    const double dt = 1e-3;
+    const auto steps = static_cast<int>((t.end_time_s() - t.start_time_s()) / dt);
+    for (int k = 1; k <= steps; ++k) {
+      static_cast<void>(world_->step(t.sample_at(t.start_time_s() + k * dt), dt));
+    }
+    auto maybe = test::make_test_context(kW, kH, 1);
+    why_not_ = maybe.why_not;
+    context_ = std::move(maybe.context);
+    if (context_) {
+      renderer_ = std::make_unique<Renderer>();
+    }
+  }
+  static void TearDownTestSuite() {
+    renderer_.reset();  // before its context
+    context_.reset();
+    world_.reset();
+    setup_.reset();
+  }
+  void require_gl() {
+    if (!context_) {
+      GTEST_SKIP() << "no offscreen GL context: " << why_not_;
+    }
+  }
+  static std::vector<std::uint8_t> render(const RenderScene& scene, const OrbitCamera& cam) {
+    renderer_->draw(scene, cam, kW, kH);
+    return context_->read_rgba();
+  }
+  static bool dominant(const test::Pixel& p, int channel, int margin) {
+    const int c[3] = {p.r, p.g, p.b};
+    return c[channel] > c[(channel + 1) % 3] + margin && c[channel] > c[(channel + 2) % 3] + margin;
+  }
+
+  static std::unique_ptr<TeleopSetup> setup_;
+  static std::unique_ptr<TeleopWorld> world_;
+  static std::unique_ptr<OffscreenContext> context_;
+  static std::unique_ptr<Renderer> renderer_;
+  static std::string why_not_;
+};
+
+std::unique_ptr<TeleopSetup> TeleopSceneTest::setup_;
+std::unique_ptr<TeleopWorld> TeleopSceneTest::world_;
+std::unique_ptr<OffscreenContext> TeleopSceneTest::context_;
+std::unique_ptr<Renderer> TeleopSceneTest::renderer_;
+std::string TeleopSceneTest::why_not_;
+
+TEST_F(TeleopSceneTest, SheetMeshHoldsTheWorldsDentedHeights) {
+  const TeleopWorld& world = *world_;
+  ASSERT_GT(world.sheet().max_depth_m(), 1e-4) << "the ball should rest in a dent";
+  TeleopScene from_world(world);
+  from_world.update_from_world(world);
+  TeleopScene from_snapshot(world);
+  from_snapshot.update(make_teleop_snapshot(world));
+  const auto heights = world.sheet().surface_heights();
+  const TriangleMesh& rest = world.sheet().mesh();
+  for (const TeleopScene* scene : {&from_world, &from_snapshot}) {
+    const RenderMesh& sheet = scene->scene().mesh(scene->sheet_mesh());
+    ASSERT_EQ(sheet.geometry().vertices.size(), heights.size());
+    for (std::size_t k = 0; k < heights.size(); ++k) {
+      ASSERT_EQ(sheet.geometry().vertices[k].z(), heights[k]) << "node " << k;
+      ASSERT_EQ(sheet.geometry().vertices[k].x(), rest.vertices[k].x());
+      ASSERT_EQ(sheet.geometry().vertices[k].y(), rest.vertices[k].y());
+    }
+    EXPECT_TRUE(sheet.X_WM.isApprox(world.description().environment.X_world_sheet, 0.0));
+  }
+  // The dent is under the ball: the node nearest the ball's footprint is the deepest around.
+  const Vec3 ball_sheet =
+      world.description().environment.X_world_sheet.inverse() * world.ball().p_world();
+  const int n = world.sheet().nodes_per_side();
+  const double h = world.sheet().spacing_m();
+  const auto i = static_cast<int>(std::lround((ball_sheet.x() + 0.5 * world.sheet().side_m()) / h));
+  const auto j = static_cast<int>(std::lround((ball_sheet.y() + 0.5 * world.sheet().side_m()) / h));
+  ASSERT_TRUE(i >= 0 && i < n && j >= 0 && j < n);
+  EXPECT_LT(heights[static_cast<std::size_t>(j * n + i)], -0.5 * world.sheet().max_depth_m());
+}
+
+TEST_F(TeleopSceneTest, BallColourAppearsWhereItsCentreProjects) {
+  require_gl();
+  const TeleopWorld& world = *world_;
+  TeleopScene scene(world);
+  scene.update_from_world(world);
+  // Look at the ball from beyond it (the robot behind it), a little from above.
+  const Vec3 ball = world.ball().p_world();
+  OrbitCamera cam;
+  cam.target_W = ball;
+  cam.yaw_rad = std::atan2(ball.y(), ball.x());
+  cam.pitch_rad = 0.4;
+  cam.distance_m = 0.8;
+  const Vec3 px = cam.project(ball, kW, kH);
+  ASSERT_TRUE(px.x() > 0 && px.x() < kW && px.y() > 0 && px.y() < kH);
+  const auto x = static_cast<int>(px.x());
+  const auto y = static_cast<int>(px.y());
+  const auto with_ball = render(scene.scene(), cam);
+  EXPECT_TRUE(dominant(pixel_at(with_ball, kW, x, y), 0, 60))
+      << "pixel " << x << "," << y << " = " << pixel_at(with_ball, kW, x, y).r << " "
+      << pixel_at(with_ball, kW, x, y).g << " " << pixel_at(with_ball, kW, x, y).b;
+  // Without the ball the red is gone (it was the ball, not the robot or the background).
+  ASSERT_FALSE(scene.scene().spheres.empty());
+  ASSERT_EQ(scene.scene().spheres[0].centre_W, ball);
+  scene.scene().spheres.erase(scene.scene().spheres.begin());
+  const auto without = render(scene.scene(), cam);
+  EXPECT_FALSE(dominant(pixel_at(without, kW, x, y), 0, 60));
+}
+
+TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
+  require_gl();
+  const TeleopWorld& world = *world_;
+  TeleopScene scene(world);
+  scene.update_from_world(world);
+  // Independent geometry: the tool from the chain's FK, the pads across its y at the pad depth.
+  const Iso3 X_tool = world.slave().chain().forward(world.slave().q());
+  const ParallelGripperParams& p = world.gripper().params();
+  const double w = world.last_result().gripper.width_m;
+  const Vec3 pad_W[2] = {X_tool * Vec3(0.0, 0.5 * w + p.pad_half_m.y(), p.pad_depth_m),
+                         X_tool * Vec3(0.0, -(0.5 * w + p.pad_half_m.y()), p.pad_depth_m)};
+  for (int i = 0; i < 2; ++i) {
+    const RenderMesh& pad = scene.scene().mesh(scene.pad_mesh(i));
+    EXPECT_LT((pad.X_WM.translation() - pad_W[i]).norm(), 1e-12) << "pad " << i;
+    EXPECT_TRUE(pad.X_WM.linear().isApprox(X_tool.linear(), 1e-12));
+  }
+  // The shadow mark is under the tool point.
+  ASSERT_EQ(scene.scene().shadow_marks.size(), 1u);
+  EXPECT_LT((scene.scene().shadow_marks[0].point_W - X_tool * Vec3(0.0, 0.0, p.pad_depth_m)).norm(),
+            1e-12);
+
+  // Only the pads, pure green: each pad's centre pixel is green.
+  RenderScene& rs = scene.scene();
+  for (MeshId id = 0; id < rs.mesh_count(); ++id) {
+    rs.mesh(id).visible = false;
+  }
+  rs.spheres.clear();
+  rs.segments.clear();
+  rs.shadow_marks.clear();
+  rs.floor.visible = false;
+  rs.style.background = Vec3f::Zero();
+  OrbitCamera cam;
+  cam.target_W = 0.5 * (pad_W[0] + pad_W[1]);
+  // Looking along the pads' face normals' perpendicular: from the tool's x side, a little above.
+  const Vec3 side = X_tool.linear().col(0);
+  cam.yaw_rad = std::atan2(side.y(), side.x());
+  cam.pitch_rad = 0.3;
+  cam.distance_m = 0.35;
+  for (int i = 0; i < 2; ++i) {
+    rs.mesh(scene.pad_mesh(i)).visible = true;
+    rs.mesh(scene.pad_mesh(i)).colour = Vec3f(0.1f, 0.9f, 0.1f);
+  }
+  const auto image = render(rs, cam);
+  for (int i = 0; i < 2; ++i) {
+    const Vec3 px = cam.project(pad_W[i], kW, kH);
+    const auto x = static_cast<int>(px.x());
+    const auto y = static_cast<int>(px.y());
+    ASSERT_TRUE(x >= 0 && x < kW && y >= 0 && y < kH);
+    const test::Pixel c = pixel_at(image, kW, x, y);
+    EXPECT_TRUE(dominant(c, 1, 40))
+        << "pad " << i << " at " << x << "," << y << ": " << c.r << " " << c.g << " " << c.b;
+  }
+}
+
+TEST(TeleopScene, LinkMeshesFollowTheirChainFrames) {
+  // The procedural Motoman with a mesh on joint 2's frame, as a URDF's collision meshes come.
+  SerialChain chain = make_procedural_motoman();
+  ChainLinkGeometry g;
+  g.link = "forearm";
+  g.frame = 2;
+  g.X_frame_mesh = Iso3(Eigen::Translation3d(0.1, 0.0, 0.02));
+  g.mesh = make_box(Vec3(0.1, 0.03, 0.03));
+  chain.set_link_geometry({g});
+  TeleopWorldDescription d;
+  d.slave = std::make_shared<const SerialChain>(std::move(chain));
+  d.slave_start_rad = {0.3, -0.2, 0.4, 0.1, 0.5, -0.2};
+  TeleopWorld world(d);
+  TeleopScene scene(world);
+  ASSERT_EQ(scene.link_meshes().size(), 1u);
+  std::array<Iso3, kMaxChainJoints> frames;
+  static_cast<void>(world.slave().chain().frames(world.slave().q(), frames));
+  const RenderMesh& mesh = scene.scene().mesh(scene.link_meshes()[0]);
+  EXPECT_TRUE(mesh.X_WM.isApprox(frames[2] * g.X_frame_mesh, 1e-12));
+  EXPECT_EQ(mesh.geometry().vertices.size(), g.mesh.vertices.size());
+  // The bounds frame the whole scene: the ball, the sheet and the master drawn beside.
+  const Box3& b = scene.rest_bounds_W();
+  EXPECT_TRUE(b.contains(world.ball().p_world()));
+  EXPECT_TRUE(b.contains(scene.master_display_origin_W()));
+}
+
+TEST(TeleopScene, BoxLinksJoinTheJointOrigins) {
+  TeleopWorldDescription d;
+  d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
+  d.slave_start_rad = {0.3, -0.2, 0.4, 0.1, 0.5, -0.2};
+  TeleopWorld world(d);
+  TeleopScene scene(world);
+  const SerialChain& chain = world.slave().chain();
+  std::array<Iso3, kMaxChainJoints> frames;
+  const Iso3 tip = chain.frames(world.slave().q(), frames);
+  // A box spans one joint origin to the next (base, joints 0..n−1, tip; coinciding origins
+  // get no box): its centroid is their midpoint, in chain order.
+  std::vector<Vec3> origins{Vec3::Zero()};
+  for (int k = 0; k < chain.dof(); ++k) {
+    origins.push_back(frames[static_cast<std::size_t>(k)].translation());
+  }
+  origins.push_back(tip.translation());
+  std::vector<Vec3> midpoints;
+  for (std::size_t k = 1; k < origins.size(); ++k) {
+    if ((origins[k] - origins[k - 1]).norm() > 1e-6) {
+      midpoints.push_back(0.5 * (origins[k] + origins[k - 1]));
+    }
+  }
+  ASSERT_EQ(scene.link_meshes().size(), midpoints.size());
+  for (std::size_t l = 0; l < midpoints.size(); ++l) {
+    const RenderMesh& m = scene.scene().mesh(scene.link_meshes()[l]);
+    Vec3 c = Vec3::Zero();
+    for (const Vec3& v : m.geometry().vertices) {
+      c += m.X_WM * v;
+    }
+    c /= static_cast<double>(m.geometry().vertices.size());
+    EXPECT_LT((c - midpoints[l]).norm(), 1e-9) << "link box " << l;
+  }
+  // And a joint sphere at each joint (after the ball).
+  const auto& spheres = scene.scene().spheres;
+  ASSERT_GE(spheres.size(), 1u + static_cast<std::size_t>(chain.dof()));
+  for (int k = 0; k < chain.dof(); ++k) {
+    EXPECT_LT((spheres[1 + static_cast<std::size_t>(k)].centre_W -
+               frames[static_cast<std::size_t>(k)].translation())
+                  .norm(),
+              1e-12);
+  }
+}
+
+}  // namespace
+}  // namespace hapsim
+
+namespace hapsim {
+namespace {
+
+TEST(TeleopScene, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
+  const auto data = std::filesystem::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7";
+  if (!std::filesystem::exists(data / "gp7.urdf")) {
+    GTEST_SKIP() << "Motoman GP7 URDF not found in " << data << " (real-data tests skip)";
+  }
+  SceneLoadOptions o;
+  o.data_dir = data;
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop_gp7.json", o);
+  const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/true);
+  const SerialChain& chain = *setup.description.slave;
+  ASSERT_FALSE(chain.link_geometry().empty());
+  TeleopWorld world(setup.description);
+  TeleopScene drawn(world);
+  std::array<Iso3, kMaxChainJoints> frames;
+  static_cast<void>(chain.frames(world.slave().q(), frames));
+  std::size_t l = 0;
+  for (const ChainLinkGeometry& g : chain.link_geometry()) {
+    if (g.mesh.empty()) {
+      continue;
+    }
+    ASSERT_LT(l, drawn.link_meshes().size());
+    const RenderMesh& m = drawn.scene().mesh(drawn.link_meshes()[l++]);
+    const Iso3 X_WF = g.frame < 0 ? Iso3::Identity() : frames[static_cast<std::size_t>(g.frame)];
+    EXPECT_TRUE(m.X_WM.isApprox(X_WF * g.X_frame_mesh, 1e-12)) << g.link;
+    EXPECT_EQ(m.geometry().vertices.size(), g.mesh.vertices.size()) << g.link;
+  }
+  EXPECT_EQ(l, drawn.link_meshes().size());
+  // Meshes drawn: no joint spheres, just the ball and the master's joints.
+  EXPECT_TRUE(drawn.rest_bounds_W().contains(frames[0].translation()));
+}
+
+}  // namespace
+}  // namespace hapsim

@@ -1,0 +1,156 @@
+// The TeleopWorld on the real-time loop: after a scripted pick-and-place start the snapshot the
+// viewer reads is the world's state exactly (ball, slave joints and tool, sheet), the world went
+// through exactly what an inline run with the same inputs goes through, a reader thread never sees
+// a torn snapshot, the haptic thread allocates nothing, and a paused client holds the world.
+#include "hapsim/runtime/teleop_haptic_client.h"
+
+#include "hapsim/device/device_profile.h"
+#include "hapsim/device/simulated_device.h"
+#include "hapsim/scene/teleop_setup.h"
+#include "support/allocation_counter.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+namespace hapsim {
+namespace {
+
+// The default teleop scene (procedural Motoman) with its scripted pick-and-place.
+TeleopSetup pick_and_place_setup() {
+  SceneDescription scene;
+  scene.is_teleop = true;
+  scene.device.has_pick_and_place = true;
+  return make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/false);
+}
+
+TEST(TeleopHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
+  const TeleopSetup setup = pick_and_place_setup();
+  TeleopWorld world(setup.description);
+  SimulatedDevice device(device_profile("simulated"), setup.trajectory);
+  TeleopHapticClient client(world);
+  HapticLoopOptions o;
+  o.max_cycles = 300;
+  HapticLoop loop(device, client, o);
+  loop.start();
+  loop.wait();
+  EXPECT_EQ(client.steps(), 300u);
+  TripleBuffer<TeleopSnapshot>& buffer = *client.snapshots();
+  ASSERT_TRUE(buffer.update());
+  const TeleopSnapshot& s = buffer.read_slot();
+  EXPECT_EQ(s.cycle, 299u);
+  EXPECT_EQ(s.ball_p_world, world.ball().p_world());
+  const auto q = world.slave().q();
+  ASSERT_EQ(s.slave_q.size(), q.size());
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    EXPECT_EQ(s.slave_q[i], q[i]) << "joint " << i;
+  }
+  EXPECT_TRUE(s.X_world_tool.isApprox(world.slave().tip_pose(), 0.0));
+  EXPECT_EQ(s.gripper_width_m, world.last_result().gripper.width_m);
+  EXPECT_EQ(s.held, world.last_result().held);
+  const auto heights = world.sheet().surface_heights();
+  ASSERT_EQ(s.sheet_heights_m.size(), heights.size());
+  for (std::size_t k = 0; k < heights.size(); ++k) {
+    ASSERT_EQ(s.sheet_heights_m[k], heights[k]) << "node " << k;
+  }
+  // The snapshot is one cycle's: the master joints the world followed are that cycle's input.
+  for (std::size_t j = 0; j < 3; ++j) {
+    EXPECT_EQ(s.master_joint_rad[j], s.input.joint_rad[j]);
+  }
+  EXPECT_EQ(s.input.joint_rad[0], setup.trajectory.sample_at(299 * o.period_s).joint_rad[0]);
+  EXPECT_EQ(s.output.joint_count, 5);
+
+  // The same inputs stepped inline give the same world, bit for bit.
+  TeleopWorld inline_world(setup.description);
+  for (std::uint64_t i = 0; i < 300; ++i) {
+    static_cast<void>(inline_world.step(
+        setup.trajectory.sample_at(static_cast<double>(i) * o.period_s), o.period_s));
+  }
+  EXPECT_EQ(inline_world.ball().p_world(), world.ball().p_world());
+  for (std::size_t i = 0; i < q.size(); ++i) {
+    EXPECT_EQ(inline_world.slave().q()[i], q[i]) << "joint " << i;
+  }
+  EXPECT_EQ(inline_world.slave().gripper_width_m(), world.slave().gripper_width_m());
+}
+
+TEST(TeleopHapticClient, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllocate) {
+  const TeleopSetup setup = pick_and_place_setup();
+  TeleopWorld world(setup.description);
+  SimulatedDevice device(device_profile("simulated"), setup.trajectory);
+  TeleopHapticClient client(world);
+
+  // Counts the haptic thread's allocations around the real client (step and after_cycle).
+  struct Counting final : HapticClient {
+    explicit Counting(TeleopHapticClient& c) : inner(c) {}
+    const DeviceCommand& step(const DeviceInput& input, double dt_s) override {
+      if (steps++ == 5) {
+        first = test::thread_allocation_count();
+      }
+      last = test::thread_allocation_count();
+      return inner.step(input, dt_s);
+    }
+    void after_cycle(const HapticCycle& c) noexcept override { inner.after_cycle(c); }
+    TeleopHapticClient& inner;
+    long first = 0;
+    long last = 0;
+    int steps = 0;
+  } counting(client);
+
+  HapticLoopOptions o;
+  o.max_cycles = 300;
+  HapticLoop loop(device, counting, o);
+  std::atomic<int> inconsistent{0};
+  std::atomic<int> snapshots{0};
+  loop.start();
+  std::thread viewer([&] {
+    std::uint64_t last_cycle = 0;
+    while (loop.running()) {
+      if (client.snapshots()->update()) {
+        const TeleopSnapshot& s = client.snapshots()->read_slot();
+        // One cycle's data: the master joints the world followed are that cycle's input.
+        if (s.master_joint_rad[0] != s.input.joint_rad[0] ||
+            s.master_joint_rad[2] != s.input.joint_rad[2] || s.cycle < last_cycle ||
+            !s.ball_p_world.allFinite()) {
+          inconsistent.fetch_add(1);
+        }
+        last_cycle = s.cycle;
+        snapshots.fetch_add(1);
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(300));
+    }
+  });
+  viewer.join();
+  loop.wait();
+  EXPECT_EQ(counting.steps, 300);
+  EXPECT_EQ(counting.last - counting.first, 0) << "the haptic thread allocated";
+  EXPECT_EQ(inconsistent.load(), 0);
+  EXPECT_GT(snapshots.load(), 10);
+}
+
+TEST(TeleopHapticClient, PausedClientHoldsTheWorldAndSendsNoTorque) {
+  const TeleopSetup setup = pick_and_place_setup();
+  TeleopWorld world(setup.description);
+  SimulatedDevice device(device_profile("simulated"), setup.trajectory);
+  TeleopHapticClient client(world);
+  client.set_paused(true);
+  EXPECT_TRUE(client.paused());
+  HapticLoopOptions o;
+  o.max_cycles = 50;
+  HapticLoop loop(device, client, o);
+  loop.start();
+  loop.wait();
+  EXPECT_EQ(client.steps(), 0u);
+  EXPECT_EQ(world.last_result().time_s, 0.0);
+  ASSERT_TRUE(client.snapshots()->update());
+  const TeleopSnapshot& s = client.snapshots()->read_slot();
+  EXPECT_EQ(s.cycle, 49u);
+  EXPECT_EQ(s.ball_p_world, setup.description.ball_start_world);
+  for (int j = 0; j < kMaxDeviceJoints; ++j) {
+    EXPECT_EQ(s.output.joint_torque_nm[static_cast<std::size_t>(j)], 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace hapsim
