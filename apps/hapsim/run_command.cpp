@@ -9,6 +9,7 @@
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/render/snapshot_writer.h"
+#include "hapsim/render/teleop_scene.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/scene_device.h"
@@ -113,6 +114,50 @@ class WorldSnapshots {
   std::size_t every_;
   std::unique_ptr<SnapshotWriter> writer_;
   std::unique_ptr<WorldScene> scene_;
+  OrbitCamera camera_;
+  std::size_t written_ = 0;
+};
+
+// The same for a teleoperation run: the slave, gripper, ball and sheet (and the master beside).
+class TeleopSnapshots {
+ public:
+  explicit TeleopSnapshots(const RunArgs& args)
+      : path_(args.snapshot_path), every_(args.snapshot_every), args_(args) {
+    const auto [w, h] = parse_size(args.size);
+    writer_ = std::make_unique<SnapshotWriter>(w, h);
+  }
+
+  void after_step(const TeleopWorld& world, std::size_t step) {
+    if (every_ > 0 && step % every_ == 0) {
+      write(world, numbered_path(path_, step));
+    }
+  }
+  void final(const TeleopWorld& world) { write(world, path_); }
+  [[nodiscard]] std::size_t written() const { return written_; }
+
+  // From the front-right, above: the robot, the ball and the sheet all in view.
+  static constexpr double kDefaultYaw = -0.9;
+  static constexpr double kDefaultPitch = 0.45;
+
+ private:
+  void write(const TeleopWorld& world, const std::string& path) {
+    if (!scene_) {  // built on first use: the world exists only inside the run
+      scene_ = std::make_unique<TeleopScene>(world);
+      scene_->scene().style.display_mode = parse_display_mode(args_.display_mode);
+      camera_ = framed_camera(scene_->rest_bounds_W(),
+                              static_cast<double>(writer_->width()) / writer_->height(),
+                              kDefaultYaw, kDefaultPitch);
+    }
+    scene_->update_from_world(world);
+    writer_->write_png(scene_->scene(), camera_, path);
+    ++written_;
+  }
+
+  std::string path_;
+  std::size_t every_;
+  const RunArgs& args_;
+  std::unique_ptr<SnapshotWriter> writer_;
+  std::unique_ptr<TeleopScene> scene_;
   OrbitCamera camera_;
   std::size_t written_ = 0;
 };
@@ -232,6 +277,22 @@ void run(const RunArgs& args) {
                          "teleoperation scenes yet");
     }
     TeleopRunOptions teleop;
+    std::unique_ptr<TeleopSnapshots> snapshots;
+    if (!args.snapshot_path.empty()) {
+      snapshots = std::make_unique<TeleopSnapshots>(args);
+      teleop.after_step = [&](const TeleopWorld& w, std::size_t step) {
+        snapshots->after_step(w, step);
+      };
+      teleop.finished = [&](const TeleopWorld& w) {
+        snapshots->final(w);
+        std::printf(
+            "snapshot     %s (%s, %s%s)\n", args.snapshot_path.c_str(), args.size.c_str(),
+            args.display_mode.c_str(),
+            args.snapshot_every > 0
+                ? (", and " + std::to_string(snapshots->written() - 1) + " numbered ones").c_str()
+                : "");
+      };
+    }
     teleop.duration_s = args.duration_s;
     teleop.trajectory = trajectory;
     teleop.json_path = args.json_path;

@@ -80,6 +80,9 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
     const Stopwatch watch;
     const TeleopStepResult& r = world.step(in, dt);
     step_us.push_back(watch.elapsed_s() * 1e6);
+    if (options.after_step) {
+      options.after_step(world, k);
+    }
     if (r.gripper.grasped_now && !grasped) {
       grasped = true;
       grasp_time = r.time_s;
@@ -97,6 +100,9 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
     }
   }
   const double wall_s = wall.elapsed_s();
+  if (options.finished) {
+    options.finished(world);
+  }
   const Vec3 final_p = world.ball().p_world();
   const double target_error = has_target ? (final_p - target).norm() : -1.0;
   const double p50 = percentile(step_us, 0.5), p99 = percentile(step_us, 0.99),

@@ -5,9 +5,14 @@
 #include "hapsim/scene/scene_description.h"
 
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>
+
+namespace hapsim {
+class TeleopWorld;
+}
 
 namespace hapsim::app {
 
@@ -16,6 +21,10 @@ struct TeleopRunOptions {
   std::optional<std::filesystem::path> trajectory;               // --device sim:FILE
   std::string json_path;
   ProgressFn progress;
+  /// Called after every step with the world and the step index (1-based), and once at the end:
+  /// headless snapshots. May be empty.
+  std::function<void(const TeleopWorld& world, std::size_t step)> after_step;
+  std::function<void(const TeleopWorld& world)> finished;
 };
 
 /// Runs the scene and prints its summary; sets exit status 1 when a pick-and-place does not end

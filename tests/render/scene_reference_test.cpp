@@ -8,9 +8,12 @@
 #include "hapsim/render/image_compare.h"
 #include "hapsim/render/png_image.h"
 #include "hapsim/render/snapshot_writer.h"
+#include "hapsim/render/teleop_scene.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
+#include "hapsim/scene/teleop_setup.h"
+#include "hapsim/world/teleop_world.h"
 
 #include <gtest/gtest.h>
 
@@ -114,6 +117,42 @@ TEST(SceneReference, KneeSegmentAndGroupColoursMatchTheReferences) {
   view.set_options(o);
   const auto groups = check_reference(*writer, view.scene(), camera, "knee_groups");
   EXPECT_GT(compare_images(segments, groups, kWidth, kHeight).differing_fraction, 0.05);
+}
+
+TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
+  auto writer = make_writer();
+  if (!writer) {
+    GTEST_SKIP() << "no EGL context on this machine";
+  }
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
+  TeleopSetup setup = make_teleop_setup(scene, std::nullopt, false);
+  TeleopWorld world(setup.description);
+  // 6 s into the scripted pick-and-place the gripper carries the ball towards the sheet.
+  const double dt = scene.run.dt_s;
+  for (int k = 1; k <= 6000; ++k) {
+    world.step(setup.trajectory.sample_at(setup.trajectory.start_time_s() + k * dt), dt);
+  }
+  ASSERT_TRUE(world.ball().held());
+  TeleopScene view(world);
+  view.update_from_world(world);
+  const OrbitCamera camera =
+      framed_camera(view.rest_bounds_W(), static_cast<double>(kWidth) / kHeight, -0.9, 0.45);
+  std::vector<std::vector<std::uint8_t>> pictures;
+  for (const DisplayMode mode : {DisplayMode::kFaces, DisplayMode::kLines, DisplayMode::kPoints}) {
+    view.scene().style.display_mode = mode;
+    pictures.push_back(
+        check_reference(*writer, view.scene(), camera, std::string("teleop_") + to_string(mode)));
+  }
+  EXPECT_GT(compare_images(pictures[0], pictures[1], kWidth, kHeight).differing_fraction, 0.01);
+  EXPECT_GT(compare_images(pictures[1], pictures[2], kWidth, kHeight).differing_fraction, 0.005);
+  // The ball is where the world says, in its colour (red), in the face picture.
+  const Vec3 px = camera.project(world.ball().p_world(), kWidth, kHeight);
+  const auto x = static_cast<int>(px.x());
+  const auto y = static_cast<int>(px.y());
+  ASSERT_TRUE(x >= 0 && x < kWidth && y >= 0 && y < kHeight);
+  const std::uint8_t* p = &pictures[0][(static_cast<std::size_t>(y) * kWidth + x) * 4];
+  EXPECT_GT(p[0], 2 * p[1]) << "no red ball at its projection";
 }
 
 }  // namespace
