@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job: install what is missing, build, then run the knee palpation scene on the simulated
 # device (scenes/knee.json: a procedural knee, one fingertip, a scripted palpation) and report what
-# happened. Extra arguments go to `hapsim run` (e.g. --method knee, --realtime, --record FILE).
+# happened, with a picture of the final state. Extra arguments go to `hapsim run` (e.g. --method
+# knee, --realtime, --record FILE, --snapshot FILE.png --snapshot-every 500).
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 hapsim_install_packages
@@ -10,5 +11,12 @@ hapsim_build
 HAPSIM="${HAPSIM_BUILD_DIR}/apps/hapsim"
 OUT="${HAPSIM_ROOT}/build/main-job"
 mkdir -p "$OUT"
-"$HAPSIM" run "${HAPSIM_ROOT}/scenes/knee.json" --json "$OUT/knee-run.json" "$@"
+# A picture of the final state too (offscreen, no display needed), unless the caller asks for one.
+snapshot=(--snapshot "$OUT/knee-final.png")
+for arg in "$@"; do
+  if [[ "$arg" == --snapshot* ]]; then
+    snapshot=()
+  fi
+done
+"$HAPSIM" run "${HAPSIM_ROOT}/scenes/knee.json" --json "$OUT/knee-run.json" "${snapshot[@]}" "$@"
 echo "hapsim: summary as JSON in $OUT/knee-run.json"

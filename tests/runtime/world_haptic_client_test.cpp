@@ -9,11 +9,14 @@
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/runtime/session.h"
+#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/scene_file.h"
 #include "support/allocation_counter.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <filesystem>
 #include <cmath>
 #include <thread>
 
@@ -166,6 +169,42 @@ TEST(WorldHapticClient, ReaderThreadSeesConsistentSnapshotsAndHapticThreadDoesNo
   EXPECT_EQ(inconsistent.load(), 0);
   EXPECT_GT(snapshots.load(), 50);
   EXPECT_EQ(records + client.dropped_records(), 700u);
+}
+
+// The shipped knee scene with its own scripted palpation device, snapshots and records on: the
+// whole haptic cycle (device read, World::step, safety, write, publish) allocates nothing.
+TEST(WorldHapticClient, KneeSceneWithItsScriptedDeviceAllocatesNothingOnTheHapticThread) {
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
+  World world(scene.world);
+  auto device = make_scene_device(scene, world);
+  WorldHapticClientOptions co;
+  co.record_capacity = 8192;
+  WorldHapticClient client(world, co);
+  struct Counting final : HapticClient {
+    explicit Counting(WorldHapticClient& c) : inner(c) {}
+    const DeviceCommand& step(const DeviceInput& input, double dt_s) override {
+      if (steps++ == 5) {
+        first = test::thread_allocation_count();
+      }
+      last = test::thread_allocation_count();
+      return inner.step(input, dt_s);
+    }
+    void after_cycle(const HapticCycle& c) noexcept override { inner.after_cycle(c); }
+    WorldHapticClient& inner;
+    long first = 0;
+    long last = 0;
+    int steps = 0;
+  } counting(client);
+  HapticLoopOptions o;
+  o.max_cycles = 2500;  // the approach, the first press (medial ligament) and its release
+  HapticLoop loop(*device, counting, o);
+  loop.start();
+  loop.wait();
+  EXPECT_EQ(counting.last - counting.first, 0) << "the haptic thread allocated";
+  EXPECT_GT(world.current_deflection_m(0, world.segment_count(0) - 1) +
+                client.max_deflection_m()[world.flat_segment(0, world.segment_count(0) - 1)],
+            0.001);  // it did press the skin
 }
 
 TEST(WorldHapticClient, ResetAndPauseReachTheSnapshot) {
