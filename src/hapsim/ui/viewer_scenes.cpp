@@ -1,7 +1,7 @@
 #include "hapsim/ui/viewer_scenes.h"
 
-#include "hapsim/core/error.h"
 #include "hapsim/scene/scene_description.h"
+#include "hapsim/ui/teleop_viewer_session.h"
 #include "hapsim/ui/world_viewer_session.h"
 
 namespace hapsim {
@@ -9,7 +9,7 @@ namespace hapsim {
 std::unique_ptr<ViewerSession> make_viewer_session(const ViewerConfig& config,
                                                    const SceneDescription& scene) {
   if (scene.is_teleop) {
-    throw Error(config.scene.string(), "teleoperation scenes are not in the viewer yet");
+    return make_teleop_viewer_session(config, scene);
   }
   return make_world_viewer_session(config, scene);
 }
