@@ -44,6 +44,7 @@ struct RunArgs {
   std::string method;
   std::string data_dir;
   bool realtime = false;
+  double spin_us = 200.0;
   bool quiet = false;
   // Headless pictures.
   std::string snapshot_path;
@@ -396,6 +397,7 @@ void run(const RunArgs& args) {
   }
   options.dt_s = scene.run.dt_s;
   options.realtime = args.realtime;
+  options.loop.spin_s = 1e-6 * args.spin_us;
   options.recorder = recorder.get();
   options.progress = progress;
   const SessionSummary summary = run_session(world, *device, options);
@@ -485,6 +487,10 @@ void add_run_command(CLI::App& app) {
                 "Run on the real-time haptic thread: an absolute 1 kHz deadline (SCHED_FIFO when "
                 "permitted), stall watchdog; the summary adds rate, period jitter and missed "
                 "deadlines");
+  cmd->add_option("--spin-us", args->spin_us,
+                  "Real time with SCHED_FIFO: wake this long before each deadline and spin to it "
+                  "(default 200, at most 500; 0 sleeps only)")
+      ->check(CLI::Range(0.0, 500.0));
   cmd->add_flag("-q,--quiet", args->quiet, "No progress lines");
   cmd->add_option("--snapshot", args->snapshot_path,
                   "Write a picture of the final state to FILE.png (offscreen: no display needed)");

@@ -181,6 +181,10 @@ class Viewer {
       glfwGetFramebufferSize(window_, &fb_w, &fb_h);
       const auto d0 = Clock::now();
       const Viewport v = view_rect(fb_w, fb_h);
+      // The whole back buffer: the panels are slightly translucent over whatever was there.
+      glViewport(0, 0, fb_w, fb_h);
+      glClearColor(0.1f, 0.1f, 0.12f, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
       renderer_->draw_in(session_->render_scene(), camera_, v.x, v.y, v.w, v.h);
       draw_panels(fb_w, fb_h);
       const double draw_ms = std::chrono::duration<double, std::milli>(Clock::now() - d0).count();
@@ -535,12 +539,12 @@ class Viewer {
     ImGui::Text("t = %.3f s   %s", r.time_s, paused_ ? "(paused)" : "");
     ImGui::TextWrapped("device: %s", session_->device_name().c_str());
     ImGui::Separator();
-    ImGui::TextUnformatted("tool / fingertip        x        y        z (mm)   F (N)");
+    ImGui::TextUnformatted("tool            x      y      z mm    F N");
     for (const ToolReadout& t : r.tools) {
-      ImGui::Text("%-14s %8.1f %8.1f %8.1f  %6.2f", t.name.c_str(), t.p_world.x() * 1e3,
+      ImGui::Text("%-12.12s %6.1f %6.1f %6.1f %6.2f", t.name.c_str(), t.p_world.x() * 1e3,
                   t.p_world.y() * 1e3, t.p_world.z() * 1e3, t.force_n);
       if ((t.proxy_world - t.p_world).norm() > 1e-4) {
-        ImGui::Text("  proxy        %8.1f %8.1f %8.1f", t.proxy_world.x() * 1e3,
+        ImGui::Text("  proxy      %6.1f %6.1f %6.1f", t.proxy_world.x() * 1e3,
                     t.proxy_world.y() * 1e3, t.proxy_world.z() * 1e3);
       }
     }

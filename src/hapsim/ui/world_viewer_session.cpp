@@ -82,8 +82,9 @@ class WorldViewerSession final : public ViewerSession {
         trajectory = config.device.substr(4);
       }
       device_ = make_scene_device(scene_, *world_, trajectory);
-      device_name_ = "simulated " + profile.name +
-                     (trajectory ? " playing " + trajectory->string() : " (scene script)");
+      const std::string what = trajectory ? "trajectory " + trajectory->string() : "scene script";
+      device_name_ = profile.name == "simulated" ? what + " (simulated device)"
+                                                 : what + " (simulated " + profile.name + ")";
     } else if (config.device == "spacemouse") {
 #if defined(HAPSIM_WITH_SPNAV)
       SpacenavOptions so;
