@@ -40,6 +40,7 @@ class LoggingDevice final : public Device {
   DeviceInput read(double time_s) noexcept override {
     const std::uint64_t n = reads_.fetch_add(1);
     if (hang_at_read_ >= 0 && n == static_cast<std::uint64_t>(hang_at_read_)) {
+      hang_started_ns_.store(monotonic_ns());
       std::this_thread::sleep_for(std::chrono::milliseconds(hang_ms_));
     }
     DeviceInput in;
@@ -63,6 +64,7 @@ class LoggingDevice final : public Device {
     hang_ms_ = ms;
   }
   void unhealthy_from(int read_index) { unhealthy_from_read_ = read_index; }
+  [[nodiscard]] std::int64_t hang_started_ns() const { return hang_started_ns_.load(); }
   [[nodiscard]] std::vector<Write> writes() const {
     return {writes_.begin(),
             writes_.begin() + static_cast<std::ptrdiff_t>(std::min(count_.load(), writes_.size()))};
@@ -75,6 +77,7 @@ class LoggingDevice final : public Device {
   std::atomic<std::uint64_t> reads_{0};
   int hang_at_read_ = -1;
   int hang_ms_ = 0;
+  std::atomic<std::int64_t> hang_started_ns_{0};
   int unhealthy_from_read_ = -1;
 };
 
@@ -91,6 +94,7 @@ class ConstantForceClient final : public HapticClient {
     }
     allocations_at_last_ = test::thread_allocation_count();
     if (stall_at_ >= 0 && n == static_cast<std::uint64_t>(stall_at_)) {
+      stall_started_ns_ = monotonic_ns();
       std::this_thread::sleep_for(std::chrono::milliseconds(stall_ms_));
     }
     if (nan_at_ >= 0 && n == static_cast<std::uint64_t>(nan_at_)) {
@@ -107,6 +111,8 @@ class ConstantForceClient final : public HapticClient {
     stall_ms_ = ms;
   }
   void nan_at(int step) { nan_at_ = step; }
+  /// When the injected stall began (read after the loop stopped).
+  [[nodiscard]] std::int64_t stall_started_ns() const { return stall_started_ns_; }
   [[nodiscard]] long allocations_during_run() const {
     return allocations_at_last_ - allocations_at_start_;
   }
@@ -118,15 +124,42 @@ class ConstantForceClient final : public HapticClient {
   int stall_at_ = -1;
   int stall_ms_ = 0;
   int nan_at_ = -1;
+  std::int64_t stall_started_ns_ = 0;
   long allocations_at_start_ = 0;
   long allocations_at_last_ = 0;
   double last_cost_us_ = 0.0;
 };
 
+// For tests that are not about stalls: a shared VM stalls the whole CPU for a few ms now and
+// then, which would (rightly) make the supervisor ramp; a long grace keeps it out of these tests.
 HapticLoopOptions quick_options(std::uint64_t cycles) {
   HapticLoopOptions o;
   o.max_cycles = cycles;
+  o.ramp.stale_timeout_s = 0.5;
   return o;
+}
+
+// For the stall tests: the default 2 ms grace and 8 ms ramp.
+HapticLoopOptions stall_options(std::uint64_t cycles) {
+  HapticLoopOptions o;
+  o.max_cycles = cycles;
+  return o;
+}
+
+// The first write below `f0` at or after `from_ns` (the event under test; a VM hiccup before it
+// may have ramped too), and the last full-force write before it.
+std::pair<std::size_t, std::size_t> ramp_start(const std::vector<LoggingDevice::Write>& w,
+                                               double f0, std::int64_t from_ns) {
+  for (std::size_t i = 1; i < w.size(); ++i) {
+    if (w[i].t_ns >= from_ns && w[i].force_n < f0 - 1e-9) {
+      std::size_t good = i;
+      while (good > 0 && w[good].force_n < f0 - 1e-9) {
+        --good;
+      }
+      return {good, i};
+    }
+  }
+  return {0, 0};
 }
 
 // Every write after the last full-force write before `from_ns` must lie under the ramp profile
@@ -160,7 +193,9 @@ TEST(HapticLoop, RunsTheCyclesAndMeasuresThem) {
   const auto writes = device.writes();
   ASSERT_GE(writes.size(), 301u);  // 300 cycles and the final zero (the supervisor may add some)
   EXPECT_EQ(writes.back().force_n, 0.0);  // stopping leaves the device pushing nothing
-  EXPECT_NEAR(writes[writes.size() - 2].force_n, 2.0, 1e-12);
+  const auto full = std::count_if(writes.begin(), writes.end(),
+                                  [](const auto& w) { return std::abs(w.force_n - 2.0) < 1e-12; });
+  EXPECT_GE(full, 290);
   for (std::size_t i = 1; i < writes.size(); ++i) {
     EXPECT_GE(writes[i].t_ns, writes[i - 1].t_ns);
   }
@@ -186,21 +221,15 @@ TEST(HapticLoop, StalledStepRampsForceToZeroThenComesBackGradually) {
   const double f0 = 4.0;
   ConstantForceClient client(Vec3(f0, 0, 0));
   client.stall_at(200, 60);  // one step takes 60 ms
-  const HapticLoopOptions options = quick_options(400);
+  const HapticLoopOptions options = stall_options(400);
   HapticLoop loop(device, client, options);
   loop.start();
   loop.wait();
   const auto w = device.writes();
   // The last full-force write before the stall, then the supervisor's writes.
-  std::size_t first_low = 0;
-  for (std::size_t i = 1; i < w.size(); ++i) {
-    if (w[i].force_n < f0 - 1e-9 && w[i - 1].force_n >= f0 - 1e-9) {
-      first_low = i;
-      break;
-    }
-  }
-  ASSERT_GT(first_low, 150u) << "no ramp found";
-  const std::int64_t t_good = w[first_low - 1].t_ns;
+  const auto [good, first_low] = ramp_start(w, f0, client.stall_started_ns());
+  ASSERT_GT(first_low, 0u) << "no ramp found";
+  const std::int64_t t_good = w[good].t_ns;
   // The stall lasts 60 ms: the supervisor reaches zero and writes zeros until cycles resume.
   std::size_t first_zero = 0;
   for (std::size_t i = first_low; i < w.size(); ++i) {
@@ -225,9 +254,13 @@ TEST(HapticLoop, StalledStepRampsForceToZeroThenComesBackGradually) {
   ASSERT_LT(resume + 3, w.size());
   EXPECT_LT(w[resume].force_n, 0.5 * f0) << "force jumped back after the stall";
   EXPECT_LT(w[resume].force_n, w[resume + 3].force_n);
-  EXPECT_NEAR(w[w.size() - 2].force_n, f0, 1e-9);  // and it does come back fully
+  double after = 0.0;  // and it does come back fully
+  for (std::size_t i = resume; i < w.size(); ++i) {
+    after = std::max(after, w[i].force_n);
+  }
+  EXPECT_NEAR(after, f0, 1e-9);
   const HapticLoopStatus st = loop.status();
-  EXPECT_EQ(st.stall_events, 1u);
+  EXPECT_GE(st.stall_events, 1u);      // the injected one (a VM hiccup may add its own)
   EXPECT_GE(st.missed_deadlines, 1u);  // the 60 ms period
   EXPECT_GT(st.ramp_cycles, 0u);
   EXPECT_GE(st.period_jitter_us.max, 50'000.0);
@@ -238,26 +271,20 @@ TEST(HapticLoop, DeviceThatHangsInReadIsRampedBySupervisor) {
   const double f0 = 3.0;
   ConstantForceClient client(Vec3(0, f0, 0));
   device.hang_at(150, 50);
-  const HapticLoopOptions options = quick_options(300);
+  const HapticLoopOptions options = stall_options(300);
   HapticLoop loop(device, client, options);
   loop.start();
   loop.wait();
   const auto w = device.writes();
-  std::size_t first_low = 0;
-  for (std::size_t i = 1; i < w.size(); ++i) {
-    if (w[i].force_n < f0 - 1e-9 && w[i - 1].force_n >= f0 - 1e-9) {
-      first_low = i;
-      break;
-    }
-  }
-  ASSERT_GT(first_low, 100u);
+  const auto [good, first_low] = ramp_start(w, f0, device.hang_started_ns());
+  ASSERT_GT(first_low, 0u) << "no ramp found";
   std::size_t first_zero = first_low;
   while (first_zero < w.size() && w[first_zero].force_n > 0.0) {
     ++first_zero;
   }
-  ASSERT_LT(first_zero, w.size() - 1);
-  expect_under_ramp_profile(w, f0, first_low, options.ramp, w[first_low - 1].t_ns, first_zero + 1);
-  EXPECT_EQ(loop.status().stall_events, 1u);
+  ASSERT_LT(first_zero, w.size() - 1) << "the force never reached zero during a 50 ms hang";
+  expect_under_ramp_profile(w, f0, first_low, options.ramp, w[good].t_ns, first_zero + 1);
+  EXPECT_GE(loop.status().stall_events, 1u);
 }
 
 TEST(HapticLoop, DeviceReportingItselfUnhealthyRampsToZeroAndStays) {
