@@ -23,7 +23,11 @@ TEST(TripleBuffer, ReaderSeesNoTornOrStaleSnapshotUnderStress) {
   TripleBuffer<Snapshot> buffer(Snapshot{});
   constexpr std::uint64_t kPublishes = 300'000;
   std::atomic<bool> done{false};
+  std::atomic<bool> go{false};
   std::thread writer([&] {
+    while (!go.load()) {
+      // start together with the reader, so the two really overlap
+    }
     for (std::uint64_t seq = 1; seq <= kPublishes; ++seq) {
       Snapshot& s = buffer.write_slot();
       for (auto& w : s.words) {
@@ -37,8 +41,13 @@ TEST(TripleBuffer, ReaderSeesNoTornOrStaleSnapshotUnderStress) {
   std::uint64_t torn = 0;
   std::uint64_t backwards = 0;
   std::uint64_t updates = 0;
-  while (!done.load() || buffer.update()) {
+  go.store(true);
+  for (;;) {
+    const bool finished = done.load();  // read before update(): the last publish is not missed
     if (!buffer.update()) {
+      if (finished) {
+        break;
+      }
       continue;
     }
     ++updates;
@@ -51,7 +60,6 @@ TEST(TripleBuffer, ReaderSeesNoTornOrStaleSnapshotUnderStress) {
     last_seen = seq;
   }
   writer.join();
-  buffer.update();
   EXPECT_EQ(torn, 0u);
   EXPECT_EQ(backwards, 0u);  // every update() gives a strictly newer snapshot
   EXPECT_GT(updates, 0u);
