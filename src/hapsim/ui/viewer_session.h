@@ -4,6 +4,7 @@
 // session when the user picks another scene, device, contact method or deformation method.
 #pragma once
 
+#include "hapsim/force/contact_material.h"
 #include "hapsim/render/render_scene.h"
 #include "hapsim/runtime/haptic_loop.h"
 #include "hapsim/world/device_io.h"
@@ -82,6 +83,12 @@ class ViewerSession {
   /// message in `error` when it cannot.
   virtual bool set_recording(const std::filesystem::path* path, std::string& error) = 0;
   [[nodiscard]] virtual bool recording() const = 0;
+  /// New contact parameters for material `material` (the control area's stiffness and limits),
+  /// applied by the haptic thread before its next step. False when this session has no such
+  /// material or the change could not be queued.
+  virtual bool set_material_contact(std::size_t /*material*/, const ContactMaterial& /*contact*/) {
+    return false;
+  }
 
  protected:
   ViewerSession() = default;

@@ -221,6 +221,14 @@ class WorldViewerSession final : public ViewerSession {
     return recorder_ != nullptr;
   }
 
+  bool set_material_contact(std::size_t material, const ContactMaterial& contact) override {
+    if (material >= materials_.size()) {
+      return false;
+    }
+    materials_[material] = contact;
+    return client_->request_material(static_cast<std::uint32_t>(material), contact);
+  }
+
   void draw_controls() override {
     WorldSceneOptions o = view_->options();
     bool changed = false;
@@ -261,10 +269,11 @@ class WorldViewerSession final : public ViewerSession {
         edited |= ImGui::SliderFloat("max force (N)", &f, 0.1f, 40.0f, "%.1f");
         edited |= ImGui::SliderFloat("max depth (mm)", &x, 0.5f, 30.0f, "%.1f");
         if (edited) {
-          c.stiffness_n_per_m = k;
-          c.max_force_n = f;
-          c.max_penetration_m = 1e-3 * x;
-          client_->request_material(static_cast<std::uint32_t>(m), c);
+          ContactMaterial changed = c;
+          changed.stiffness_n_per_m = k;
+          changed.max_force_n = f;
+          changed.max_penetration_m = 1e-3 * x;
+          set_material_contact(m, changed);
         }
         ImGui::PopID();
       }

@@ -1,0 +1,138 @@
+// The viewer's session for a World scene, without a window: the mouse probe's input reaches the
+// haptic thread and its force comes back in the readout (Hooke's law on a penalty sphere), a
+// stiffness change from the control area takes effect live, recording writes a file that reads
+// back with the world's hash, and an unknown device or a missing 3D mouse is a clear error.
+#include "hapsim/ui/world_viewer_session.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/device/interactive_device.h"
+#include "hapsim/device/recording.h"
+#include "hapsim/geometry/procedural.h"
+#include "hapsim/scene/scene_description.h"
+#include "hapsim/world/world.h"
+
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+namespace hapsim {
+namespace {
+
+// A soft (penalty) sphere of radius 30 mm at the origin, k = 300 N/m, rigid (no deflection, so
+// the force is exactly k·depth), and one point-like tool on the omega.3's limits.
+SceneDescription soft_sphere_scene() {
+  SceneDescription scene;
+  scene.file = "soft_sphere.json";
+  scene.device.profile = "omega3";
+  MaterialDescription m;
+  m.name = "muscle";
+  m.response = ContactResponse::kPenalty;
+  m.contact.stiffness_n_per_m = 300.0;
+  m.contact.max_penetration_m = 0.02;
+  m.contact.max_force_n = 10.0;
+  scene.world.materials.push_back(m);
+  BodyDescription body;
+  body.name = "ball";
+  body.kind = BodyKind::kStatic;
+  SegmentDescription seg;
+  seg.name = "sphere";
+  seg.mesh = make_uv_sphere(0.03, 96, 48);
+  body.segments.push_back(std::move(seg));
+  scene.world.bodies.push_back(std::move(body));
+  ToolDescription tool;
+  tool.name = "tip";
+  tool.radius_m = 0.0;
+  scene.world.tools.push_back(tool);
+  return scene;
+}
+
+void run_for(ViewerSession& session, double seconds) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (std::chrono::steady_clock::now() < end) {
+    session.update();
+    std::this_thread::sleep_for(std::chrono::milliseconds(16));
+  }
+  session.update();
+}
+
+TEST(WorldViewerSession, MouseProbeForceFollowsHookeAndLiveStiffness) {
+  ViewerConfig config;
+  config.scene = "soft_sphere.json";
+  config.device = "mouse";
+  const auto session = make_world_viewer_session(config, soft_sphere_scene());
+  InteractiveDevice* mouse = session->mouse_device();
+  ASSERT_NE(mouse, nullptr);
+  // 4 mm into the top of the sphere (the UV sphere's pole is a vertex: exact depth there).
+  DeviceInput in;
+  in.p_world = Vec3(0.0, 0.0, 0.026);
+  mouse->set_input(in);
+  run_for(*session, 0.3);
+  ASSERT_EQ(session->readout().tools.size(), 1u);
+  EXPECT_NEAR(session->readout().tools[0].force_n, 300.0 * 0.004, 0.02);
+  EXPECT_NEAR(mouse->last_command().force_world_n.z(), 300.0 * 0.004, 0.02);  // pushes up
+  EXPECT_GT(session->loop_status().cycles, 200u);
+  // The control area's stiffness change reaches the haptic thread: twice as stiff, twice the
+  // force at the same depth.
+  ContactMaterial stiffer = soft_sphere_scene().world.materials[0].contact;
+  stiffer.stiffness_n_per_m = 600.0;
+  ASSERT_TRUE(session->set_material_contact(0, stiffer));
+  run_for(*session, 0.2);
+  EXPECT_NEAR(session->readout().tools[0].force_n, 600.0 * 0.004, 0.04);
+  EXPECT_FALSE(session->set_material_contact(7, stiffer));  // no such material
+  // Out of the sphere: no force.
+  in.p_world = Vec3(0.0, 0.0, 0.05);
+  mouse->set_input(in);
+  run_for(*session, 0.1);
+  EXPECT_EQ(session->readout().tools[0].force_n, 0.0);
+}
+
+TEST(WorldViewerSession, RecordingWritesEveryCycleWithTheWorldsHash) {
+  ViewerConfig config;
+  config.scene = "soft_sphere.json";
+  config.device = "mouse";
+  const auto session = make_world_viewer_session(config, soft_sphere_scene());
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("hapsim_view_rec_" + std::to_string(::getpid()) + ".rec");
+  std::string error;
+  ASSERT_TRUE(session->set_recording(&path, error)) << error;
+  EXPECT_TRUE(session->recording());
+  run_for(*session, 0.5);
+  ASSERT_TRUE(session->set_recording(nullptr, error));
+  EXPECT_FALSE(session->recording());
+  const Recording r = read_recording(path);
+  EXPECT_GT(r.frames.size(), 300u);
+  for (std::size_t i = 1; i < r.frames.size(); ++i) {
+    ASSERT_EQ(r.frames[i].cycle_index, r.frames[i - 1].cycle_index + 1);  // none dropped
+  }
+  World reference(soft_sphere_scene().world);
+  EXPECT_EQ(r.header.scene_hash, reference.content_hash());
+  std::filesystem::remove(path);
+  const std::filesystem::path bad = "/nonexistent/dir/x.rec";
+  EXPECT_FALSE(session->set_recording(&bad, error));
+  EXPECT_NE(error.find("/nonexistent/dir/x.rec"), std::string::npos) << error;
+}
+
+TEST(WorldViewerSession, UnknownDeviceAndMissing3dMouseAreClearErrors) {
+  ViewerConfig config;
+  config.scene = "soft_sphere.json";
+  config.device = "joystick";
+  try {
+    (void)make_world_viewer_session(config, soft_sphere_scene());
+    FAIL() << "an unknown device was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("joystick"), std::string::npos) << e.what();
+  }
+  config.device = "spacemouse";
+  try {
+    (void)make_world_viewer_session(config, soft_sphere_scene());
+    GTEST_SKIP() << "a 3D mouse answered here (spacenavd is running)";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("3D mouse"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace hapsim
