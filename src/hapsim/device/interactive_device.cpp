@@ -2,7 +2,7 @@
 
 namespace hapsim {
 
-InteractiveDevice::InteractiveDevice(DeviceProfile profile, DeviceInput initial)
+InteractiveDevice::InteractiveDevice(DeviceProfile profile, const DeviceInput& initial)
     : profile_(std::move(profile)), input_(initial), command_(DeviceCommand{}) {}
 
 void InteractiveDevice::set_input(const DeviceInput& input) noexcept {

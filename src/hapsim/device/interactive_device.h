@@ -15,7 +15,7 @@ namespace hapsim {
 
 class InteractiveDevice final : public Device {
  public:
-  explicit InteractiveDevice(DeviceProfile profile, DeviceInput initial = {});
+  explicit InteractiveDevice(DeviceProfile profile, const DeviceInput& initial = {});
 
   // --- the driving thread (one) ---
 

@@ -163,7 +163,9 @@ constexpr int kLitFloats = 9;
 constexpr int kUnlitFloats = 6;
 
 const void* byte_offset(std::size_t floats) {
-  return reinterpret_cast<const void*>(floats * sizeof(float));
+  // GL's buffer-offset idiom: the "pointer" is a byte offset into the bound buffer.
+  return reinterpret_cast<const void*>(floats *
+                                       sizeof(float));  // NOLINT(performance-no-int-to-ptr)
 }
 
 static_assert(sizeof(TriangleIndices) == 3 * sizeof(std::uint32_t), "indices upload as is");
@@ -295,17 +297,19 @@ struct Renderer::Impl {
   }
 
   void set_lit_lighting(const Lighting& lighting, const Eigen::Matrix3d& R_CW) {
-    std::array<float, 3 * Lighting::kMaxLights> dirs{};
-    std::array<float, 3 * Lighting::kMaxLights> colours{};
+    constexpr auto kSlots = 3 * static_cast<std::size_t>(Lighting::kMaxLights);
+    std::array<float, kSlots> dirs{};
+    std::array<float, kSlots> colours{};
     const int count = std::min(static_cast<int>(lighting.lights.size()), Lighting::kMaxLights);
     for (int i = 0; i < count; ++i) {
       const DirectionalLight& light = lighting.lights[static_cast<std::size_t>(i)];
       Vec3 d_C = light.frame == LightFrame::kWorld ? Vec3(R_CW * light.direction_to_light)
                                                    : light.direction_to_light;
       d_C.normalize();
+      const auto base = 3 * static_cast<std::size_t>(i);
       for (int k = 0; k < 3; ++k) {
-        dirs[static_cast<std::size_t>(3 * i + k)] = static_cast<float>(d_C[k]);
-        colours[static_cast<std::size_t>(3 * i + k)] = light.colour[k];
+        dirs[base + static_cast<std::size_t>(k)] = static_cast<float>(d_C[k]);
+        colours[base + static_cast<std::size_t>(k)] = light.colour[k];
       }
     }
     glUniform1i(lit_u.light_count, count);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace hapsim {
 
@@ -54,7 +55,7 @@ Vec3 master_point_W(const Vec3& origin_W, double scale, const Vec3& p_master) {
 }  // namespace
 
 TeleopScene::TeleopScene(const TeleopWorld& world, TeleopSceneOptions options)
-    : world_(world), options_(options), scratch_(make_teleop_snapshot(world)) {
+    : world_(world), options_(std::move(options)), scratch_(make_teleop_snapshot(world)) {
   build_slave();
   build_gripper();
   // The sheet, placed by the environment; its x, y never change, z follows the heights.

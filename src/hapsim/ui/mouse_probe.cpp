@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace hapsim {
 
 MouseProbe::MouseProbe(const Vec3& start_W, MouseProbeOptions options)
-    : options_(options), p_W_(start_W) {
+    : options_(std::move(options)), p_W_(start_W) {
   place(start_W);
 }
 
