@@ -269,11 +269,11 @@ class WorldViewerSession final : public ViewerSession {
         edited |= ImGui::SliderFloat("max force (N)", &f, 0.1f, 40.0f, "%.1f");
         edited |= ImGui::SliderFloat("max depth (mm)", &x, 0.5f, 30.0f, "%.1f");
         if (edited) {
-          ContactMaterial changed = c;
-          changed.stiffness_n_per_m = k;
-          changed.max_force_n = f;
-          changed.max_penetration_m = 1e-3 * x;
-          set_material_contact(m, changed);
+          ContactMaterial edited_material = c;
+          edited_material.stiffness_n_per_m = k;
+          edited_material.max_force_n = f;
+          edited_material.max_penetration_m = 1e-3 * static_cast<double>(x);
+          set_material_contact(m, edited_material);
         }
         ImGui::PopID();
       }
