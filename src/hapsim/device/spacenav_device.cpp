@@ -31,7 +31,7 @@ SpacenavDevice::SpacenavDevice(DeviceProfile profile, SpacenavOptions options)
       }()) {
   if (spnav_open() == -1) {
     throw Error("3D mouse",
-                "no 3D mouse: the spacenavd daemon does not answer (is it installed and running, "
+                "none found: the spacenavd daemon does not answer (is it installed and running, "
                 "and a SpaceMouse plugged in?)");
   }
   reader_ = std::thread([this] { reader_main(); });

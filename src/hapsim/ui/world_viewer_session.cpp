@@ -3,6 +3,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/device/interactive_device.h"
 #include "hapsim/device/recording.h"
+#include "hapsim/kinematics/hand_model.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/scene/scene_device.h"
@@ -69,6 +70,19 @@ class WorldViewerSession final : public ViewerSession {
     // In front of the scene from the default camera (+Y, a little −X), a finger's width clear.
     probe_start_W_ =
         b.center() + Vec3(-0.2, 1.0, 0.0).normalized() * (0.5 * b.sizes().head<2>().norm() + 0.03);
+    if (scene_.world.has_hand) {
+      // A glove drives a hand: the probe is the tracker. Place it so that the fingertip nearest
+      // the scene (straight fingers, the device's orientation) lands on that spot and the others
+      // are farther out: the hand starts clear of the body.
+      const HandModel hand(scene_.world.hand);
+      const Vec3 towards_viewer = Vec3(-0.2, 1.0, 0.0).normalized();
+      const auto tips = hand.fingertips_world(GloveReading{});
+      Vec3 nearest = tips[0];
+      for (const Vec3& tip : tips) {
+        nearest = tip.dot(towards_viewer) < nearest.dot(towards_viewer) ? tip : nearest;
+      }
+      probe_start_W_ -= nearest;
+    }
     if (config.device == "mouse") {
       DeviceInput start;
       start.p_world = probe_start_W_;
