@@ -15,14 +15,8 @@ namespace hapsim::bench {
 namespace {
 
 ContactMethod method_from_name(const std::string& name) {
-  if (name == "exact") {
-    return ContactMethod::kExact;
-  }
-  if (name == "spheretree") {
-    return ContactMethod::kSphereTree;
-  }
-  if (name == "knee") {
-    return ContactMethod::kKnee;
+  if (const auto m = parse_contact_method(name)) {
+    return *m;
   }
   throw Error("--methods", "unknown method '" + name + "', expected exact, spheretree or knee");
 }

@@ -164,13 +164,7 @@ class TeleopSnapshots {
 };
 
 ContactMethod parse_method(const std::string& name) {
-  if (name == "exact") {
-    return ContactMethod::kExact;
-  }
-  if (name == "spheretree") {
-    return ContactMethod::kSphereTree;
-  }
-  return ContactMethod::kKnee;  // CLI11 has checked the name
+  return parse_contact_method(name).value_or(ContactMethod::kKnee);  // CLI11 has checked it
 }
 
 nlohmann::json summary_json(const SceneDescription& scene, const World& world,

@@ -21,14 +21,8 @@ namespace hapsim {
 namespace {
 
 ContactMethod method_from(const std::string& name) {
-  if (name == "exact") {
-    return ContactMethod::kExact;
-  }
-  if (name == "spheretree") {
-    return ContactMethod::kSphereTree;
-  }
-  if (name == "knee") {
-    return ContactMethod::kKnee;
+  if (const auto m = parse_contact_method(name)) {
+    return *m;
   }
   throw Error("contact method", "expected exact, spheretree or knee, got '" + name + "'");
 }

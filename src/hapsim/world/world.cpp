@@ -31,6 +31,16 @@ std::string_view to_string(ContactMethod method) {
   return "unknown";
 }
 
+std::optional<ContactMethod> parse_contact_method(std::string_view name) {
+  for (const ContactMethod m :
+       {ContactMethod::kExact, ContactMethod::kSphereTree, ContactMethod::kKnee}) {
+    if (name == to_string(m)) {
+      return m;
+    }
+  }
+  return std::nullopt;
+}
+
 std::string_view to_string(BodyKind kind) {
   switch (kind) {
     case BodyKind::kStatic:

@@ -11,6 +11,7 @@
 #include "hapsim/kinematics/hand_model.h"
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -43,6 +44,8 @@ enum class BodyKind : std::uint8_t {
 [[nodiscard]] std::string_view to_string(ContactResponse response);
 [[nodiscard]] std::string_view to_string(ContactMethod method);
 [[nodiscard]] std::string_view to_string(BodyKind kind);
+/// "exact" | "spheretree" | "knee" (to_string's names); nullopt for anything else.
+[[nodiscard]] std::optional<ContactMethod> parse_contact_method(std::string_view name);
 
 struct MaterialDescription {
   std::string name;
