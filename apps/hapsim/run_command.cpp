@@ -244,6 +244,15 @@ void run(const RunArgs& args) {
       throw CommandError("--json " + args.json_path + ": cannot open for writing");
     }
   }
+  if (!args.snapshot_path.empty()) {
+    // Fail before the run, not after it: the folder must be there.
+    const std::filesystem::path folder = std::filesystem::path(args.snapshot_path).parent_path();
+    if (!folder.empty() && !std::filesystem::is_directory(folder)) {
+      throw CommandError("--snapshot " + args.snapshot_path + ": no such folder " +
+                         folder.string());
+    }
+    (void)parse_size(args.size);
+  }
   std::optional<std::filesystem::path> trajectory;
   if (!args.device.empty() && args.device != "sim") {
     if (args.device.rfind("sim:", 0) != 0 || args.device.size() <= 4) {

@@ -40,9 +40,10 @@ void view(const ViewArgs& args) {
   o.config.deformation = args.deformation;
   char x = 0;
   std::istringstream size(args.size);
-  if (!(size >> o.width_px >> x >> o.height_px) || x != 'x' || o.width_px < 320 ||
-      o.height_px < 240) {
-    throw CommandError("--size " + args.size + ": expected WIDTHxHEIGHT, at least 320x240");
+  if (!(size >> o.width_px >> x >> o.height_px) || x != 'x' || !size.eof() || o.width_px < 320 ||
+      o.height_px < 240 || o.width_px > 8192 || o.height_px > 8192) {
+    throw CommandError("--size " + args.size +
+                       ": expected WIDTHxHEIGHT, from 320x240 to 8192x8192 pixels");
   }
   o.vsync = !args.no_vsync;
   o.panels = !args.no_panels;

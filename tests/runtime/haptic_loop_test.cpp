@@ -105,6 +105,10 @@ class ConstantForceClient final : public HapticClient {
     return command_;
   }
   void after_cycle(const HapticCycle& cycle) noexcept override { last_cost_us_ = cycle.cost_us; }
+  bool take_soft_start() noexcept override {
+    return soft_at_ >= 0 && steps_ == static_cast<std::uint64_t>(soft_at_) + 1;
+  }
+  void soft_start_at(int step) { soft_at_ = step; }
 
   void stall_at(int step, int ms) {
     stall_at_ = step;
@@ -124,6 +128,7 @@ class ConstantForceClient final : public HapticClient {
   int stall_at_ = -1;
   int stall_ms_ = 0;
   int nan_at_ = -1;
+  int soft_at_ = -1;
   std::int64_t stall_started_ns_ = 0;
   long allocations_at_start_ = 0;
   long allocations_at_last_ = 0;
@@ -356,6 +361,43 @@ TEST(HapticLoop, StopRequestEndsAnEndlessLoop) {
   EXPECT_GE(loop.status().cycles, 20u);
   EXPECT_EQ(device.writes().back().force_n, 0.0);
   loop.stop();  // idempotent
+}
+
+TEST(HapticLoop, EndingByItselfLeavesTheDeviceAtZeroBeforeAnyoneWaits) {
+  LoggingDevice device(device_profile("omega3"));
+  ConstantForceClient client(Vec3(0, 0, 4.0));
+  HapticLoop loop(device, client, quick_options(100));
+  loop.start();
+  while (loop.running()) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  // Not waited for yet: the haptic thread's own last write was zero.
+  const auto w = device.writes();
+  ASSERT_GE(w.size(), 101u);
+  EXPECT_EQ(w.back().force_n, 0.0);
+  loop.wait();
+}
+
+TEST(HapticLoop, SoftStartBringsTheForceBackOverTheRampTime) {
+  LoggingDevice device(device_profile("omega3"));
+  const double f0 = 6.0;
+  ConstantForceClient client(Vec3(f0, 0, 0));
+  client.soft_start_at(100);  // e.g. a simulation resumed after a pause
+  const HapticLoopOptions options = quick_options(200);
+  HapticLoop loop(device, client, options);
+  loop.start();
+  loop.wait();
+  const auto w = device.writes();
+  ASSERT_GE(w.size(), 200u);
+  EXPECT_NEAR(w[99].force_n, f0, 1e-9);
+  // From zero, up in equal steps, full at the end of the ramp time (8 cycles of 1 ms).
+  const int ramp_cycles =
+      static_cast<int>(std::lround(options.ramp.ramp_duration_s / options.period_s));
+  for (int i = 0; i < ramp_cycles; ++i) {
+    EXPECT_NEAR(w[static_cast<std::size_t>(100 + i)].force_n, f0 * (i + 1) / ramp_cycles, 1e-9)
+        << i;
+  }
+  EXPECT_LT(w[100].force_n, 0.2 * f0);
 }
 
 TEST(HapticLoop, BadOptionsAreErrors) {

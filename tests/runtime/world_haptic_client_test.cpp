@@ -210,6 +210,29 @@ TEST(WorldHapticClient, KneeSceneWithItsScriptedDeviceAllocatesNothingOnTheHapti
             0.001);  // it did press the skin
 }
 
+// Back from a pause with the device moved deep into the soft ball: no velocity from where the
+// tool was before the pause (no damping spike: the force is the spring's, k·x), and the loop is
+// asked to bring the force back gradually.
+TEST(WorldHapticClient, ResumingAfterAPauseHasNoDampingSpikeAndAsksForASoftStart) {
+  World world(soft_ball_world());
+  WorldHapticClient client(world);
+  DeviceInput in;
+  in.p_world = Vec3(0.2, 0.0, 0.05);  // well above the ball (top at z = 0)
+  (void)client.step(in, 0.001);
+  EXPECT_FALSE(client.take_soft_start());
+  client.set_paused(true);
+  in.p_world = Vec3(0.2, 0.0, -0.005 + 0.004);  // meanwhile 5 mm into the ball
+  for (int i = 0; i < 5; ++i) {
+    EXPECT_EQ(client.step(in, 0.001).force_world_n.norm(), 0.0);
+  }
+  client.set_paused(false);
+  const double f = client.step(in, 0.001).force_world_n.norm();
+  EXPECT_TRUE(client.take_soft_start());
+  EXPECT_FALSE(client.take_soft_start());  // once
+  // 300 N/m · 5 mm = 1.5 N; 50 mm in 1 ms through the damping floor would add ~15 N.
+  EXPECT_NEAR(f, 1.5, 0.1);
+}
+
 TEST(WorldHapticClient, ResetAndPauseReachTheSnapshot) {
   World world(soft_ball_world());
   SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);

@@ -22,7 +22,11 @@ SnapshotWriter::SnapshotWriter(int width_px, int height_px, int samples)
 
 SnapshotWriter::~SnapshotWriter() {
   if (context_) {
-    context_->make_current();  // the renderer frees its GL objects in its own context
+    try {
+      context_->make_current();  // the renderer frees its GL objects in its own context
+    } catch (...) {
+      // A context that cannot be made current any more: its objects go with it.
+    }
   }
   renderer_.reset();
   context_.reset();

@@ -1,8 +1,8 @@
 #include "hapsim/runtime/haptic_loop.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/runtime/deadline_clock.h"
 #include "hapsim/core/triple_buffer.h"
+#include "hapsim/runtime/deadline_clock.h"
 
 #include <spdlog/spdlog.h>
 
@@ -177,6 +177,9 @@ void HapticLoop::haptic_thread_main() noexcept {
     }
     const double now_s = 1e-9 * static_cast<double>(c0 - start_ns);
     DeviceCommand out = s.watchdog.update(now_s, fresh, healthy);
+    if (client_.take_soft_start()) {
+      resume_limit = 0.0;
+    }
     // Force comes back gradually after any ramp (the supervisor's or the watchdog's own).
     resume_limit = std::min(1.0, resume_limit + resume_per_cycle);
     resume_limit = std::min(resume_limit, s.supervisor_gain.exchange(1.0));
@@ -215,6 +218,15 @@ void HapticLoop::haptic_thread_main() noexcept {
     cycle.healthy = healthy;
     client_.after_cycle(cycle);
   }
+  // Leave the device pushing nothing before anyone can stop watching it (the caller may not
+  // reach wait() for a while). The supervisor's ramp base becomes zero too.
+  DeviceCommand zero;
+  zero.finger_count = device_.profile().finger_count;
+  s.last_written.write_slot() = zero;
+  s.last_written.publish();
+  while (!try_write(zero)) {
+    // The supervisor is writing right now: it holds the device for one write only.
+  }
   s.end_ns.store(monotonic_ns());
   running_.store(false, std::memory_order_release);
 }
@@ -222,6 +234,11 @@ void HapticLoop::haptic_thread_main() noexcept {
 // Not on the haptic path: may log (and so allocate) when something happens.
 void HapticLoop::supervisor_thread_main() noexcept {
   Shared& s = *shared_;
+  // Above the haptic thread where real-time scheduling is allowed: it sleeps almost always, and
+  // it must still run when the machine is busy (its wake-ups bound the ramp's timing).
+  if (options_.realtime_priority) {
+    (void)try_set_realtime_priority(options_.fifo_priority + 1);
+  }
   const auto period_ns =
       static_cast<std::int64_t>(std::llround(options_.supervisor_period_s * 1e9));
   DeviceCommand base;  // the last command the haptic thread wrote
@@ -236,7 +253,10 @@ void HapticLoop::supervisor_thread_main() noexcept {
     next_ns = std::max(next_ns, now_ns - period_ns);  // after a long preemption, no burst
     const std::int64_t heartbeat = s.heartbeat_ns.load(std::memory_order_acquire);
     const double since_s = 1e-9 * static_cast<double>(now_ns - heartbeat);
-    if (since_s > options_.ramp.stale_timeout_s && running_.load(std::memory_order_acquire)) {
+    // Nothing to watch before the first cycle has written anything (start-up, RT set-up).
+    const bool started = s.cycles.load(std::memory_order_acquire) > 0;
+    if (started && since_s > options_.ramp.stale_timeout_s &&
+        running_.load(std::memory_order_acquire)) {
       if (!stalled) {
         stalled = true;
         stall_start_ns = heartbeat;

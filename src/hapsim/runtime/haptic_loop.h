@@ -13,7 +13,8 @@
 // ramp.stale_timeout_s (the step overran, stalled, or the device read hung) the supervisor ramps
 // the last good command to zero so that the output is zero by ramp.zero_by_s() (10 ms by
 // default) after the last good cycle, and logs the event. When cycles resume, the force comes
-// back over ramp.ramp_duration_s instead of jumping (no kick in the user's hand).
+// back over ramp.ramp_duration_s instead of jumping (no kick in the user's hand). When the loop
+// ends (max_cycles or stop()), the haptic thread's last write is a zero command.
 #pragma once
 
 #include "hapsim/device/device.h"
@@ -70,6 +71,10 @@ class HapticClient {
   virtual const DeviceCommand& step(const DeviceInput& input, double dt_s) = 0;
   /// haptic path, after the device write (outside the timed cost): publish snapshots.
   virtual void after_cycle(const HapticCycle& /*cycle*/) noexcept {}
+  /// haptic path, right after step(): true when the force should come back from zero over the
+  /// ramp time instead of at once (the simulation resumed after a pause or a reset, with the
+  /// device possibly deep inside a body by now).
+  virtual bool take_soft_start() noexcept { return false; }
 
  protected:
   HapticClient() = default;

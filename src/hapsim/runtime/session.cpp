@@ -344,6 +344,11 @@ SessionSummary run_session(World& world, Device& device, const SessionOptions& o
     throw Error("session", "dt must be in (0, 0.1] s, got " + std::to_string(options.dt_s));
   }
   const auto steps = static_cast<std::size_t>(std::llround(options.duration_s / options.dt_s));
+  if (steps == 0) {
+    throw Error("session", "duration " + std::to_string(options.duration_s) +
+                               " s is shorter than one step of " + std::to_string(options.dt_s) +
+                               " s");
+  }
   return options.realtime ? run_realtime(world, device, options, steps)
                           : run_inline(world, device, options, steps);
 }

@@ -11,7 +11,12 @@ TeleopHapticClient::TeleopHapticClient(TeleopWorld& world, TeleopHapticClientOpt
 
 // haptic path
 const DeviceCommand& TeleopHapticClient::step(const DeviceInput& input, double dt_s) {
-  if (paused_.load(std::memory_order_relaxed)) {
+  const bool paused = paused_.load(std::memory_order_relaxed);
+  if (paused != was_paused_) {
+    was_paused_ = paused;
+    soft_start_ = !paused;  // back from a pause: the master's torques come back gradually
+  }
+  if (paused) {
     return zero_command_;
   }
   const DeviceCommand& command = world_.step(input, dt_s).command;

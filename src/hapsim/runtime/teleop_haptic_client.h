@@ -35,6 +35,12 @@ class TeleopHapticClient final : public HapticClient {
   /// Any thread: stop stepping the world (the slave and the ball freeze, zero torque) or go on.
   /// (TeleopWorld has no reset yet, so there is no request_reset() here.)
   void set_paused(bool paused) { paused_.store(paused, std::memory_order_relaxed); }
+  /// haptic path: true once after a pause ends.
+  bool take_soft_start() noexcept override {
+    const bool soft = soft_start_;
+    soft_start_ = false;
+    return soft;
+  }
   [[nodiscard]] bool paused() const { return paused_.load(std::memory_order_relaxed); }
 
   /// Cycles that stepped the world (read from any thread).
@@ -46,6 +52,8 @@ class TeleopHapticClient final : public HapticClient {
   DeviceCommand zero_command_;
   std::unique_ptr<TripleBuffer<TeleopSnapshot>> snapshots_;
   std::atomic<bool> paused_{false};
+  bool was_paused_ = false;  // haptic thread only
+  bool soft_start_ = false;
   std::atomic<std::uint64_t> steps_{0};
 };
 

@@ -40,6 +40,7 @@ WorldHapticClient::WorldHapticClient(World& world, WorldHapticClientOptions opti
 const DeviceCommand& WorldHapticClient::step(const DeviceInput& input, double dt_s) {
   if (reset_requested_.exchange(false, std::memory_order_acquire)) {
     world_.reset();
+    soft_start_ = true;
     // Every vertex may have moved back to rest (a rare O(vertices) cycle, asked for by a user).
     for (DeformableSegment& seg : deformable_) {
       for (std::size_t k = 0; k < 3; ++k) {
@@ -60,7 +61,17 @@ const DeviceCommand& WorldHapticClient::step(const DeviceInput& input, double dt
     material_changes_.pop();
   }
   stepped_ = false;
-  if (paused_.load(std::memory_order_relaxed)) {
+  const bool paused = paused_.load(std::memory_order_relaxed);
+  if (paused != was_paused_) {
+    was_paused_ = paused;
+    if (!paused) {
+      // Back from a pause: the device may have moved far meanwhile. No velocity from the old
+      // position (no damping spike), and the force comes back gradually.
+      world_.forget_tool_motion();
+      soft_start_ = true;
+    }
+  }
+  if (paused) {
     last_result_ = &world_.last_result();
     return zero_command_;
   }

@@ -36,6 +36,12 @@ class WorldHapticClient final : public HapticClient {
   const DeviceCommand& step(const DeviceInput& input, double dt_s) override;
   /// haptic path
   void after_cycle(const HapticCycle& cycle) noexcept override;
+  /// haptic path: true once after a pause ends or a reset.
+  bool take_soft_start() noexcept override {
+    const bool soft = soft_start_;
+    soft_start_ = false;
+    return soft;
+  }
 
   /// Reader side of the snapshots (one reader thread), null when not publishing.
   [[nodiscard]] TripleBuffer<WorldSnapshot>* snapshots() { return snapshots_.get(); }
@@ -78,7 +84,9 @@ class WorldHapticClient final : public HapticClient {
   World& world_;
   WorldHapticClientOptions options_;
   const StepResult* last_result_ = nullptr;
-  bool stepped_ = false;  // this cycle stepped the world (not paused)
+  bool stepped_ = false;     // this cycle stepped the world (not paused)
+  bool was_paused_ = false;  // haptic thread's view of the last cycle
+  bool soft_start_ = false;
   DeviceCommand zero_command_;
   std::unique_ptr<TripleBuffer<WorldSnapshot>> snapshots_;
   std::unique_ptr<SpscRing<CycleRecord>> records_;

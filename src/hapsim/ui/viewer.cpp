@@ -254,21 +254,24 @@ class Viewer {
 
   void rebuild(const ViewerConfig& config) {
     std::unique_ptr<ViewerSession> next;
+    session_.reset();  // one haptic loop (and one exclusive device) at a time
     try {
-      session_.reset();  // one haptic loop at a time
       next = make_session(config);
       config_ = config;
       status_message_.clear();
     } catch (const std::exception& e) {
       status_message_ = e.what();
       spdlog::error("viewer: {}", status_message_);
-      if (!session_ && !(config == config_)) {
-        next = make_session(config_);  // back to what worked
-      } else if (!next) {
-        throw;
+      try {
+        next = make_session(config_);  // back to what ran before
+      } catch (const std::exception& again) {
+        // Nothing can run (e.g. the scene file was broken while open): end with both reasons.
+        throw Error(config_.scene.string(),
+                    status_message_ + "; and again with the previous settings: " + again.what());
       }
     }
     session_ = std::move(next);
+    session_->set_paused(paused_);
     pending_config_ = config_;
     glfwSetWindowTitle(window_, ("hapsim — " + session_->title()).c_str());
     int fb_w = 0;

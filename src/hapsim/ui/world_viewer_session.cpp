@@ -120,6 +120,7 @@ class WorldViewerSession final : public ViewerSession {
   ~WorldViewerSession() override {
     loop_->stop();
     if (recorder_) {
+      drain_records();  // the last cycles too
       recorder_->close();
     }
   }
@@ -128,18 +129,24 @@ class WorldViewerSession final : public ViewerSession {
   WorldViewerSession(WorldViewerSession&&) = delete;
   WorldViewerSession& operator=(WorldViewerSession&&) = delete;
 
-  void update() override {
-    // Every cycle's record: to the recorder while recording, else let go.
+  // Every cycle's record: to the recorder while recording, else let go.
+  void drain_records() {
     SpscRing<CycleRecord>& records = *client_->records();
     while (const CycleRecord* r = records.front()) {
       if (recorder_) {
-        recorder_->record(to_recorded_frame(*r));
+        if (!recorder_->record(to_recorded_frame(*r))) {
+          ++recorded_dropped_;
+        }
         if (recorder_->frames_buffered() >= recorder_->capacity_frames() / 2) {
           recorder_->flush();
         }
       }
       records.pop();
     }
+  }
+
+  void update() override {
+    drain_records();
     TripleBuffer<WorldSnapshot>& snapshots = *client_->snapshots();
     snapshots.update();
     const WorldSnapshot& s = snapshots.read_slot();
@@ -212,13 +219,22 @@ class WorldViewerSession final : public ViewerSession {
   bool set_recording(const std::filesystem::path* path, std::string& error) override {
     if (path == nullptr) {
       if (recorder_) {
+        drain_records();
         recorder_->close();
         recorder_.reset();
       }
       return true;
     }
     try {
-      recorder_ = std::make_unique<SessionRecorder>(*path, world_->content_hash(), 8192);
+      // The hash of what the haptic thread runs: the scene with the materials as edited here
+      // (computed from this thread's copy; the world's own is the haptic thread's).
+      WorldDescription running = scene_.world;
+      for (std::size_t m = 0; m < materials_.size(); ++m) {
+        running.materials[m].contact = materials_[m];
+      }
+      drain_records();  // start with the next cycle
+      recorder_ = std::make_unique<SessionRecorder>(*path, content_hash(running), 8192);
+      recorded_dropped_ = 0;
       return true;
     } catch (const std::exception& e) {
       error = e.what();
@@ -230,7 +246,8 @@ class WorldViewerSession final : public ViewerSession {
   }
 
   bool set_material_contact(std::size_t material, const ContactMaterial& contact) override {
-    if (material >= materials_.size()) {
+    // A recording names the materials it was made with (its hash): no edits during one.
+    if (material >= materials_.size() || recorder_) {
       return false;
     }
     materials_[material] = contact;
@@ -265,6 +282,11 @@ class WorldViewerSession final : public ViewerSession {
       }
     }
     if (ImGui::CollapsingHeader("Stiffness and limits")) {
+      if (recorder_) {
+        ImGui::TextWrapped(
+            "Recording: stop it to change materials (a recording names its "
+            "materials).");
+      }
       for (std::size_t m = 0; m < materials_.size(); ++m) {
         ContactMaterial& c = materials_[m];
         ImGui::PushID(static_cast<int>(m));
@@ -298,6 +320,7 @@ class WorldViewerSession final : public ViewerSession {
   std::unique_ptr<WorldHapticClient> client_;
   std::unique_ptr<HapticLoop> loop_;
   std::unique_ptr<SessionRecorder> recorder_;
+  std::size_t recorded_dropped_ = 0;
   std::vector<ContactMaterial> materials_;  // the UI's copy (the world's is the haptic thread's)
   SessionReadout readout_;
   Vec3 probe_start_W_ = Vec3::Zero();

@@ -284,6 +284,12 @@ ContactMaterial World::effective_material(std::uint32_t material, double dt_s) c
   return m;
 }
 
+void World::forget_tool_motion() noexcept {
+  for (auto& tool : tools_) {
+    tool->has_previous = false;
+  }
+}
+
 bool World::set_material_contact(std::uint32_t material, const ContactMaterial& c) noexcept {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };
@@ -498,6 +504,10 @@ void World::reset() {
 }
 
 std::string World::content_hash() const {
+  return hapsim::content_hash(description_);
+}
+
+std::string content_hash(const WorldDescription& description_) {
   Fnv64 h;
   h.text(description_.name);
   for (const MaterialDescription& m : description_.materials) {

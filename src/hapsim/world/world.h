@@ -72,6 +72,9 @@ struct StepResult {
   std::int32_t dropped_contacts = 0;
 };
 
+/// A content hash of a world description (meshes, materials, tools), as recordings carry it.
+[[nodiscard]] std::string content_hash(const WorldDescription& description);
+
 class World {
  public:
   /// Builds every query structure and deformation state. Throws hapsim::Error naming the body
@@ -91,6 +94,9 @@ class World {
   /// nothing, for a bad index or values a step cannot use (non-finite, stiffness, limits ≤ 0,
   /// negative damping or friction, dynamic above static friction).
   bool set_material_contact(std::uint32_t material, const ContactMaterial& contact) noexcept;
+  /// haptic path. The next step takes the tools' positions as new, with no velocity from where
+  /// they were (after a pause, the device may have moved far: no damping spike).
+  void forget_tool_motion() noexcept;
 
   [[nodiscard]] const WorldDescription& description() const { return description_; }
   [[nodiscard]] const StepResult& last_result() const { return result_; }
@@ -116,7 +122,8 @@ class World {
   /// The material a step actually uses (stiffness clamped, damping floor applied for `dt_s`).
   [[nodiscard]] ContactMaterial effective_material(std::uint32_t material, double dt_s) const;
 
-  /// A content hash of the description (meshes, materials, tools), for recordings.
+  /// A content hash of the description (meshes, materials, tools), for recordings; the same as
+  /// content_hash(description()).
   [[nodiscard]] std::string content_hash() const;
   /// Bytes of all query structures (meshes excluded).
   [[nodiscard]] std::size_t query_memory_bytes() const;
