@@ -45,6 +45,9 @@ class Device {
 
   /// haptic path: non-blocking, no allocation, no throw. The command must already be clamped
   /// to profile() (force_safety.h); a device may clamp again but never amplifies.
+  /// Threads: the real-time loop calls write() from the haptic thread and, while a cycle is
+  /// stalled, from its supervisor — possibly while the haptic thread is inside read(), never
+  /// two write() calls at once.
   virtual void write(const DeviceCommand& command) noexcept = 0;
 
   /// Rated limits; constant for the device's lifetime.

@@ -35,8 +35,13 @@ void LatencyHistogram::record_us(double value_us) noexcept {
   bin.store(bin.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   const double v = std::isfinite(value_us) ? std::max(0.0, value_us) : 0.0;
   sum_us_.store(sum_us_.load(std::memory_order_relaxed) + v, std::memory_order_relaxed);
-  if (v > max_us_.load(std::memory_order_relaxed)) {
-    max_us_.store(v, std::memory_order_relaxed);
+  // A non-finite sample lands in the overflow bin: the maximum says so (infinite).
+  const double as_max = std::isfinite(value_us) ? v
+                        : std::isnan(value_us) || value_us > 0.0
+                            ? std::numeric_limits<double>::infinity()
+                            : 0.0;
+  if (as_max > max_us_.load(std::memory_order_relaxed)) {
+    max_us_.store(as_max, std::memory_order_relaxed);
   }
   count_.store(count_.load(std::memory_order_relaxed) + 1, std::memory_order_release);
 }

@@ -107,7 +107,7 @@ class WorldViewerSession final : public ViewerSession {
                   "expected mouse, sim, sim:FILE or spacemouse, got '" + config.device + "'");
     }
     WorldHapticClientOptions co;
-    co.record_capacity = 4096;
+    co.record_capacity = 1024;  // drained every frame: 1 s of slack at 1 fps
     client_ = std::make_unique<WorldHapticClient>(*world_, co);
     loop_ = std::make_unique<HapticLoop>(*device_, *client_);
     title_ = scene_.file.filename().string() + " — " + device_name_;
