@@ -274,11 +274,15 @@ void run(const RunArgs& args) {
   const Stopwatch load_watch;
   SceneDescription scene = load_scene(args.scene, load_options);
   if (scene.is_teleop) {
-    if (!args.replay_path.empty() || !args.record_path.empty() || !args.method.empty() ||
-        args.realtime) {
+    if (!args.replay_path.empty() || !args.record_path.empty() || !args.method.empty()) {
       throw CommandError(args.scene +
-                         ": --record, --replay, --method and --realtime are not available for "
+                         ": --record, --replay and --method are not available for "
                          "teleoperation scenes yet");
+    }
+    if (args.realtime && args.snapshot_every > 0) {
+      throw CommandError(
+          "--snapshot-every: not with --realtime (the haptic thread owns the world "
+          "while it runs; the final snapshot is written after the run)");
     }
     TeleopRunOptions teleop;
     std::unique_ptr<TeleopSnapshots> snapshots;
@@ -298,6 +302,8 @@ void run(const RunArgs& args) {
       };
     }
     teleop.duration_s = args.duration_s;
+    teleop.realtime = args.realtime;
+    teleop.spin_s = 1e-6 * args.spin_us;
     teleop.trajectory = trajectory;
     teleop.json_path = args.json_path;
     teleop.progress = progress;

@@ -8,15 +8,22 @@
 #include "commands.h"
 
 #include "hapsim/core/stopwatch.h"
+#include "hapsim/device/device_profile.h"
+#include "hapsim/device/simulated_device.h"
+#include "hapsim/runtime/haptic_loop.h"
+#include "hapsim/runtime/teleop_haptic_client.h"
 #include "hapsim/scene/teleop_setup.h"
 #include "hapsim/world/teleop_world.h"
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
+#include <thread>
 #include <vector>
 
 namespace hapsim::app {
@@ -74,15 +81,8 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
   double slave_error = 0.0;
   std::size_t nonfinite = 0;
   const double start_z = world.ball().p_world().z();
-  const Stopwatch wall;
-  for (std::size_t k = 1; k <= steps; ++k) {
-    const DeviceInput in = trajectory.sample_at(trajectory.start_time_s() + k * dt);
-    const Stopwatch watch;
-    const TeleopStepResult& r = world.step(in, dt);
-    step_us.push_back(watch.elapsed_s() * 1e6);
-    if (options.after_step) {
-      options.after_step(world, k);
-    }
+  const auto account = [&](const TeleopStepResult& r, double cost_us) {
+    step_us.push_back(cost_us);
     if (r.gripper.grasped_now && !grasped) {
       grasped = true;
       grasp_time = r.time_s;
@@ -95,9 +95,59 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
     deepest_sheet = std::max(deepest_sheet, r.sheet_depth_m);
     slave_error = std::max(slave_error, r.slave.position_error_m);
     nonfinite += r.ball_p_world.allFinite() ? 0 : 1;
+    const std::size_t k = step_us.size();
     if (options.progress && k % std::max<std::size_t>(steps / 100, 1) == 0) {
-      options.progress("run", static_cast<double>(k) / static_cast<double>(steps));
+      options.progress(options.realtime ? "run (real time)" : "run",
+                       static_cast<double>(k) / static_cast<double>(steps));
     }
+  };
+  std::optional<HapticLoopStatus> realtime;
+  std::uint64_t dropped_records = 0;
+  const Stopwatch wall;
+  if (!options.realtime) {
+    for (std::size_t k = 1; k <= steps; ++k) {
+      const DeviceInput in = trajectory.sample_at(trajectory.start_time_s() + k * dt);
+      const Stopwatch watch;
+      const TeleopStepResult& r = world.step(in, dt);
+      const double cost_us = watch.elapsed_s() * 1e6;
+      if (options.after_step) {
+        options.after_step(world, k);
+      }
+      account(r, cost_us);
+    }
+  } else {
+    // The same cycles on the real-time haptic thread: cycle i plays the trajectory at
+    // start + (i + 1)·dt as the inline loop does; every result comes back through a ring.
+    const Trajectory& played = trajectory;
+    SimulatedDevice device(
+        device_profile("simulated"),
+        [&played, dt](double t_s) { return played.sample_at(played.start_time_s() + t_s + dt); },
+        static_cast<double>(steps) * dt);
+    TeleopHapticClientOptions co;
+    co.publish_snapshots = false;
+    co.record_capacity = 4096;
+    TeleopHapticClient client(world, co);
+    HapticLoopOptions lo;
+    lo.period_s = dt;
+    lo.max_cycles = steps;
+    lo.missed_period_s = 2.0 * dt;
+    lo.spin_s = options.spin_s;
+    HapticLoop loop(device, client, lo);
+    loop.start();
+    for (;;) {
+      const bool running = loop.running();  // before draining: nothing is left behind
+      while (const TeleopCycleRecord* r = client.records()->front()) {
+        account(r->result, r->cost_us);
+        client.records()->pop();
+      }
+      if (!running) {
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    loop.wait();
+    realtime = loop.status();
+    dropped_records = client.dropped_records();
   }
   const double wall_s = wall.elapsed_s();
   if (options.finished) {
@@ -125,6 +175,15 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
   std::printf("\nsheet        deepest dent %.3f mm\n", deepest_sheet * 1e3);
   std::printf("slave        largest tip error while tracking %.3f mm\n", slave_error * 1e3);
   std::printf("step cost: p50 %.2f us, p99 %.2f us, max %.1f us\n", p50, p99, max_us);
+  if (realtime) {
+    std::printf(
+        "real time: %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f us; "
+        "missed deadlines (period > 2x): %llu; stalls ramped: %llu\n",
+        realtime->rate_hz, realtime->realtime_priority ? "SCHED_FIFO" : "normal scheduling",
+        realtime->period_jitter_us.p50, realtime->period_jitter_us.p99,
+        realtime->period_jitter_us.max, static_cast<unsigned long long>(realtime->missed_deadlines),
+        static_cast<unsigned long long>(realtime->stall_events));
+  }
 
   const bool ok =
       nonfinite == 0 && (!has_target || (grasped && release_time >= 0.0 && target_error <= 0.005));
@@ -151,6 +210,19 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
     j["max_slave_tracking_error_m"] = slave_error;
     j["step_us"] = {{"p50", p50}, {"p99", p99}, {"max", max_us}};
     j["wall_s"] = wall_s;
+    if (realtime) {
+      j["realtime"] = {{"rate_hz", realtime->rate_hz},
+                       {"period_jitter_us",
+                        {{"p50", realtime->period_jitter_us.p50},
+                         {"p99", realtime->period_jitter_us.p99},
+                         {"max", realtime->period_jitter_us.max}}},
+                       {"missed_deadlines", realtime->missed_deadlines},
+                       {"scheduling", realtime->realtime_priority ? "SCHED_FIFO" : "normal"},
+                       {"stall_events", realtime->stall_events},
+                       {"ramp_cycles", realtime->ramp_cycles},
+                       {"failed_steps", realtime->failed_steps},
+                       {"dropped_records", dropped_records}};
+    }
     j["ok"] = ok;
     std::ofstream out(options.json_path);
     out << j.dump(2) << '\n';

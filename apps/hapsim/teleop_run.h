@@ -21,6 +21,9 @@ struct TeleopRunOptions {
   std::optional<std::filesystem::path> trajectory;               // --device sim:FILE
   std::string json_path;
   ProgressFn progress;
+  /// Run on the real-time haptic thread (1 kHz absolute deadlines); the summary adds its figures.
+  bool realtime = false;
+  double spin_s = 200e-6;
   /// Called after every step with the world and the step index (1-based), and once at the end:
   /// headless snapshots. May be empty.
   std::function<void(const TeleopWorld& world, std::size_t step)> after_step;

@@ -71,3 +71,25 @@ TEST(RunCommand, BadSnapshotOptionsAreNamed) {
 
 }  // namespace
 }  // namespace hapsim
+
+namespace hapsim {
+namespace {
+
+// The pick-and-place on the real-time haptic thread places the ball as the inline run does
+// (the simulated master plays by simulation time; every cycle is accounted through the ring).
+TEST(RunCommand, TeleopRealtimePlacesTheBallAndReportsTheLoop) {
+  const auto json = test::temp_path("teleop_rt.json");
+  const auto r = test::run_hapsim("run " + std::string(HAPSIM_SCENES_DIR) +
+                                  "/teleop.json -q --realtime --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j["ok"].get<bool>());
+  EXPECT_LT(j["ball_target_error_m"].get<double>(), 0.005);
+  ASSERT_TRUE(j.contains("realtime")) << j.dump(2);
+  EXPECT_GT(j["realtime"]["rate_hz"].get<double>(), 0.0);
+  EXPECT_EQ(j["realtime"]["dropped_records"].get<int>(), 0);
+}
+
+}  // namespace
+}  // namespace hapsim

@@ -58,7 +58,8 @@ TEST(TeleopRun, Gp7VariantRunsWhenTheDataIsThere) {
 
 TEST(TeleopRun, UnsupportedOptionsAreOneLine) {
   for (const std::string opt :
-       {"--record /tmp/x.rec", "--method knee", "--realtime", "--duration -1"}) {
+       {"--record /tmp/x.rec", "--method knee",
+        "--realtime --snapshot-every 10 --snapshot /tmp/x.png", "--duration -1"}) {
     SCOPED_TRACE(opt);
     const RunResult r = run_hapsim("run " + kScenes + "/teleop.json -q " + opt);
     EXPECT_EQ(r.exit_code, 2) << r.output;

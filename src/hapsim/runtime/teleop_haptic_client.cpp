@@ -7,6 +7,9 @@ TeleopHapticClient::TeleopHapticClient(TeleopWorld& world, TeleopHapticClientOpt
   if (options_.publish_snapshots) {
     snapshots_ = std::make_unique<TripleBuffer<TeleopSnapshot>>(make_teleop_snapshot(world_));
   }
+  if (options_.record_capacity > 0) {
+    records_ = std::make_unique<SpscRing<TeleopCycleRecord>>(options_.record_capacity);
+  }
 }
 
 // haptic path
@@ -16,9 +19,11 @@ const DeviceCommand& TeleopHapticClient::step(const DeviceInput& input, double d
     was_paused_ = paused;
     soft_start_ = !paused;  // back from a pause: the master's torques come back gradually
   }
+  stepped_ = false;
   if (paused) {
     return zero_command_;
   }
+  stepped_ = true;
   const DeviceCommand& command = world_.step(input, dt_s).command;
   steps_.store(steps_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
   return command;
@@ -26,6 +31,15 @@ const DeviceCommand& TeleopHapticClient::step(const DeviceInput& input, double d
 
 // haptic path
 void TeleopHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
+  if (records_ && stepped_) {
+    scratch_record_.result = world_.last_result();
+    scratch_record_.output = cycle.output != nullptr ? *cycle.output : zero_command_;
+    scratch_record_.cost_us = cycle.cost_us;
+    if (!records_->push(scratch_record_)) {
+      dropped_records_.store(dropped_records_.load(std::memory_order_relaxed) + 1,
+                             std::memory_order_relaxed);
+    }
+  }
   if (!snapshots_) {
     return;
   }
