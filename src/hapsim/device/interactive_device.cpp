@@ -1,9 +1,13 @@
 #include "hapsim/device/interactive_device.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace hapsim {
 
-InteractiveDevice::InteractiveDevice(DeviceProfile profile, const DeviceInput& initial)
-    : profile_(std::move(profile)), input_(initial), command_(DeviceCommand{}) {}
+InteractiveDevice::InteractiveDevice(DeviceProfile profile, const DeviceInput& initial,
+                                     InteractiveDeviceOptions options)
+    : profile_(std::move(profile)), options_(options), input_(initial), command_(DeviceCommand{}) {}
 
 void InteractiveDevice::set_input(const DeviceInput& input) noexcept {
   input_.write_slot() = input;
@@ -22,6 +26,18 @@ void InteractiveDevice::set_connected(bool connected) noexcept {
 DeviceInput InteractiveDevice::read(double time_s) noexcept {
   input_.update();
   DeviceInput in = input_.read_slot();
+  const double tau = options_.position_smoothing_s;
+  if (tau > 0.0 && in.p_world.allFinite()) {
+    if (!have_smoothed_) {
+      smoothed_p_world_ = in.p_world;
+      have_smoothed_ = true;
+    } else {
+      const double dt = std::clamp(time_s - last_read_s_, 0.0, 1.0);
+      smoothed_p_world_ += (1.0 - std::exp(-dt / tau)) * (in.p_world - smoothed_p_world_);
+    }
+    last_read_s_ = time_s;
+    in.p_world = smoothed_p_world_;
+  }
   in.time_s = time_s;
   in.healthy = in.healthy && connected_.load(std::memory_order_acquire);
   return in;

@@ -13,9 +13,17 @@
 
 namespace hapsim {
 
+struct InteractiveDeviceOptions {
+  /// Time constant of a first-order filter on the position, seconds (0: none). A mouse moves
+  /// the probe in 60 Hz steps; read at 1 kHz, each step would be a velocity spike (damping) and
+  /// a force jump against a stiff surface. 10 ms smooths them and lags the hand by about as much.
+  double position_smoothing_s = 0.0;
+};
+
 class InteractiveDevice final : public Device {
  public:
-  explicit InteractiveDevice(DeviceProfile profile, const DeviceInput& initial = {});
+  explicit InteractiveDevice(DeviceProfile profile, const DeviceInput& initial = {},
+                             InteractiveDeviceOptions options = {});
 
   // --- the driving thread (one) ---
 
@@ -37,7 +45,12 @@ class InteractiveDevice final : public Device {
 
  private:
   DeviceProfile profile_;
+  InteractiveDeviceOptions options_;
   TripleBuffer<DeviceInput> input_;
+  // haptic thread only: the filtered position and when it was last read
+  Vec3 smoothed_p_world_ = Vec3::Zero();
+  double last_read_s_ = 0.0;
+  bool have_smoothed_ = false;
   TripleBuffer<DeviceCommand> command_;
   std::atomic<bool> connected_{true};
 };

@@ -126,7 +126,8 @@ class TeleopViewerSession final : public ViewerSession {
       device_ = std::make_unique<SimulatedDevice>(profile, std::move(setup.trajectory));
       device_name_ = setup.device_name;
     } else if (config.device == "mouse") {
-      auto mouse = std::make_unique<InteractiveDevice>(profile, start);
+      auto mouse = std::make_unique<InteractiveDevice>(
+          profile, start, InteractiveDeviceOptions{.position_smoothing_s = 0.01});
       mouse_ = mouse.get();
       probe_ = std::move(mouse);
       device_ = std::make_unique<MasterProbeDevice>(*probe_, hand_mapping);

@@ -245,8 +245,8 @@ class Viewer {
     glfwGetWindowSize(window_, &win_w, &win_h);
     const double sx = win_w > 0 ? static_cast<double>(fb_w) / win_w : 1.0;
     Viewport v;
-    v.x = static_cast<int>(control_width() * sx);
-    v.w = std::max(1, fb_w - v.x - static_cast<int>(data_width() * sx));
+    v.x = static_cast<int>(static_cast<double>(control_width()) * sx);
+    v.w = std::max(1, fb_w - v.x - static_cast<int>(static_cast<double>(data_width()) * sx));
     v.y = 0;
     v.h = std::max(1, fb_h);
     return v;
@@ -302,7 +302,8 @@ class Viewer {
     int win_w = 0;
     int win_h = 0;
     glfwGetWindowSize(window_, &win_w, &win_h);
-    const bool in_view = x >= control_width() && x <= win_w - data_width();
+    const bool in_view =
+        x >= static_cast<double>(control_width()) && x <= win_w - static_cast<double>(data_width());
     const bool left = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_LEFT) == GLFW_PRESS;
     const bool right = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS;
     const bool middle = glfwGetMouseButton(window_, GLFW_MOUSE_BUTTON_MIDDLE) == GLFW_PRESS;

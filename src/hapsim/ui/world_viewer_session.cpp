@@ -80,7 +80,8 @@ class WorldViewerSession final : public ViewerSession {
     if (config.device == "mouse") {
       DeviceInput start;
       start.p_world = probe_start_W_;
-      auto mouse = std::make_unique<InteractiveDevice>(profile, start);
+      auto mouse = std::make_unique<InteractiveDevice>(
+          profile, start, InteractiveDeviceOptions{.position_smoothing_s = 0.01});
       mouse_ = mouse.get();
       device_ = std::move(mouse);
       device_name_ = "mouse probe (" + profile.name + " limits)";
