@@ -260,6 +260,9 @@ class Viewer {
       config_ = config;
       status_message_.clear();
     } catch (const std::exception& e) {
+      if (!built_once_) {
+        throw;  // nothing ran before: the start-up error is the whole story
+      }
       status_message_ = e.what();
       spdlog::error("viewer: {}", status_message_);
       try {
@@ -271,6 +274,7 @@ class Viewer {
       }
     }
     session_ = std::move(next);
+    built_once_ = true;
     session_->set_paused(paused_);
     pending_config_ = config_;
     glfwSetWindowTitle(window_, ("hapsim — " + session_->title()).c_str());
@@ -654,6 +658,7 @@ class Viewer {
   bool was_pressed_ = false;
   bool drag_in_view_ = false;
   bool paused_ = false;
+  bool built_once_ = false;
   bool panels_ = true;
   bool screenshot_requested_ = false;
   std::array<bool, 512> key_down_{};
