@@ -104,7 +104,9 @@ void WorldHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
   if (snapshots_) {
     publish_snapshot(cycle);
   }
-  if (records_ && last_result_ != nullptr) {
+  // Records of stepped cycles only: a paused cycle changed nothing (a recording of a session with
+  // pauses replays the steps it took).
+  if (records_ && stepped_ && last_result_ != nullptr) {
     fill_cycle_record(scratch_record_, cycle.index, *cycle.input, *last_result_, *cycle.output,
                       cycle.cost_us);
     if (!records_->push(scratch_record_)) {
