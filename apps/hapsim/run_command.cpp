@@ -3,6 +3,7 @@
 // simulated time, and reports contacts, forces, deflection, pop-throughs and the step cost.
 #include "commands.h"
 #include "progress_printer.h"
+#include "realtime_json.h"
 #include "teleop_run.h"
 
 #include "hapsim/core/error.h"
@@ -23,6 +24,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -76,92 +78,66 @@ std::pair<int, int> parse_size(const std::string& text) {
   return {w, h};
 }
 
-// Headless pictures of a World run: the same scene the viewer shows, drawn offscreen.
-class WorldSnapshots {
+// Headless pictures of a run: the same scene the viewer shows (WorldScene or TeleopScene),
+// drawn offscreen, every N steps and at the end. The scene is built on first use (a teleop world
+// exists only inside its run) with `make_scene`.
+template <class WorldT, class SceneT>
+class RunSnapshots {
  public:
-  WorldSnapshots(const World& world, const RunArgs& args)
-      : path_(args.snapshot_path), every_(args.snapshot_every) {
-    const auto [w, h] = parse_size(args.size);
-    writer_ = std::make_unique<SnapshotWriter>(w, h);
-    WorldSceneOptions o;
-    o.colouring = parse_colouring(args.colours);
-    o.sphere_tree_level = args.sphere_tree_level;
-    scene_ = std::make_unique<WorldScene>(world, o);
-    scene_->scene().style.display_mode = parse_display_mode(args.display_mode);
-    camera_ = framed_camera(scene_->rest_bounds_W(), static_cast<double>(w) / h, kDefaultYaw,
-                            kDefaultPitch);
-  }
+  using MakeScene = std::function<std::unique_ptr<SceneT>(const WorldT&)>;
 
-  void after_cycle(const World& world, std::size_t cycle) {
-    if (every_ > 0 && (cycle + 1) % every_ == 0) {
-      write(world, numbered_path(path_, cycle + 1));
-    }
-  }
-  void final(const World& world) { write(world, path_); }
-  [[nodiscard]] std::size_t written() const { return written_; }
-
-  // From the front (+Y) and a little medial (−X), slightly above: the patella faces the camera.
-  static constexpr double kDefaultYaw = 1.95;
-  static constexpr double kDefaultPitch = 0.3;
-
- private:
-  void write(const World& world, const std::string& path) {
-    scene_->update_from_world(world);
-    writer_->write_png(scene_->scene(), camera_, path);
-    ++written_;
-  }
-
-  std::string path_;
-  std::size_t every_;
-  std::unique_ptr<SnapshotWriter> writer_;
-  std::unique_ptr<WorldScene> scene_;
-  OrbitCamera camera_;
-  std::size_t written_ = 0;
-};
-
-// The same for a teleoperation run: the slave, gripper, ball and sheet (and the master beside).
-class TeleopSnapshots {
- public:
-  explicit TeleopSnapshots(const RunArgs& args)
-      : path_(args.snapshot_path), every_(args.snapshot_every), args_(args) {
+  RunSnapshots(const RunArgs& args, MakeScene make_scene, double yaw_rad, double pitch_rad)
+      : args_(args), make_scene_(std::move(make_scene)), yaw_rad_(yaw_rad), pitch_rad_(pitch_rad) {
     const auto [w, h] = parse_size(args.size);
     writer_ = std::make_unique<SnapshotWriter>(w, h);
   }
 
-  void after_step(const TeleopWorld& world, std::size_t step) {
-    if (every_ > 0 && step % every_ == 0) {
-      write(world, numbered_path(path_, step));
+  /// `step` counts from 1: the picture after that many steps.
+  void after_step(const WorldT& world, std::size_t step) {
+    if (args_.snapshot_every > 0 && step % args_.snapshot_every == 0) {
+      write(world, numbered_path(args_.snapshot_path, step));
     }
   }
-  void final(const TeleopWorld& world) { write(world, path_); }
-  [[nodiscard]] std::size_t written() const { return written_; }
-
-  // From the front-right, above: the robot, the ball and the sheet all in view.
-  static constexpr double kDefaultYaw = -0.9;
-  static constexpr double kDefaultPitch = 0.45;
+  void final(const WorldT& world) {
+    write(world, args_.snapshot_path);
+    std::printf("snapshot     %s (%s, %s", args_.snapshot_path.c_str(), args_.size.c_str(),
+                args_.display_mode.c_str());
+    if (written_ > 1) {
+      std::printf(", and %zu numbered ones", written_ - 1);
+    }
+    std::printf(")\n");
+  }
 
  private:
-  void write(const TeleopWorld& world, const std::string& path) {
-    if (!scene_) {  // built on first use: the world exists only inside the run
-      scene_ = std::make_unique<TeleopScene>(world);
+  void write(const WorldT& world, const std::string& path) {
+    if (!scene_) {
+      scene_ = make_scene_(world);
       scene_->scene().style.display_mode = parse_display_mode(args_.display_mode);
       camera_ = framed_camera(scene_->rest_bounds_W(),
-                              static_cast<double>(writer_->width()) / writer_->height(),
-                              kDefaultYaw, kDefaultPitch);
+                              static_cast<double>(writer_->width()) / writer_->height(), yaw_rad_,
+                              pitch_rad_);
     }
     scene_->update_from_world(world);
     writer_->write_png(scene_->scene(), camera_, path);
     ++written_;
   }
 
-  std::string path_;
-  std::size_t every_;
   const RunArgs& args_;
+  MakeScene make_scene_;
+  double yaw_rad_;
+  double pitch_rad_;
   std::unique_ptr<SnapshotWriter> writer_;
-  std::unique_ptr<TeleopScene> scene_;
+  std::unique_ptr<SceneT> scene_;
   OrbitCamera camera_;
   std::size_t written_ = 0;
 };
+
+// The knee from the front (+Y) and a little medial (−X), slightly above: the patella faces the
+// camera. The teleop scene from the front-right, above: robot, ball and sheet all in view.
+constexpr double kKneeYaw = 1.95;
+constexpr double kKneePitch = 0.3;
+constexpr double kTeleopYaw = -0.9;
+constexpr double kTeleopPitch = 0.45;
 
 ContactMethod parse_method(const std::string& name) {
   return parse_contact_method(name).value_or(ContactMethod::kKnee);  // CLI11 has checked it
@@ -191,18 +167,7 @@ nlohmann::json summary_json(const SceneDescription& scene, const World& world,
   j["missed_deadlines"] = s.missed_deadlines;
   j["recorded_frames"] = s.recorded_frames;
   if (s.realtime) {
-    const RealtimeSummary& rt = *s.realtime;
-    j["realtime"] = {{"rate_hz", rt.rate_hz},
-                     {"period_jitter_us",
-                      {{"p50", rt.period_jitter_us.p50},
-                       {"p99", rt.period_jitter_us.p99},
-                       {"max", rt.period_jitter_us.max}}},
-                     {"missed_deadlines", rt.missed_deadlines},
-                     {"scheduling", rt.realtime_priority ? "SCHED_FIFO" : "normal"},
-                     {"stall_events", rt.stall_events},
-                     {"ramp_cycles", rt.ramp_cycles},
-                     {"failed_steps", rt.failed_steps},
-                     {"dropped_records", rt.dropped_records}};
+    j["realtime"] = realtime_json(*s.realtime);
   }
   j["tools"] = nlohmann::json::array();
   for (const ToolSummary& t : s.tools) {
@@ -285,21 +250,15 @@ void run(const RunArgs& args) {
           "while it runs; the final snapshot is written after the run)");
     }
     TeleopRunOptions teleop;
-    std::unique_ptr<TeleopSnapshots> snapshots;
+    std::unique_ptr<RunSnapshots<TeleopWorld, TeleopScene>> snapshots;
     if (!args.snapshot_path.empty()) {
-      snapshots = std::make_unique<TeleopSnapshots>(args);
+      snapshots = std::make_unique<RunSnapshots<TeleopWorld, TeleopScene>>(
+          args, [](const TeleopWorld& w) { return std::make_unique<TeleopScene>(w); }, kTeleopYaw,
+          kTeleopPitch);
       teleop.after_step = [&](const TeleopWorld& w, std::size_t step) {
         snapshots->after_step(w, step);
       };
-      teleop.finished = [&](const TeleopWorld& w) {
-        snapshots->final(w);
-        std::printf(
-            "snapshot     %s (%s, %s%s)\n", args.snapshot_path.c_str(), args.size.c_str(),
-            args.display_mode.c_str(),
-            args.snapshot_every > 0
-                ? (", and " + std::to_string(snapshots->written() - 1) + " numbered ones").c_str()
-                : "");
-      };
+      teleop.finished = [&](const TeleopWorld& w) { snapshots->final(w); };
     }
     teleop.duration_s = args.duration_s;
     teleop.realtime = args.realtime;
@@ -389,20 +348,28 @@ void run(const RunArgs& args) {
     recorder = std::make_unique<SessionRecorder>(record_path, world.content_hash(), 8192);
   }
 
-  std::unique_ptr<WorldSnapshots> snapshots;
+  std::unique_ptr<RunSnapshots<World, WorldScene>> snapshots;
   if (!args.snapshot_path.empty()) {
     if (args.realtime && args.snapshot_every > 0) {
       throw CommandError(
           "--snapshot-every: not with --realtime (the haptic thread owns the world "
           "while it runs; the final snapshot is written after the run)");
     }
-    snapshots = std::make_unique<WorldSnapshots>(world, args);
+    snapshots = std::make_unique<RunSnapshots<World, WorldScene>>(
+        args,
+        [&args](const World& w) {
+          WorldSceneOptions o;
+          o.colouring = parse_colouring(args.colours);
+          o.sphere_tree_level = args.sphere_tree_level;
+          return std::make_unique<WorldScene>(w, o);
+        },
+        kKneeYaw, kKneePitch);
   }
 
   SessionOptions options;
   options.duration_s = duration_s;
   if (snapshots && args.snapshot_every > 0) {
-    options.after_cycle = [&](std::size_t cycle) { snapshots->after_cycle(world, cycle); };
+    options.after_cycle = [&](std::size_t cycle) { snapshots->after_step(world, cycle + 1); };
   }
   options.dt_s = scene.run.dt_s;
   options.realtime = args.realtime;
@@ -416,12 +383,6 @@ void run(const RunArgs& args) {
   std::cout << format_session_summary(summary);
   if (snapshots) {
     snapshots->final(world);
-    std::printf(
-        "snapshot     %s (%s, %s%s)\n", args.snapshot_path.c_str(), args.size.c_str(),
-        args.display_mode.c_str(),
-        args.snapshot_every > 0
-            ? (", and " + std::to_string(snapshots->written() - 1) + " numbered ones").c_str()
-            : "");
   }
 
   bool failed = false;

@@ -6,11 +6,14 @@
 #include "teleop_run.h"
 
 #include "commands.h"
+#include "realtime_json.h"
 
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/device/device_profile.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/runtime/haptic_loop.h"
+#include "hapsim/runtime/record_drain.h"
+#include "hapsim/runtime/session.h"
 #include "hapsim/runtime/teleop_haptic_client.h"
 #include "hapsim/scene/teleop_setup.h"
 #include "hapsim/world/teleop_world.h"
@@ -18,12 +21,10 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <optional>
-#include <thread>
 #include <vector>
 
 namespace hapsim::app {
@@ -101,8 +102,7 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
                        static_cast<double>(k) / static_cast<double>(steps));
     }
   };
-  std::optional<HapticLoopStatus> realtime;
-  std::uint64_t dropped_records = 0;
+  std::optional<RealtimeSummary> realtime;
   const Stopwatch wall;
   if (!options.realtime) {
     for (std::size_t k = 1; k <= steps; ++k) {
@@ -134,20 +134,10 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
     lo.spin_s = options.spin_s;
     HapticLoop loop(device, client, lo);
     loop.start();
-    for (;;) {
-      const bool running = loop.running();  // before draining: nothing is left behind
-      while (const TeleopCycleRecord* r = client.records()->front()) {
-        account(r->result, r->cost_us);
-        client.records()->pop();
-      }
-      if (!running) {
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    drain_until_stopped(loop, *client.records(),
+                        [&](const TeleopCycleRecord& r) { account(r.result, r.cost_us); });
     loop.wait();
-    realtime = loop.status();
-    dropped_records = client.dropped_records();
+    realtime = realtime_summary(loop.status(), client.dropped_records());
   }
   const double wall_s = wall.elapsed_s();
   if (options.finished) {
@@ -176,13 +166,7 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
   std::printf("slave        largest tip error while tracking %.3f mm\n", slave_error * 1e3);
   std::printf("step cost: p50 %.2f us, p99 %.2f us, max %.1f us\n", p50, p99, max_us);
   if (realtime) {
-    std::printf(
-        "real time: %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f us; "
-        "missed deadlines (period > 2x): %llu; stalls ramped: %llu\n",
-        realtime->rate_hz, realtime->realtime_priority ? "SCHED_FIFO" : "normal scheduling",
-        realtime->period_jitter_us.p50, realtime->period_jitter_us.p99,
-        realtime->period_jitter_us.max, static_cast<unsigned long long>(realtime->missed_deadlines),
-        static_cast<unsigned long long>(realtime->stall_events));
+    std::fputs(format_realtime_summary(*realtime).c_str(), stdout);
   }
 
   const bool ok =
@@ -211,17 +195,7 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
     j["step_us"] = {{"p50", p50}, {"p99", p99}, {"max", max_us}};
     j["wall_s"] = wall_s;
     if (realtime) {
-      j["realtime"] = {{"rate_hz", realtime->rate_hz},
-                       {"period_jitter_us",
-                        {{"p50", realtime->period_jitter_us.p50},
-                         {"p99", realtime->period_jitter_us.p99},
-                         {"max", realtime->period_jitter_us.max}}},
-                       {"missed_deadlines", realtime->missed_deadlines},
-                       {"scheduling", realtime->realtime_priority ? "SCHED_FIFO" : "normal"},
-                       {"stall_events", realtime->stall_events},
-                       {"ramp_cycles", realtime->ramp_cycles},
-                       {"failed_steps", realtime->failed_steps},
-                       {"dropped_records", dropped_records}};
+      j["realtime"] = realtime_json(*realtime);
     }
     j["ok"] = ok;
     std::ofstream out(options.json_path);

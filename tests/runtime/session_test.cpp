@@ -3,11 +3,12 @@
 // the session's own recording, and nearest-rank percentiles on known samples.
 #include "hapsim/runtime/session.h"
 
+#include "runtime/two_body_world.h"
+
 #include "hapsim/core/error.h"
 #include "hapsim/device/device_profile.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/device/simulated_device.h"
-#include "hapsim/geometry/procedural.h"
 
 #include <gtest/gtest.h>
 
@@ -21,49 +22,7 @@
 namespace hapsim {
 namespace {
 
-MaterialDescription material(const char* name, ContactResponse response, double k,
-                             double max_force_n) {
-  MaterialDescription m;
-  m.name = name;
-  m.response = response;
-  m.contact.stiffness_n_per_m = k;
-  m.contact.max_penetration_m = 0.02;
-  m.contact.max_force_n = max_force_n;
-  return m;
-}
-
-// A stiff "bone" block (proxy) with its top face at z = 0, and a soft deformable "muscle" sphere
-// beside it at x = 0.2, resting on nothing.
-WorldDescription two_body_world() {
-  WorldDescription w;
-  w.name = "session-test";
-  w.materials.push_back(material("bone", ContactResponse::kProxy, 3000.0, 40.0));
-  w.materials.push_back(material("muscle", ContactResponse::kPenalty, 300.0, 2.0));
-  BodyDescription bone;
-  bone.name = "bone";
-  bone.X_world_body = Iso3(Eigen::Translation3d(0, 0, -0.02));
-  SegmentDescription block;
-  block.name = "block";
-  block.material = 0;
-  block.mesh = make_box(Vec3(0.05, 0.05, 0.02));
-  bone.segments.push_back(std::move(block));
-  w.bodies.push_back(std::move(bone));
-  BodyDescription soft;
-  soft.name = "soft";
-  soft.kind = BodyKind::kDeformable;
-  soft.X_world_body = Iso3(Eigen::Translation3d(0.2, 0, -0.03));
-  SegmentDescription ball;
-  ball.name = "ball";
-  ball.material = 1;
-  ball.mesh = make_uv_sphere(0.03, 48, 24);
-  soft.segments.push_back(std::move(ball));
-  w.bodies.push_back(std::move(soft));
-  ToolDescription tip;
-  tip.name = "tip";
-  tip.radius_m = 0.004;
-  w.tools.push_back(tip);
-  return w;
-}
+using test::two_body_world;
 
 // 0-1 s: press the bone 10 mm deep at 1 m/s-ish speeds (fast enough to tunnel without a proxy);
 // 1-2 s: press the soft ball 5 mm; then hover.

@@ -7,7 +7,7 @@
 #include "hapsim/device/device_profile.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/scene/teleop_setup.h"
-#include "support/allocation_counter.h"
+#include "support/allocation_counting_client.h"
 
 #include <gtest/gtest.h>
 
@@ -82,21 +82,7 @@ TEST(TeleopHapticClient, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllo
   TeleopHapticClient client(world);
 
   // Counts the haptic thread's allocations around the real client (step and after_cycle).
-  struct Counting final : HapticClient {
-    explicit Counting(TeleopHapticClient& c) : inner(c) {}
-    const DeviceCommand& step(const DeviceInput& input, double dt_s) override {
-      if (steps++ == 5) {
-        first = test::thread_allocation_count();
-      }
-      last = test::thread_allocation_count();
-      return inner.step(input, dt_s);
-    }
-    void after_cycle(const HapticCycle& c) noexcept override { inner.after_cycle(c); }
-    TeleopHapticClient& inner;
-    long first = 0;
-    long last = 0;
-    int steps = 0;
-  } counting(client);
+  test::AllocationCountingClient counting(client);
 
   HapticLoopOptions o;
   o.max_cycles = 300;
@@ -123,8 +109,8 @@ TEST(TeleopHapticClient, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllo
   });
   viewer.join();
   loop.wait();
-  EXPECT_EQ(counting.steps, 300);
-  EXPECT_EQ(counting.last - counting.first, 0) << "the haptic thread allocated";
+  EXPECT_EQ(counting.steps(), 300);
+  EXPECT_EQ(counting.allocations(), 0) << "the haptic thread allocated";
   EXPECT_EQ(inconsistent.load(), 0);
   EXPECT_GT(snapshots.load(), 10);
 }

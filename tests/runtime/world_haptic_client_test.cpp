@@ -12,7 +12,8 @@
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
-#include "support/allocation_counter.h"
+#include "runtime/two_body_world.h"
+#include "support/allocation_counting_client.h"
 
 #include <gtest/gtest.h>
 
@@ -26,48 +27,6 @@
 namespace hapsim {
 namespace {
 
-// A soft deformable sphere (penalty) on a stiff block (proxy), one tool.
-WorldDescription soft_ball_world() {
-  WorldDescription w;
-  w.name = "client-test";
-  MaterialDescription bone;
-  bone.name = "bone";
-  bone.response = ContactResponse::kProxy;
-  bone.contact.stiffness_n_per_m = 2000.0;
-  bone.contact.max_force_n = 20.0;
-  MaterialDescription muscle;
-  muscle.name = "muscle";
-  muscle.response = ContactResponse::kPenalty;
-  muscle.contact.stiffness_n_per_m = 300.0;
-  muscle.contact.max_penetration_m = 0.02;
-  muscle.contact.max_force_n = 3.0;
-  w.materials = {bone, muscle};
-  BodyDescription block;
-  block.name = "block";
-  block.X_world_body = Iso3(Eigen::Translation3d(0, 0, -0.02));
-  SegmentDescription box;
-  box.name = "box";
-  box.material = 0;
-  box.mesh = make_box(Vec3(0.05, 0.05, 0.02));
-  block.segments.push_back(std::move(box));
-  w.bodies.push_back(std::move(block));
-  BodyDescription soft;
-  soft.name = "soft";
-  soft.kind = BodyKind::kDeformable;
-  soft.X_world_body = Iso3(Eigen::Translation3d(0.2, 0, -0.03));
-  SegmentDescription ball;
-  ball.name = "ball";
-  ball.material = 1;
-  ball.mesh = make_uv_sphere(0.03, 48, 24);
-  soft.segments.push_back(std::move(ball));
-  w.bodies.push_back(std::move(soft));
-  ToolDescription tip;
-  tip.name = "tip";
-  tip.radius_m = 0.004;
-  w.tools.push_back(tip);
-  return w;
-}
-
 // Presses the soft ball 6 mm deep in a 0.4 s sine, then lifts away (the dent recovers).
 DeviceInput press_ball(double t) {
   DeviceInput in;
@@ -78,7 +37,7 @@ DeviceInput press_ball(double t) {
 }
 
 TEST(WorldHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
-  World world(soft_ball_world());
+  World world(test::two_body_world());
   SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);
   WorldHapticClient client(world);
   HapticLoopOptions o;
@@ -113,28 +72,14 @@ TEST(WorldHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
 }
 
 TEST(WorldHapticClient, ReaderThreadSeesConsistentSnapshotsAndHapticThreadDoesNotAllocate) {
-  World world(soft_ball_world());
+  World world(test::two_body_world());
   SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);
   WorldHapticClientOptions co;
   co.record_capacity = 1024;
   WorldHapticClient client(world, co);
 
   // Counts the haptic thread's allocations around the real client.
-  struct Counting final : HapticClient {
-    explicit Counting(WorldHapticClient& c) : inner(c) {}
-    const DeviceCommand& step(const DeviceInput& input, double dt_s) override {
-      if (steps++ == 5) {
-        first = test::thread_allocation_count();
-      }
-      last = test::thread_allocation_count();
-      return inner.step(input, dt_s);
-    }
-    void after_cycle(const HapticCycle& c) noexcept override { inner.after_cycle(c); }
-    WorldHapticClient& inner;
-    long first = 0;
-    long last = 0;
-    int steps = 0;
-  } counting(client);
+  test::AllocationCountingClient counting(client);
 
   HapticLoopOptions o;
   o.max_cycles = 700;  // the press and part of the recovery
@@ -168,7 +113,7 @@ TEST(WorldHapticClient, ReaderThreadSeesConsistentSnapshotsAndHapticThreadDoesNo
   }
   viewer.join();
   loop.wait();
-  EXPECT_EQ(counting.last - counting.first, 0) << "the haptic thread allocated";
+  EXPECT_EQ(counting.allocations(), 0) << "the haptic thread allocated";
   EXPECT_EQ(inconsistent.load(), 0);
   EXPECT_GT(snapshots.load(), 50);
   EXPECT_EQ(records + client.dropped_records(), 700u);
@@ -184,27 +129,13 @@ TEST(WorldHapticClient, KneeSceneWithItsScriptedDeviceAllocatesNothingOnTheHapti
   WorldHapticClientOptions co;
   co.record_capacity = 8192;
   WorldHapticClient client(world, co);
-  struct Counting final : HapticClient {
-    explicit Counting(WorldHapticClient& c) : inner(c) {}
-    const DeviceCommand& step(const DeviceInput& input, double dt_s) override {
-      if (steps++ == 5) {
-        first = test::thread_allocation_count();
-      }
-      last = test::thread_allocation_count();
-      return inner.step(input, dt_s);
-    }
-    void after_cycle(const HapticCycle& c) noexcept override { inner.after_cycle(c); }
-    WorldHapticClient& inner;
-    long first = 0;
-    long last = 0;
-    int steps = 0;
-  } counting(client);
+  test::AllocationCountingClient counting(client);
   HapticLoopOptions o;
   o.max_cycles = 2500;  // the approach, the first press (medial ligament) and its release
   HapticLoop loop(*device, counting, o);
   loop.start();
   loop.wait();
-  EXPECT_EQ(counting.last - counting.first, 0) << "the haptic thread allocated";
+  EXPECT_EQ(counting.allocations(), 0) << "the haptic thread allocated";
   EXPECT_GT(world.current_deflection_m(0, world.segment_count(0) - 1) +
                 client.max_deflection_m()[world.flat_segment(0, world.segment_count(0) - 1)],
             0.001);  // it did press the skin
@@ -214,7 +145,7 @@ TEST(WorldHapticClient, KneeSceneWithItsScriptedDeviceAllocatesNothingOnTheHapti
 // tool was before the pause (no damping spike: the force is the spring's, k·x), and the loop is
 // asked to bring the force back gradually.
 TEST(WorldHapticClient, ResumingAfterAPauseHasNoDampingSpikeAndAsksForASoftStart) {
-  World world(soft_ball_world());
+  World world(test::two_body_world());
   WorldHapticClient client(world);
   DeviceInput in;
   in.p_world = Vec3(0.2, 0.0, 0.05);  // well above the ball (top at z = 0)
@@ -234,7 +165,7 @@ TEST(WorldHapticClient, ResumingAfterAPauseHasNoDampingSpikeAndAsksForASoftStart
 }
 
 TEST(WorldHapticClient, ResetAndPauseReachTheSnapshot) {
-  World world(soft_ball_world());
+  World world(test::two_body_world());
   SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);
   WorldHapticClient client(world);
   HapticLoopOptions o;
@@ -266,11 +197,11 @@ TEST(Session, RealtimeRunAccountsTheSameContactsAsAnInlineRun) {
   options.duration_s = 0.8;
   SessionSummary inline_run;
   {
-    World world(soft_ball_world());
+    World world(test::two_body_world());
     SimulatedDevice device(omega, press_ball, 1.0);
     inline_run = run_session(world, device, options);
   }
-  World world(soft_ball_world());
+  World world(test::two_body_world());
   SimulatedDevice device(omega, press_ball, 1.0);
   options.realtime = true;
   const SessionSummary rt = run_session(world, device, options);
@@ -305,7 +236,7 @@ TEST(Session, RealtimeRecordingReplaysBitForBitOffline) {
                      ("hapsim_rt_rec_again_" + std::to_string(::getpid()) + ".rec");
   SessionSummary rt;
   {
-    World world(soft_ball_world());
+    World world(test::two_body_world());
     SimulatedDevice device(omega, press_ball, 1.0);
     SessionRecorder recorder(path, world.content_hash(), 256);  // flushed many times meanwhile
     SessionOptions o;
@@ -320,7 +251,7 @@ TEST(Session, RealtimeRecordingReplaysBitForBitOffline) {
   EXPECT_EQ(rt.recording_dropped_frames, 0u);
   const Recording original = read_recording(path);
   ASSERT_EQ(original.frames.size(), 600u);
-  World world(soft_ball_world());
+  World world(test::two_body_world());
   ReplayDevice replay(omega, original.frames);
   SessionRecorder recorder(again, world.content_hash(), 256);
   SessionOptions o;

@@ -2,7 +2,6 @@
 
 #include <pthread.h>
 #include <sched.h>
-#include <sys/mman.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -42,10 +41,6 @@ bool try_set_realtime_priority(int priority) noexcept {
   return pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
 }
 
-bool try_lock_memory() noexcept {
-  return mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
-}
-
 DeadlineClock::DeadlineClock(std::int64_t period_ns, std::int64_t spin_ns) noexcept
     : period_ns_(std::max<std::int64_t>(1, period_ns)),
       // At most half a period: a real-time thread that never sleeps is throttled by the kernel
@@ -70,7 +65,6 @@ std::int64_t DeadlineClock::wait_next() noexcept {
   const std::int64_t now = monotonic_ns();
   if (now - deadline_ns_ > period_ns_) {
     deadline_ns_ = now;
-    ++restarts_;
   }
   return now;
 }

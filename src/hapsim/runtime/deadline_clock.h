@@ -22,10 +22,6 @@ void sleep_until_ns(std::int64_t deadline_ns) noexcept;
 /// when not permitted (EPERM for non-root, containers without CAP_SYS_NICE) or unsupported.
 [[nodiscard]] bool try_set_realtime_priority(int priority) noexcept;
 
-/// Locks current and future pages in memory (no page faults on the haptic path). False when not
-/// permitted; harmless then.
-[[nodiscard]] bool try_lock_memory() noexcept;
-
 class DeadlineClock {
  public:
   /// `spin_ns`: wake this long before each deadline and spin to it (0: sleep only).
@@ -38,16 +34,10 @@ class DeadlineClock {
   /// catch-up cycles (a haptic device wants the newest force, not old ones fast).
   std::int64_t wait_next() noexcept;
 
-  [[nodiscard]] std::int64_t period_ns() const noexcept { return period_ns_; }
-  [[nodiscard]] std::int64_t deadline_ns() const noexcept { return deadline_ns_; }
-  /// Times the schedule restarted because a cycle ran a whole period late.
-  [[nodiscard]] std::uint64_t restarts() const noexcept { return restarts_; }
-
  private:
   std::int64_t period_ns_;
   std::int64_t spin_ns_;
   std::int64_t deadline_ns_ = 0;
-  std::uint64_t restarts_ = 0;
 };
 
 }  // namespace hapsim

@@ -236,7 +236,7 @@ void HapticLoop::supervisor_thread_main() noexcept {
   Shared& s = *shared_;
   // Real-time too where allowed, so a busy machine (the viewer's rasteriser threads) cannot
   // delay its wake-ups, which bound the ramp's timing; one level below the haptic thread, so it
-  // never delays a cycle (measured: above it, period jitter p99 rose from ~5 to ~45 us).
+  // never delays a cycle (measured: above it, period jitter p99 rose from ~0.1 to ~45 us).
   if (options_.realtime_priority) {
     (void)try_set_realtime_priority(options_.fifo_priority - 1);
   }

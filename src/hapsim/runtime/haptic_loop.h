@@ -134,8 +134,6 @@ class HapticLoop {
 
   [[nodiscard]] bool running() const noexcept { return running_.load(std::memory_order_acquire); }
   [[nodiscard]] HapticLoopStatus status() const noexcept;
-  [[nodiscard]] const LatencyHistogram& period_jitter_histogram() const { return jitter_us_; }
-  [[nodiscard]] const LatencyHistogram& cycle_cost_histogram() const { return cost_us_; }
   [[nodiscard]] const HapticLoopOptions& options() const { return options_; }
 
  private:

@@ -3,6 +3,7 @@
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/core/error.h"
 #include "hapsim/device/force_safety.h"
+#include "hapsim/runtime/record_drain.h"
 #include "hapsim/runtime/world_haptic_client.h"
 
 #include <algorithm>
@@ -12,7 +13,6 @@
 #include <ctime>
 #include <memory>
 #include <sstream>
-#include <thread>
 
 namespace hapsim {
 namespace {
@@ -293,22 +293,13 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
   std::size_t accounted = 0;
   const auto wall_start = std::chrono::steady_clock::now();
   loop.start();
-  for (;;) {
-    const bool running = loop.running();  // read before draining: nothing is left behind
-    while (const CycleRecord* r = records.front()) {
-      accountant.account(*r);
-      records.pop();
-      ++accounted;
-      if (accounted % progress_every == 0) {
-        report_progress(options.progress, "run (real time)",
-                        static_cast<double>(accounted) / static_cast<double>(steps));
-      }
+  drain_until_stopped(loop, records, [&](const CycleRecord& r) {
+    accountant.account(r);
+    if (++accounted % progress_every == 0) {
+      report_progress(options.progress, "run (real time)",
+                      static_cast<double>(accounted) / static_cast<double>(steps));
     }
-    if (!running) {
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  });
   loop.wait();
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -320,20 +311,42 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
   summary.clamped_cycles = st.clamped_cycles;
   summary.nonfinite_commands = st.nonfinite_commands;
   summary.missed_deadlines = st.missed_deadlines;
-  RealtimeSummary rt;
-  rt.rate_hz = st.rate_hz;
-  rt.period_jitter_us = st.period_jitter_us;
-  rt.missed_deadlines = st.missed_deadlines;
-  rt.realtime_priority = st.realtime_priority;
-  rt.stall_events = st.stall_events;
-  rt.ramp_cycles = st.ramp_cycles;
-  rt.failed_steps = st.failed_steps;
-  rt.dropped_records = client.dropped_records();
+  const RealtimeSummary rt = realtime_summary(st, client.dropped_records());
   summary.realtime = rt;
   return summary;
 }
 
 }  // namespace
+
+RealtimeSummary realtime_summary(const HapticLoopStatus& status, std::size_t dropped_records) {
+  RealtimeSummary rt;
+  rt.rate_hz = status.rate_hz;
+  rt.period_jitter_us = status.period_jitter_us;
+  rt.missed_deadlines = status.missed_deadlines;
+  rt.realtime_priority = status.realtime_priority;
+  rt.stall_events = status.stall_events;
+  rt.ramp_cycles = status.ramp_cycles;
+  rt.failed_steps = status.failed_steps;
+  rt.dropped_records = dropped_records;
+  return rt;
+}
+
+std::string format_realtime_summary(const RealtimeSummary& rt) {
+  char line[320];
+  std::snprintf(line, sizeof line,
+                "real time: %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f us; "
+                "missed deadlines (period > 2x): %zu; stalls ramped: %zu\n",
+                rt.rate_hz, rt.realtime_priority ? "SCHED_FIFO" : "normal scheduling",
+                rt.period_jitter_us.p50, rt.period_jitter_us.p99, rt.period_jitter_us.max,
+                rt.missed_deadlines, rt.stall_events);
+  std::string text = line;
+  if (rt.dropped_records > 0 || rt.failed_steps > 0) {
+    text += "real time: " + std::to_string(rt.dropped_records) +
+            " cycle record(s) not accounted (bookkeeping fell behind), " +
+            std::to_string(rt.failed_steps) + " failed step(s)\n";
+  }
+  return text;
+}
 
 SessionSummary run_session(World& world, Device& device, const SessionOptions& options) {
   if (!(options.duration_s > 0.0) || !std::isfinite(options.duration_s)) {
@@ -398,18 +411,7 @@ std::string format_session_summary(const SessionSummary& s) {
         << ")\n";
   }
   if (s.realtime) {
-    const RealtimeSummary& rt = *s.realtime;
-    std::snprintf(line, sizeof line,
-                  "real time: %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f us; "
-                  "missed deadlines (period > 2x): %zu; stalls ramped: %zu\n",
-                  rt.rate_hz, rt.realtime_priority ? "SCHED_FIFO" : "normal scheduling",
-                  rt.period_jitter_us.p50, rt.period_jitter_us.p99, rt.period_jitter_us.max,
-                  rt.missed_deadlines, rt.stall_events);
-    out << line;
-    if (rt.dropped_records > 0 || rt.failed_steps > 0) {
-      out << "real time: " << rt.dropped_records << " cycle record(s) not accounted (bookkeeping "
-          << "fell behind), " << rt.failed_steps << " failed step(s)\n";
-    }
+    out << format_realtime_summary(*s.realtime);
   }
   return out.str();
 }

@@ -111,6 +111,12 @@ struct SessionSummary {
 [[nodiscard]] SessionSummary run_session(World& world, Device& device,
                                          const SessionOptions& options);
 
+/// The real-time figures of a finished loop; `dropped_records`: records its consumer missed.
+[[nodiscard]] RealtimeSummary realtime_summary(const HapticLoopStatus& status,
+                                               std::size_t dropped_records);
+/// The "real time: …" line(s) of a summary.
+[[nodiscard]] std::string format_realtime_summary(const RealtimeSummary& realtime);
+
 /// Short human summary (a dozen lines).
 [[nodiscard]] std::string format_session_summary(const SessionSummary& summary);
 
