@@ -98,8 +98,9 @@ class EmbreeOracle final : public ClosestPointOracle {
     // Float rounding of vertices (BVH bounds) and of the query point: a few ulps of the largest
     // coordinate (query points lie near the mesh, so its extent bounds theirs).
     state_.mesh = &mesh_;
-    state_.pad = static_cast<float>(16.0 * std::numeric_limits<float>::epsilon() *
-                                    std::max(max_abs, 1e-3));
+    state_.pad =
+        static_cast<float>(16.0 * static_cast<double>(std::numeric_limits<float>::epsilon()) *
+                           std::max(max_abs, 1e-3));
   }
 
   ~EmbreeOracle() override {

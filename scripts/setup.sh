@@ -9,17 +9,29 @@ HAPSIM_PRESET="${HAPSIM_PRESET:-release}"
 HAPSIM_BUILD_DIR="${HAPSIM_ROOT}/build/${HAPSIM_PRESET}"
 
 HAPSIM_PACKAGES=(
-  # toolchain
+  # Each line names what CMake (or a test, or the main job) looks for; checked on a bare Debian 12
+  # with ../shared/tools/check-fresh-debian.sh, so nothing is assumed from the machine.
+  # toolchain: gcc/g++/make, cmake, ninja, pkg-config (stb, imgui and spnav are found through it)
   build-essential cmake ninja-build pkg-config
-  # product libraries
+  # product libraries: find_package(Eigen3, assimp, urdfdom, nlohmann_json, CLI11, spdlog)
   libeigen3-dev libassimp-dev liburdfdom-dev nlohmann-json3-dev libcli11-dev libspdlog-dev
-  # viewer and headless rendering: GLFW + OpenGL + Dear ImGui, EGL surfaceless on Mesa's software
-  # rasterizer, stb for PNG, libspnav for a 3D mouse; Xvfb + xauth for the viewer's smoke test
-  libglfw3-dev libgl-dev libegl-dev libgl1-mesa-dri libimgui-dev libstb-dev libspnav-dev xvfb xauth
-  # the viewer smoke test moves the real X pointer with xdotool
-  xdotool
-  # tests and benchmarks; CGAL, FCL, Embree and orocos-kdl are reference oracles only
-  libgtest-dev libgmock-dev libbenchmark-dev libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev
+  # find_package(OpenGL COMPONENTS OpenGL EGL): GL/gl.h and KHR/ (libgl-dev), libOpenGL.so
+  # (libopengl-dev, GLVND's OpenGL library: the renderer links it, not libGL), EGL/egl.h and
+  # libEGL.so (libegl-dev)
+  libgl-dev libopengl-dev libegl-dev
+  # at run time GLVND dispatches to Mesa: EGL surfaceless for headless pictures (libegl-mesa0),
+  # GLX under Xvfb for the viewer (libglx-mesa0), llvmpipe, the software rasteriser (libgl1-mesa-dri)
+  libegl-mesa0 libglx-mesa0 libgl1-mesa-dri
+  # the viewer: find_package(glfw3), pkg-config imgui (Dear ImGui with its GLFW/OpenGL3 backends),
+  # stb (PNG), spnav (a 3D mouse; optional in CMake, installed so the viewer offers it)
+  libglfw3-dev libimgui-dev libstb-dev libspnav-dev
+  # the viewer's smoke test: xvfb-run (xvfb, which needs xauth) and xdotool for the real X pointer
+  xvfb xauth xdotool
+  # tests and benchmarks: find_package(GTest) with GMock, find_package(benchmark)
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # reference oracles for tests and benchmarks only (HAPSIM_REQUIRE_ORACLES: configure fails
+  # without them rather than skipping their tests): CGAL, FCL, Embree 3, orocos-kdl
+  libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev
 )
 
 hapsim_install_packages() {

@@ -32,8 +32,10 @@ TriangleMesh load_stl(const std::filesystem::path& path) {
     const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
     for (unsigned v = 0; v < am->mNumVertices; ++v) {
       // STL files of the knee are in millimetres.
-      mesh.vertices.emplace_back(1e-3 * am->mVertices[v].x, 1e-3 * am->mVertices[v].y,
-                                 1e-3 * am->mVertices[v].z);
+      const aiVector3D& p_mm = am->mVertices[v];
+      mesh.vertices.emplace_back(1e-3 * static_cast<double>(p_mm.x),
+                                 1e-3 * static_cast<double>(p_mm.y),
+                                 1e-3 * static_cast<double>(p_mm.z));
     }
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       if (am->mFaces[f].mNumIndices == 3) {

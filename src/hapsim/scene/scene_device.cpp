@@ -190,7 +190,9 @@ std::array<double, kGloveAnglesPerFinger> reach_with_finger(const HandModel& han
                                                             const Vec3& goal_hand,
                                                             double* residual_m) {
   std::array<double, kGloveAnglesPerFinger> a{0.0, 0.35, 0.45};
-  const auto tip = [&](const std::array<double, kGloveAnglesPerFinger>& angles) {
+  // Returns a Vec3, not `auto`: translation() is a view into the temporary transform, which is gone
+  // when the lambda returns (a stack-use-after-return under AddressSanitizer).
+  const auto tip = [&](const std::array<double, kGloveAnglesPerFinger>& angles) -> Vec3 {
     return hand.finger(f).forward(hand.finger_joints(f, angles)).translation();
   };
   for (int it = 0; it < 60; ++it) {
