@@ -27,8 +27,9 @@ HAPSIM_PACKAGES=(
   libglfw3-dev libimgui-dev libstb-dev libspnav-dev
   # the viewer's smoke test: xvfb-run (xvfb, which needs xauth) and xdotool for the real X pointer
   xvfb xauth xdotool
-  # tests and benchmarks: find_package(GTest) with GMock, find_package(benchmark)
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks: find_package(GTest) with GMock, find_package(benchmark), and
+  # find_package(ZLIB) for the golden run traces (tests/golden/*.trace.gz)
+  libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev
   # reference oracles for tests and benchmarks only (HAPSIM_REQUIRE_ORACLES: configure fails
   # without them rather than skipping their tests): CGAL, FCL, Embree 3, orocos-kdl
   libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev
