@@ -2,6 +2,7 @@
 
 #include "hapsim/core/data_dir.h"
 #include "hapsim/core/error.h"
+#include "hapsim/core/statistics.h"
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/geometry/procedural.h"
 #include "oracles/closest_point_oracle.h"
@@ -75,7 +76,9 @@ class Reference {
 #endif
   }
 
-  [[nodiscard]] const TriangleMesh& mesh() const { return mesh_; }
+  [[nodiscard]] const TriangleMesh& mesh() const {
+    return mesh_;
+  }
 
  private:
   const TriangleMesh& mesh_;
@@ -231,9 +234,8 @@ class HapsimMethod final : public BenchMethod {
   double query(const Vec3& p) override {
     if (contact_radius_) {
       SurfacePoint out;
-      return query_->contact_within(p, kContactRadius, &out, &hint_)
-                 ? std::abs(out.signed_distance)
-                 : kInf;
+      return query_->contact_within(p, kContactRadius, &out, &hint_) ? std::abs(out.signed_distance)
+                                                                     : kInf;
     }
     return std::abs(query_->closest_point(p, &hint_).signed_distance);
   }
@@ -274,24 +276,13 @@ double timer_overhead_ns() {
     for (double& s : samples) {
       const auto t0 = Clock::now();
       const auto t1 = Clock::now();
-      s = static_cast<double>(std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());
+      s = static_cast<double>(
+          std::chrono::duration_cast<std::chrono::nanoseconds>(t1 - t0).count());
     }
     std::nth_element(samples.begin(), samples.begin() + samples.size() / 2, samples.end());
     return samples[samples.size() / 2];
   }();
   return overhead;
-}
-
-double percentile(std::vector<double>& sorted_or_not, double q) {
-  if (sorted_or_not.empty()) {
-    return 0.0;
-  }
-  const auto n = sorted_or_not.size();
-  auto index = static_cast<std::size_t>(std::ceil(q * static_cast<double>(n))) ;
-  index = std::clamp<std::size_t>(index, 1, n) - 1;
-  std::nth_element(sorted_or_not.begin(), sorted_or_not.begin() + static_cast<std::ptrdiff_t>(index),
-                   sorted_or_not.end());
-  return sorted_or_not[index];
 }
 
 struct Timing {
@@ -324,8 +315,8 @@ Timing time_queries(BenchMethod& method, const std::vector<Vec3>& points, std::s
     sum += samples[i];
   }
   timing.mean_ns = points.empty() ? 0.0 : sum / static_cast<double>(points.size());
-  timing.median_ns = percentile(samples, 0.5);
-  timing.p99_ns = percentile(samples, 0.99);
+  timing.median_ns = nearest_rank_percentile(samples, 0.5);
+  timing.p99_ns = nearest_rank_percentile(samples, 0.99);
   timing.distances = std::move(distances);
   return timing;
 }
@@ -380,12 +371,12 @@ std::optional<std::filesystem::path> default_data_dir() {
 }
 
 std::vector<std::string> all_collision_mesh_names() {
-  return {"bumpy-13.5k", "bumpy-100k", "bumpy-1m",  "knee-tibia",
+  return {"bumpy-13.5k", "bumpy-100k", "bumpy-1m", "knee-tibia",
           "knee-all",    "sheet-16",   "sheet-256"};
 }
 
-std::vector<std::string> collision_mesh_names(bool quick,
-                                              const std::optional<std::filesystem::path>& data_dir) {
+std::vector<std::string> collision_mesh_names(
+    bool quick, const std::optional<std::filesystem::path>& data_dir) {
   std::vector<std::string> names{"bumpy-13.5k", "bumpy-100k"};
   if (!quick) {
     names.emplace_back("bumpy-1m");
@@ -459,8 +450,8 @@ std::vector<Vec3> make_workload_points(const TriangleMesh& mesh, Workload worklo
 }
 
 std::vector<std::string> all_method_names() {
-  return {"hapsim-exact", "hapsim-spheretree", "hapsim-contact-radius", "cgal", "cgal-hint",
-          "fcl",          "embree"};
+  return {"hapsim-exact", "hapsim-spheretree", "hapsim-contact-radius", "cgal", "cgal-hint", "fcl",
+          "embree"};
 }
 
 std::vector<std::string> available_methods() {
@@ -502,11 +493,10 @@ std::unique_ptr<BenchMethod> make_method(const std::string& name, const Triangle
   for (const auto& n : available_methods()) {
     built += (built.empty() ? "" : ", ") + n;
   }
-  throw Error("--methods " + name,
-              std::string(std::find(all.begin(), all.end(), name) != all.end()
-                              ? "not built in this binary"
-                              : "unknown method") +
-                  "; available: " + built);
+  throw Error("--methods " + name, std::string(std::find(all.begin(), all.end(), name) != all.end()
+                                                   ? "not built in this binary"
+                                                   : "unknown method") +
+                                       "; available: " + built);
 }
 
 std::vector<CollisionRow> run_collision_bench(const CollisionBenchOptions& options) {
@@ -515,15 +505,14 @@ std::vector<CollisionRow> run_collision_bench(const CollisionBenchOptions& optio
                              : options.meshes;
   const std::vector<std::string> methods =
       options.methods.empty() ? available_methods() : options.methods;
-  const std::size_t queries = options.queries != 0 ? options.queries
-                              : options.quick      ? 4000
-                                                   : 20000;
-  const std::size_t warmup = options.warmup != 0 ? options.warmup : std::min<std::size_t>(1000, queries / 4);
+  const std::size_t queries = options.queries != 0 ? options.queries : options.quick ? 4000 : 20000;
+  const std::size_t warmup =
+      options.warmup != 0 ? options.warmup : std::min<std::size_t>(1000, queries / 4);
 
   // Progress: per mesh, one unit for the mesh and workloads, then per method one for the build
   // and one per workload.
-  const double units_per_mesh =
-      1.0 + static_cast<double>(methods.size()) * (1.0 + static_cast<double>(options.workloads.size()));
+  const double units_per_mesh = 1.0 + static_cast<double>(methods.size()) *
+                                          (1.0 + static_cast<double>(options.workloads.size()));
   const double total_units = units_per_mesh * static_cast<double>(meshes.size());
   double done = 0.0;
   const auto progress = [&](const std::string& label) {
@@ -569,8 +558,9 @@ std::vector<CollisionRow> run_collision_bench(const CollisionBenchOptions& optio
         row.p99_ns = timing.p99_ns;
         row.mean_ns = timing.mean_ns;
         row.build_ms = build_ms;
-        row.bytes_per_triangle = static_cast<double>(method->memory_bytes()) /
-                                 static_cast<double>(std::max<std::size_t>(1, mesh.triangle_count()));
+        row.bytes_per_triangle =
+            static_cast<double>(method->memory_bytes()) /
+            static_cast<double>(std::max<std::size_t>(1, mesh.triangle_count()));
         row.query_count = points[w].size();
         check_against_reference(method_name, timing.distances, reference_distances[w], row);
         rows.push_back(std::move(row));
@@ -584,7 +574,9 @@ std::vector<CollisionRow> run_collision_bench(const CollisionBenchOptions& optio
 }
 
 namespace {
-bool is_library_method(const std::string& method) { return method.rfind("hapsim-", 0) != 0; }
+bool is_library_method(const std::string& method) {
+  return method.rfind("hapsim-", 0) != 0;
+}
 }  // namespace
 
 void compute_ratios(std::vector<CollisionRow>& rows) {
@@ -606,8 +598,7 @@ void compute_ratios(std::vector<CollisionRow>& rows) {
       row.p99_ratio_to_fastest_library = 0.0;
       continue;
     }
-    row.ratio_to_fastest_library =
-        it->second.first > 0.0 ? row.median_ns / it->second.first : 0.0;
+    row.ratio_to_fastest_library = it->second.first > 0.0 ? row.median_ns / it->second.first : 0.0;
     row.p99_ratio_to_fastest_library =
         it->second.second > 0.0 ? row.p99_ns / it->second.second : 0.0;
   }
@@ -657,11 +648,11 @@ std::string format_table(const std::vector<CollisionRow>& rows_in_run_order) {
                     format_count(row.triangles).c_str(), row.workload.c_str());
       out << line;
       std::snprintf(line, sizeof line, "  %-22s %10s %10s %9s %9s %10s %9s %9s %5s\n", "method",
-                    "median ns", "p99 ns", "x lib", "x lib p99", "build ms", "B/tri", "err",
-                    "bad");
+                    "median ns", "p99 ns", "x lib", "x lib p99", "build ms", "B/tri", "err", "bad");
       out << line;
     }
-    std::snprintf(line, sizeof line, "  %-22s %10.0f %10.0f %8.2fx %8.2fx %10.1f %9.1f %9.1e %5zu\n",
+    std::snprintf(line, sizeof line,
+                  "  %-22s %10.0f %10.0f %8.2fx %8.2fx %10.1f %9.1f %9.1e %5zu\n",
                   row.method.c_str(), row.median_ns, row.p99_ns, row.ratio_to_fastest_library,
                   row.p99_ratio_to_fastest_library, row.build_ms, row.bytes_per_triangle,
                   row.max_distance_error, row.mismatches);

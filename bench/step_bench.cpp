@@ -5,7 +5,7 @@
 #include "bench/collision_cases.h"
 #include "bench/step_cases.h"
 
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/world/world.h"

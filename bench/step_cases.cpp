@@ -1,7 +1,7 @@
 #include "bench/step_cases.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"

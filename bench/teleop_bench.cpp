@@ -3,7 +3,7 @@
 // sheet contacts, sheet update, ball dynamics), IK while tracking (last cycle's answer as seed)
 // and IK from cold, for the procedural Motoman and the GP7 when its URDF is there. The per-step
 // percentiles of the whole scene come from `hapsim run scenes/teleop.json --json FILE`.
-#include "hapsim/device/pick_and_place_trajectory.h"
+#include "hapsim/script/pick_and_place_trajectory.h"
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
 #include "hapsim/world/teleop_world.h"

@@ -56,10 +56,12 @@ hapsim_install_packages() {
 
 hapsim_build() {
   cd "$HAPSIM_ROOT"
+  local started=$SECONDS
   if [ ! -f "${HAPSIM_BUILD_DIR}/build.ninja" ]; then
     cmake --preset "$HAPSIM_PRESET"
   fi
   cmake --build --preset "$HAPSIM_PRESET"
+  echo "hapsim: build up to date in $((SECONDS - started)) s (${HAPSIM_BUILD_DIR})"
 }
 
 if [ "${BASH_SOURCE[0]}" = "$0" ]; then

@@ -8,8 +8,9 @@
 #include "commands.h"
 #include "realtime_json.h"
 
+#include "hapsim/core/device_profile.h"
+#include "hapsim/core/statistics.h"
 #include "hapsim/core/stopwatch.h"
-#include "hapsim/device/device_profile.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/runtime/haptic_loop.h"
 #include "hapsim/runtime/record_drain.h"
@@ -28,18 +29,6 @@
 #include <vector>
 
 namespace hapsim::app {
-namespace {
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) {
-    return 0.0;
-  }
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(std::llround(p * static_cast<double>(v.size() - 1)));
-  return v[std::min(i, v.size() - 1)];
-}
-
-}  // namespace
 
 void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) {
   if (std::isfinite(options.duration_s) && !(options.duration_s > 0.0)) {
@@ -145,8 +134,8 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
   }
   const Vec3 final_p = world.ball().p_world();
   const double target_error = has_target ? (final_p - target).norm() : -1.0;
-  const double p50 = percentile(step_us, 0.5), p99 = percentile(step_us, 0.99),
-               max_us = step_us.empty() ? 0.0 : *std::max_element(step_us.begin(), step_us.end());
+  const SampleSummary cost = summarize_samples(step_us);
+  const double p50 = cost.p50, p99 = cost.p99, max_us = cost.max;
 
   std::printf("%zu steps, %.3f s simulated in %.3f s wall\n", steps, steps * dt, wall_s);
   if (grasped) {

@@ -2,7 +2,7 @@
 // the position filter against the exact first-order step response, and the link going away.
 #include "hapsim/device/interactive_device.h"
 
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 
 #include <gtest/gtest.h>
 

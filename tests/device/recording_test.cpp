@@ -1,6 +1,6 @@
 #include "hapsim/device/recording.h"
 
-#include "device_test_util.h"
+#include "support/temp_path.h"
 #include "hapsim/core/error.h"
 #include "hapsim/device/force_safety.h"
 #include "hapsim/device/simulated_device.h"

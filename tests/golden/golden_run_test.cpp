@@ -7,7 +7,7 @@
 #include "golden_trace.h"
 
 #include "hapsim/core/data_dir.h"
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/scene_device.h"

@@ -6,7 +6,7 @@
 #include "hapsim/runtime/haptic_loop.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/runtime/deadline_clock.h"
 #include "support/allocation_counter.h"
 

@@ -25,7 +25,7 @@ TEST(LatencyHistogram, PercentilesMatchExactNearestRankWithinABin) {
     h.record_us(v);
   }
   std::vector<double> sorted = samples;
-  const StepTimingUs exact = step_timing(sorted);
+  const SampleSummary exact = summarize_samples(sorted);
   const LatencyPercentilesUs s = h.summary();
   EXPECT_EQ(s.count, 20'000u);
   const auto bin_width = [](double v) { return v < 1000.0 ? 0.1 : 10.0; };

@@ -6,7 +6,7 @@
 #include "runtime/two_body_world.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/device/simulated_device.h"
 
@@ -47,21 +47,6 @@ DeviceInput script(double t) {
 std::filesystem::path temp_path(const std::string& name) {
   return std::filesystem::temp_directory_path() /
          ("hapsim_session_" + std::to_string(::getpid()) + "_" + name);
-}
-
-TEST(StepTiming, NearestRankPercentiles) {
-  std::vector<double> samples(100);
-  std::iota(samples.begin(), samples.end(), 1.0);
-  std::reverse(samples.begin(), samples.end());
-  const StepTimingUs t = step_timing(samples);
-  EXPECT_EQ(t.p50, 50.0);
-  EXPECT_EQ(t.p99, 99.0);
-  EXPECT_EQ(t.max, 100.0);
-  EXPECT_DOUBLE_EQ(t.mean, 50.5);
-  std::vector<double> one{7.0};
-  EXPECT_EQ(step_timing(one).p99, 7.0);
-  std::vector<double> none;
-  EXPECT_EQ(step_timing(none).max, 0.0);
 }
 
 TEST(Session, CountsContactsWithinLimitsWithoutPopThrough) {

@@ -4,7 +4,7 @@
 // a torn snapshot, the haptic thread allocates nothing, and a paused client holds the world.
 #include "hapsim/runtime/teleop_haptic_client.h"
 
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/scene/teleop_setup.h"
 #include "support/allocation_counting_client.h"

@@ -5,7 +5,7 @@
 #include "hapsim/runtime/world_haptic_client.h"
 
 #include "hapsim/deform/vertex_deflection.h"
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/geometry/procedural.h"

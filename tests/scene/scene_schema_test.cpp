@@ -4,7 +4,7 @@
 // the keywords the file uses; it refuses any other keyword, so the schema cannot quietly grow
 // beyond what is checked. (Debian's python3-jsonschema agrees, but CI does not install it.)
 #include "hapsim/core/error.h"
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/scene/scene_file.h"
 
 #include <gtest/gtest.h>

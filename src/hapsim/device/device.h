@@ -2,8 +2,8 @@
 // real hardware): read an input sample, write a command, report rated limits and health.
 #pragma once
 
-#include "hapsim/device/device_profile.h"
-#include "hapsim/world/device_io.h"
+#include "hapsim/core/device_profile.h"
+#include "hapsim/core/device_io.h"
 
 #include <string_view>
 

@@ -4,8 +4,8 @@
 // small per-cycle watchdog that strings them together for the haptic loop.
 #pragma once
 
-#include "hapsim/device/device_profile.h"
-#include "hapsim/world/device_io.h"
+#include "hapsim/core/device_profile.h"
+#include "hapsim/core/device_io.h"
 
 #include <cstdint>
 

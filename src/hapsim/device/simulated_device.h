@@ -4,7 +4,7 @@
 #pragma once
 
 #include "hapsim/device/device.h"
-#include "hapsim/device/trajectory.h"
+#include "hapsim/script/trajectory.h"
 
 #include <functional>
 #include <string>

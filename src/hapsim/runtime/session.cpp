@@ -78,29 +78,6 @@ bool exceeds_limits(const DeviceCommand& command, const DeviceProfile& profile) 
 
 }  // namespace
 
-StepTimingUs step_timing(std::vector<double>& samples_us) {
-  StepTimingUs t;
-  if (samples_us.empty()) {
-    return t;
-  }
-  std::sort(samples_us.begin(), samples_us.end());
-  // Nearest-rank percentiles: a value that was actually measured.
-  const auto rank = [&](double q) {
-    const auto n = samples_us.size();
-    const auto k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(n)));
-    return samples_us[std::clamp<std::size_t>(k, 1, n) - 1];
-  };
-  t.p50 = rank(0.50);
-  t.p99 = rank(0.99);
-  t.max = samples_us.back();
-  double sum = 0.0;
-  for (double v : samples_us) {
-    sum += v;
-  }
-  t.mean = sum / static_cast<double>(samples_us.size());
-  return t;
-}
-
 namespace {
 
 // The run's figures, from one cycle record at a time: the same code for an inline run and for
@@ -214,7 +191,7 @@ class SessionAccountant {
       ts.mean_force_n =
           ts.contact_steps > 0 ? force_sum_[t] / static_cast<double>(ts.contact_steps) : 0.0;
     }
-    summary_.step_us = step_timing(cost_us_);
+    summary_.step_us = summarize_samples(cost_us_);
     return std::move(summary_);
   }
 

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "hapsim/core/progress.h"
+#include "hapsim/core/statistics.h"
 #include "hapsim/device/device.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/runtime/haptic_loop.h"
@@ -40,12 +41,8 @@ struct SessionOptions {
   std::function<void(std::size_t cycle)> after_cycle;
 };
 
-struct StepTimingUs {
-  double p50 = 0.0;
-  double p99 = 0.0;
-  double max = 0.0;
-  double mean = 0.0;
-};
+/// Step costs, microseconds.
+using StepTimingUs = SampleSummary;
 
 /// Forces as the device renders them (after the safety layer's clamp): a finger tool's actuator
 /// force, or the tool's share of the tip force.
@@ -119,8 +116,5 @@ struct SessionSummary {
 
 /// Short human summary (a dozen lines).
 [[nodiscard]] std::string format_session_summary(const SessionSummary& summary);
-
-/// Percentiles of step costs (microseconds); sorts `samples_us`.
-[[nodiscard]] StepTimingUs step_timing(std::vector<double>& samples_us);
 
 }  // namespace hapsim

@@ -2,8 +2,8 @@
 
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/core/error.h"
-#include "hapsim/device/device_profile.h"
-#include "hapsim/device/trajectory.h"
+#include "hapsim/core/device_profile.h"
+#include "hapsim/script/trajectory.h"
 #include "hapsim/kinematics/hand_model.h"
 
 #include <algorithm>

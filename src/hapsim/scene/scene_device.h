@@ -2,7 +2,7 @@
 // scripted palpation aimed at named segments of the world (SPEC §10: the knee runs unattended).
 #pragma once
 
-#include "hapsim/device/palpation_trajectory.h"
+#include "hapsim/script/palpation_trajectory.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/scene/scene_description.h"
 #include "hapsim/world/world.h"

@@ -2,11 +2,11 @@
 
 #include "hapsim/core/data_dir.h"
 #include "hapsim/core/error.h"
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/geometry/procedural_knee.h"
-#include "hapsim/world/device_io.h"
+#include "hapsim/core/device_io.h"
 
 #include <nlohmann/json.hpp>
 

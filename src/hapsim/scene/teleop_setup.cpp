@@ -1,7 +1,7 @@
 #include "hapsim/scene/teleop_setup.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/device/pick_and_place_trajectory.h"
+#include "hapsim/script/pick_and_place_trajectory.h"
 #include "hapsim/kinematics/inverse_kinematics.h"
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"

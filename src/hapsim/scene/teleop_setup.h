@@ -4,7 +4,7 @@
 // `hapsim run` and the viewer, so both build exactly the same world.
 #pragma once
 
-#include "hapsim/device/trajectory.h"
+#include "hapsim/script/trajectory.h"
 #include "hapsim/scene/scene_description.h"
 #include "hapsim/world/teleop_world.h"
 

@@ -6,7 +6,7 @@
 #pragma once
 
 #include "hapsim/render/camera.h"
-#include "hapsim/world/device_io.h"
+#include "hapsim/core/device_io.h"
 
 #include <array>
 

@@ -1,7 +1,7 @@
 #include "hapsim/ui/teleop_viewer_session.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 #include "hapsim/device/interactive_device.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/render/teleop_scene.h"

@@ -1,6 +1,7 @@
 #include "hapsim/ui/viewer.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/statistics.h"
 #include "hapsim/device/interactive_device.h"
 #include "hapsim/render/camera.h"
 #include "hapsim/render/png_image.h"
@@ -75,15 +76,6 @@ std::vector<std::uint8_t> read_window(int width, int height) {
     std::copy(row.begin(), row.end(), b);
   }
   return rgba;
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) {
-    return 0.0;
-  }
-  std::sort(v.begin(), v.end());
-  const auto k = static_cast<std::size_t>(std::ceil(q * static_cast<double>(v.size())));
-  return v[std::clamp<std::size_t>(k, 1, v.size()) - 1];
 }
 
 struct FrameStats {
@@ -575,8 +567,9 @@ class Viewer {
   int finish(double wall_s) {
     const HapticLoopStatus st = session_->loop_status();
     const double fps = wall_s > 0.0 ? static_cast<double>(stats_.frames) / wall_s : 0.0;
-    const double frame_p50 = percentile(stats_.frame_ms, 0.5);
-    const double frame_p99 = percentile(stats_.frame_ms, 0.99);
+    std::vector<double> frame_ms = stats_.frame_ms;
+    const double frame_p50 = nearest_rank_percentile(frame_ms, 0.5);
+    const double frame_p99 = nearest_rank_percentile(frame_ms, 0.99);
     double peak = 0.0;
     for (const double p : forces_.peaks()) {
       peak = std::max(peak, p);

@@ -7,7 +7,7 @@
 #include "hapsim/force/contact_material.h"
 #include "hapsim/render/render_scene.h"
 #include "hapsim/runtime/haptic_loop.h"
-#include "hapsim/world/device_io.h"
+#include "hapsim/core/device_io.h"
 
 #include <filesystem>
 #include <optional>

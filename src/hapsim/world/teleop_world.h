@@ -15,7 +15,7 @@
 #include "hapsim/dynamics/rigid_ball.h"
 #include "hapsim/kinematics/master_arm.h"
 #include "hapsim/kinematics/slave_follower.h"
-#include "hapsim/world/device_io.h"
+#include "hapsim/core/device_io.h"
 
 #include <array>
 #include <memory>

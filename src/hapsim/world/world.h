@@ -20,7 +20,7 @@
 #include "hapsim/collision/proximity_query.h"
 #include "hapsim/core/types.h"
 #include "hapsim/force/god_object.h"
-#include "hapsim/world/device_io.h"
+#include "hapsim/core/device_io.h"
 #include "hapsim/world/world_description.h"
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Helpers shared by the device tests.
+// A unique temporary path per test and process, shared by the test suites.
 #pragma once
 
 #include <unistd.h>

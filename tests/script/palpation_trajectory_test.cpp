@@ -1,4 +1,4 @@
-#include "hapsim/device/palpation_trajectory.h"
+#include "hapsim/script/palpation_trajectory.h"
 
 #include "hapsim/core/error.h"
 

@@ -5,7 +5,7 @@
 // so the same script works whatever the scale, offset or master geometry.
 #pragma once
 
-#include "hapsim/device/trajectory.h"
+#include "hapsim/script/trajectory.h"
 #include "hapsim/kinematics/master_arm.h"
 #include "hapsim/kinematics/slave_follower.h"
 

@@ -2,7 +2,7 @@
 // device plays back, loaded from a CSV file (docs/trajectory-format.md) or built in code.
 #pragma once
 
-#include "hapsim/world/device_io.h"
+#include "hapsim/core/device_io.h"
 
 #include <cstddef>
 #include <filesystem>

@@ -1,7 +1,7 @@
-#include "hapsim/device/device_profile.h"
+#include "hapsim/core/device_profile.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/world/device_io.h"
+#include "hapsim/core/device_io.h"
 
 #include <string>
 

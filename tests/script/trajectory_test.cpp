@@ -1,6 +1,6 @@
-#include "hapsim/device/trajectory.h"
+#include "hapsim/script/trajectory.h"
 
-#include "device_test_util.h"
+#include "support/temp_path.h"
 #include "hapsim/core/error.h"
 
 #include <cmath>

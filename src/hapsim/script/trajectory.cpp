@@ -1,4 +1,4 @@
-#include "hapsim/device/trajectory.h"
+#include "hapsim/script/trajectory.h"
 
 #include "hapsim/core/error.h"
 

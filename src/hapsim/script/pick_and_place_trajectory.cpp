@@ -1,7 +1,7 @@
-#include "hapsim/device/pick_and_place_trajectory.h"
+#include "hapsim/script/pick_and_place_trajectory.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/device/palpation_trajectory.h"
+#include "hapsim/script/palpation_trajectory.h"
 #include "hapsim/kinematics/inverse_kinematics.h"
 
 #include <cmath>

@@ -4,7 +4,7 @@
 // the probe never jerks and a scene can ship an unattended palpation run.
 #pragma once
 
-#include "hapsim/device/trajectory.h"
+#include "hapsim/script/trajectory.h"
 
 #include <span>
 #include <vector>

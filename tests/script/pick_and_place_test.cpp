@@ -2,7 +2,7 @@
 // slave (procedural Motoman, and the GP7 when its URDF is there) grasps it, lifts and carries it,
 // lets go over the sheet, and the ball comes to rest on the sheet within 5 mm of the target spot,
 // the sheet dented under it.
-#include "hapsim/device/pick_and_place_trajectory.h"
+#include "hapsim/script/pick_and_place_trajectory.h"
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
 #include "hapsim/world/teleop_world.h"
