@@ -409,7 +409,7 @@ void run(const RunArgs& args) {
                 recorder->frames_written());
   }
   if (summary.pop_throughs > 0) {
-    std::printf("FAILED: %zu pop-through(s): a proxy entered a closed segment\n",
+    std::printf("FAILED: %zu pop-through(s): a tool went through a segment\n",
                 summary.pop_throughs);
     failed = true;
   }

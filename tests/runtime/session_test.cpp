@@ -5,10 +5,11 @@
 
 #include "runtime/two_body_world.h"
 
-#include "hapsim/core/error.h"
 #include "hapsim/core/device_profile.h"
+#include "hapsim/core/error.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/device/simulated_device.h"
+#include "hapsim/geometry/procedural.h"
 
 #include <gtest/gtest.h>
 
@@ -173,6 +174,43 @@ TEST(Session, BadOptionsAreErrors) {
   options.duration_s = 1.0;
   options.dt_s = -0.001;
   EXPECT_THROW((void)run_session(world, device, options), Error);
+}
+
+// A tool pushed through a thin penalty plate is a pop-through in the run's summary, even though
+// no proxy segment is involved (the world reports it when the tool leaves through the far side).
+TEST(Session, ToolPushedThroughAPenaltyPlateIsAPopThrough) {
+  WorldDescription w;
+  w.name = "plate";
+  MaterialDescription m;
+  m.name = "membrane";
+  m.response = ContactResponse::kPenalty;
+  m.contact.stiffness_n_per_m = 300.0;
+  m.contact.max_penetration_m = 0.05;
+  m.contact.max_force_n = 5.0;
+  w.materials.push_back(m);
+  BodyDescription body;
+  body.name = "plate";
+  SegmentDescription seg;
+  seg.name = "plate";
+  seg.mesh = make_box(Vec3(0.05, 0.05, 0.001));  // 2 mm thick, centred on z = 0
+  body.segments.push_back(std::move(seg));
+  w.bodies.push_back(std::move(body));
+  w.tools.push_back(ToolDescription{"tip", 0.0, Vec3::Zero(), -1});
+  World world(std::move(w));
+  SimulatedDevice device(
+      device_profile("omega3"),
+      [](double t) {
+        DeviceInput in;
+        in.time_s = t;
+        in.p_world = Vec3(0.0, 0.0, 0.01 - 0.02 * t);  // 10 mm above to 10 mm below in 1 s
+        return in;
+      },
+      1.0);
+  SessionOptions options;
+  options.duration_s = 1.0;
+  const SessionSummary s = run_session(world, device, options);
+  EXPECT_EQ(s.pop_throughs, 1u);
+  EXPECT_GT(s.segments[0].contacts, 0u);
 }
 
 }  // namespace

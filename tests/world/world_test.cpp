@@ -134,6 +134,54 @@ TEST(World, NoPopThroughAnOpenSheetAtOneMetrePerSecond) {
   expect_no_pop_through(std::move(w), 0.0);
 }
 
+// A probe driven down through a 2 mm penalty plate (0.1 mm per step): past the middle the nearest
+// surface is the bottom face, whose outward normal points down; the force must still never point
+// further in (down), and leaving through the bottom is one pop-through, reported by the step.
+TEST(World, PenaltyPlateNeverPullsTheToolThroughAndCountsThePopThrough) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.001, BodyKind::kStatic, 0.0);
+  w.materials[0].contact.max_penetration_m = 0.05;  // soft and deep: the probe can go through
+  w.materials[0].contact.max_force_n = 100.0;
+  World world(std::move(w));
+  int pop_throughs = 0;
+  double deepest_force_z = 0.0;
+  for (int i = 0; i <= 60; ++i) {
+    const double z = 0.001 - 0.0001 * i;  // from 1 mm above to 5 mm below the 2 mm plate
+    const StepResult& r = world.step(at(Vec3(0.003, -0.002, z)), 1e-3);
+    const Vec3& f = r.tools[0].force_world_n;
+    EXPECT_GE(f.z(), 0.0) << "pulled in at z " << z;
+    EXPECT_NEAR(f.head<2>().norm(), 0.0, 1e-9);
+    if (z < 0.0 && z > -0.002) {
+      // Depth below the top face the probe entered through, even past the middle.
+      EXPECT_NEAR(f.z(), 500.0 * -z, 1e-9) << "z " << z;
+      deepest_force_z = std::max(deepest_force_z, f.z());
+    }
+    pop_throughs += r.penalty_pop_throughs;
+  }
+  EXPECT_GT(deepest_force_z, 0.9);
+  EXPECT_EQ(pop_throughs, 1);
+}
+
+// Sliding over a curved penalty body turns the normal gradually: no crossing, no pop-through, the
+// force radial all the way round, when the probe circles a sphere half way at a constant depth.
+TEST(World, SlidingRoundAPenaltySphereIsNotAPopThrough) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0);
+  w.bodies[0].X_world_body = Iso3::Identity();
+  w.bodies[0].segments[0].mesh = make_uv_sphere(0.03, 128, 64);
+  World world(std::move(w));
+  int pop_throughs = 0;
+  for (int i = 0; i <= 400; ++i) {
+    const double a = M_PI * i / 400.0;
+    const Vec3 p = 0.028 * Vec3(std::cos(a), std::sin(a), 0.0);  // 2 mm deep
+    const StepResult& r = world.step(at(p), 1e-3);
+    const Vec3& f = r.tools[0].force_world_n;
+    ASSERT_GT(f.norm(), 0.5) << "step " << i;
+    EXPECT_GT(f.normalized().dot(p.normalized()), 0.99) << "step " << i;
+    pop_throughs += r.penalty_pop_throughs;
+  }
+  world.step(at(Vec3(-0.05, 0.0, 0.0)), 1e-3);  // out through the side it came from
+  EXPECT_EQ(pop_throughs + world.last_result().penalty_pop_throughs, 0);
+}
+
 TEST(World, NaNAndUnhealthyInputGiveZeroForce) {
   World world(box_world(ContactResponse::kProxy, 0.02, BodyKind::kDeformable, 0.0));
   world.step(at(Vec3(0, 0, 0.001)), 1e-3);

@@ -20,6 +20,7 @@ void fill_cycle_record(CycleRecord& record, std::uint64_t cycle, const DeviceInp
   record.contact_count = static_cast<std::int32_t>(contacts);
   record.dropped_contacts = std::max(0, result.dropped_contacts) +
                             static_cast<std::int32_t>(result.contacts.size() - contacts);
+  record.penalty_pop_throughs = result.penalty_pop_throughs;
   record.cost_us = cost_us;
 }
 

@@ -28,6 +28,8 @@ struct CycleRecord {
   std::int32_t contact_count = 0;
   /// Contacts the world could not report plus those beyond kMaxCycleContacts.
   std::int32_t dropped_contacts = 0;
+  /// Tools pulled through a penalty segment this cycle (StepResult::penalty_pop_throughs).
+  std::int32_t penalty_pop_throughs = 0;
   double cost_us = 0.0;
 };
 

@@ -117,6 +117,7 @@ class SessionAccountant {
     }
     summary_.peak_command_force_n = std::max(summary_.peak_command_force_n, command_peak_n(out));
     summary_.dropped_contacts += static_cast<std::size_t>(std::max(0, r.dropped_contacts));
+    summary_.pop_throughs += static_cast<std::size_t>(std::max(0, r.penalty_pop_throughs));
     std::fill(touched_.begin(), touched_.end(), std::uint8_t{0});
     for (std::int32_t i = 0; i < r.contact_count; ++i) {
       const WorldContact& c = r.contacts[static_cast<std::size_t>(i)];

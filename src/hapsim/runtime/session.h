@@ -84,7 +84,8 @@ struct SessionSummary {
   double simulated_s = 0.0;
   double wall_s = 0.0;
   StepTimingUs step_us;
-  /// Steps at which a tool's proxy centre was inside a closed proxy segment (must be 0).
+  /// Steps at which a tool's proxy centre was inside a closed proxy segment, plus tools that
+  /// left a penalty segment through its far side (must be 0).
   std::size_t pop_throughs = 0;
   /// Deepest the proxy sphere ever reached into a proxy segment, metres (tolerance-sized).
   double max_proxy_penetration_m = 0.0;

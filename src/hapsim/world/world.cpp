@@ -70,6 +70,21 @@ struct World::Segment {
   std::size_t pending_count = 0;
 };
 
+// Which side of a penalty segment a tool is pressing from. A penalty contact's depth is measured to
+// the nearest rest surface; inside a thin segment (a 2 mm plate, a membrane) the nearest surface
+// becomes the far one once the tool passes the middle, and the spring would then pull the tool
+// through. So a contact remembers the side it is on: the normal and surface point of its last step
+// on that side; a normal that flips within one step (more than 90°: no sliding over a curved
+// surface turns it that far in a millisecond) means the tool crossed the middle, and from then on
+// the force stays along the remembered normal, with the depth below the remembered tangent plane.
+// Leaving the segment while crossed is leaving through the far side: a pop-through.
+struct PenaltySide {
+  Vec3 n_world = Vec3::Zero();      // unit, out of the segment on the entry side
+  Vec3 point_world = Vec3::Zero();  // surface point on the entry side
+  bool in_contact = false;
+  bool crossed = false;  // the nearest surface is now the far one
+};
+
 struct World::Tool {
   GodObject proxy;
   std::vector<ProxySurface> surfaces;        // one per proxy segment
@@ -79,6 +94,8 @@ struct World::Tool {
   // deeper than the reach now (it moves far less than a reach per cycle), so only then is the
   // costly deep-inside query needed.
   std::vector<std::uint8_t> near_last_step;
+  // Per flat segment: the side a penalty contact came from (see step_tool).
+  std::vector<PenaltySide> penalty_side;
   Vec3 p_previous_world = Vec3::Zero();
   bool has_previous = false;
 };
@@ -211,6 +228,7 @@ World::World(WorldDescription description, WorldOptions options)
     tool->proxy = GodObject(gp);
     tool->hints.resize(segments_.size());
     tool->near_last_step.assign(segments_.size(), 0);
+    tool->penalty_side.assign(segments_.size(), PenaltySide{});
     for (std::size_t i = 0; i < segments_.size(); ++i) {
       const Segment& seg = *segments_[i];
       if (seg.response != ContactResponse::kProxy) {
@@ -319,6 +337,14 @@ void World::update_materials(double dt_s) {
   }
 }
 
+void World::end_penalty_contact(PenaltySide& side) {
+  if (side.in_contact && side.crossed) {
+    ++pop_throughs_;  // left through the far side
+  }
+  side.in_contact = false;
+  side.crossed = false;
+}
+
 void World::add_contact(const WorldContact& contact) {
   if (contact_count_ < contacts_.size()) {
     contacts_[contact_count_++] = contact;
@@ -378,34 +404,52 @@ void World::step_tool(std::size_t t, const Vec3& p_world, double dt_s) {
     }
     SurfacePoint sp;
     std::uint8_t& near = tool.near_last_step[i];
+    PenaltySide& side = tool.penalty_side[i];
     if (!seg.rest_query->contact_within(p_body, reach, &sp, &tool.hints[i])) {
       // Either clear of the surface or deeper inside than the reach (saturated spring). Deeper
       // is only possible inside the bounds, and only for a tool that was near or inside last
       // step or has moved more than a reach since (a first cycle, a jump).
       if (!seg.rest_bounds_body.contains(p_body) || (near == 0 && moved_m < reach)) {
         near = 0;
+        end_penalty_contact(side);
         continue;
       }
       sp = seg.rest_query->closest_point(p_body, &tool.hints[i]);
       if (!(sp.signed_distance < 0.0)) {
         near = 0;
+        end_penalty_contact(side);
         continue;
       }
     }
     near = 1;
-    const double depth = radius - sp.signed_distance;
+    double depth = radius - sp.signed_distance;
     if (!(depth > 0.0) || !std::isfinite(depth)) {
+      end_penalty_contact(side);
       continue;
     }
-    const Vec3 n_world = seg.X_world_body.linear() * sp.normal;
+    Vec3 n_world = seg.X_world_body.linear() * sp.normal;
+    Vec3 point_world = seg.X_world_body * sp.point;
+    // Past the middle (or back): the nearest surface faces away from the entry side's normal.
+    side.crossed = side.in_contact && n_world.dot(side.n_world) < 0.0;
+    if (!side.in_contact || !side.crossed) {
+      side.n_world = n_world;  // on the entry side: follow the surface
+      side.point_world = point_world;
+    } else {
+      // Past the middle: push back out of the entry side, never further in.
+      depth = radius - (p_world - side.point_world).dot(side.n_world);
+      n_world = side.n_world;
+      point_world = p_world - (radius - depth) * n_world;
+    }
+    side.in_contact = true;
     const Vec3 f = penalty_force(material, depth, n_world, -v_world.dot(n_world));
     total += f;
     add_contact(WorldContact{static_cast<std::int32_t>(t), static_cast<std::int32_t>(seg.body),
-                             static_cast<std::int32_t>(seg.index_in_body),
-                             seg.X_world_body * sp.point, n_world, depth, f.norm(), false});
+                             static_cast<std::int32_t>(seg.index_in_body), point_world, n_world,
+                             depth, f.norm(), false});
     ++state.contact_count;
     if (seg.deflection && seg.pending_count < seg.pending.size()) {
-      seg.pending[seg.pending_count++] = DeflectionContact{sp.point, depth, radius, 0};
+      seg.pending[seg.pending_count++] =
+          DeflectionContact{seg.X_body_world * point_world, depth, radius, 0};
     }
   }
   state.force_world_n = total.allFinite() ? total : Vec3::Zero();
@@ -418,6 +462,7 @@ const StepResult& World::step(const DeviceInput& input, double dt_s) {
   time_s_ += dt;
   contact_count_ = 0;
   dropped_contacts_ = 0;
+  pop_throughs_ = 0;
   for (auto& seg : segments_) {
     seg->pending_count = 0;
   }
@@ -459,6 +504,9 @@ const StepResult& World::step(const DeviceInput& input, double dt_s) {
     }
     for (auto& tool : tools_) {
       tool->has_previous = false;  // no velocity spike when the input comes back
+      for (PenaltySide& side : tool->penalty_side) {
+        side = PenaltySide{};  // the tool may come back anywhere
+      }
     }
   }
   // 4. Deformation: contacts deflect, everything else recovers.
@@ -476,6 +524,7 @@ const StepResult& World::step(const DeviceInput& input, double dt_s) {
   result_.contacts = {contacts_.data(), contact_count_};
   result_.command = command;
   result_.dropped_contacts = dropped_contacts_;
+  result_.penalty_pop_throughs = pop_throughs_;
   return result_;
 }
 
@@ -486,6 +535,9 @@ void World::reset() {
     tool->has_previous = false;
     for (QueryHint& h : tool->hints) {
       h = QueryHint{};
+    }
+    for (PenaltySide& side : tool->penalty_side) {
+      side = PenaltySide{};
     }
   }
   for (auto& seg : segments_) {

@@ -9,7 +9,8 @@
 //  1. proxy segments (bone, ligament, sheet): the tool's god-object proxy moves towards the
 //     tool without entering any of them; force = spring from the tool to the proxy;
 //  2. penalty segments (skin, muscle): F = k·x along the normal at the tool's own depth x,
-//     capped by the segment's maximum penetration and maximum force;
+//     capped by the segment's maximum penetration and maximum force; a contact remembers the
+//     side it entered from, so a thin segment never pulls the tool through (world.cpp);
 //  3. normal damping on both, never below the passivity floor factor·k·dt;
 //  4. deformable segments deflect under every contact (eq. 1), the rest recover.
 // Depths are measured against each segment's rest surface (the tissue's spring), which keeps
@@ -18,9 +19,9 @@
 #pragma once
 
 #include "hapsim/collision/proximity_query.h"
+#include "hapsim/core/device_io.h"
 #include "hapsim/core/types.h"
 #include "hapsim/force/god_object.h"
-#include "hapsim/core/device_io.h"
 #include "hapsim/world/world_description.h"
 
 #include <cstdint>
@@ -33,6 +34,7 @@ namespace hapsim {
 
 class MeshBvh;
 class VertexDeflection;
+struct PenaltySide;
 
 struct WorldOptions {
   /// Stiffness of every material is clamped to this (the device's rated maximum keeps the
@@ -70,6 +72,9 @@ struct StepResult {
   DeviceCommand command;
   /// Contacts found but not reported because the per-step buffer was full.
   std::int32_t dropped_contacts = 0;
+  /// Tools that left a penalty segment through its far side this step (pulled through a thin
+  /// segment: must stay 0).
+  std::int32_t penalty_pop_throughs = 0;
 };
 
 /// A content hash of a world description (meshes, materials, tools), as recordings carry it.
@@ -137,6 +142,7 @@ class World {
   void update_materials(double dt_s);
   void step_tool(std::size_t t, const Vec3& p_world, double dt_s);
   void add_contact(const WorldContact& contact);
+  void end_penalty_contact(PenaltySide& side);
 
   WorldDescription description_;
   std::unique_ptr<HandModel> hand_;  // when a glove drives the tools
@@ -150,6 +156,7 @@ class World {
   std::vector<WorldContact> contacts_;  // capacity fixed at construction
   std::size_t contact_count_ = 0;
   std::int32_t dropped_contacts_ = 0;
+  std::int32_t pop_throughs_ = 0;
   StepResult result_;
   double time_s_ = 0.0;
   bool tools_placed_ = false;
