@@ -47,6 +47,8 @@ TEST(MaterialChange, StiffnessChangeTakesEffectAtTheNextStep) {
   ContactMaterial c = world.description().materials[0].contact;
   c.stiffness_n_per_m = 1000.0;
   ASSERT_TRUE(world.set_material_contact(0, c));
+  EXPECT_EQ(world.material_contact(0).stiffness_n_per_m, 1000.0);
+  EXPECT_EQ(world.description().materials[0].contact.stiffness_n_per_m, 400.0);  // as described
   EXPECT_NEAR(force_at_depth(world, 0.005), 1000.0 * 0.005, 1e-9);
   c.max_force_n = 3.0;  // the cap too
   ASSERT_TRUE(world.set_material_contact(0, c));

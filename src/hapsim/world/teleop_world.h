@@ -9,13 +9,13 @@
 // Allocation-free after construction.
 #pragma once
 
+#include "hapsim/core/device_io.h"
 #include "hapsim/deform/virtual_sheet.h"
 #include "hapsim/dynamics/ball_environment.h"
 #include "hapsim/dynamics/parallel_gripper.h"
 #include "hapsim/dynamics/rigid_ball.h"
 #include "hapsim/kinematics/master_arm.h"
 #include "hapsim/kinematics/slave_follower.h"
-#include "hapsim/core/device_io.h"
 
 #include <array>
 #include <memory>

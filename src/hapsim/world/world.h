@@ -1,18 +1,17 @@
-// The simulated world and its deterministic step (SPEC §3, §4, §7): device input in, per-tool
-// forces, contacts and deformation out.
-//
-// Built once from a WorldDescription (read-only afterwards); step() only touches per-step state
-// that was sized at construction, so it allocates nothing (haptic path) and is a pure function
-// of the state and the input: the same inputs replay to the same bits.
-//
-// One step, per tool (a sphere at the device pose times its offset):
-//  1. proxy segments (bone, ligament, sheet): the tool's god-object proxy moves towards the
-//     tool without entering any of them; force = spring from the tool to the proxy;
-//  2. penalty segments (skin, muscle): F = k·x along the normal at the tool's own depth x,
-//     capped by the segment's maximum penetration and maximum force; a contact remembers the
-//     side it entered from, so a thin segment never pulls the tool through (world.cpp);
-//  3. normal damping on both, never below the passivity floor factor·k·dt;
-//  4. deformable segments deflect under every contact (eq. 1), the rest recover.
+// The simulated world (SPEC §3, §4, §7): device input in, per-tool forces, contacts and
+// deformation out. A World holds the read-only model (world_model.h, built once from a
+// WorldDescription) and the per-step state (world_state.h, sized at construction), and steps them
+// with the deterministic, allocation-free step() of world_step.h: the same inputs replay to the
+// same bits. The stages of a step are listed in world_stages.h:
+//  1. place tools: a sphere at the device pose times its offset, or the glove hand's fingertips;
+//  2. detect contacts with penalty segments (skin, muscle), remembering the side a tool entered
+//     from so a thin segment never pulls it through;
+//  3. respond: proxy segments (bone, ligament, sheet) through each tool's god-object (the proxy
+//     never enters them; force = spring from the tool to the proxy); penalty segments F = k·x
+//     along the normal, capped by the segment's maximum penetration and force; normal damping on
+//     both, never below the passivity floor factor·k·dt;
+//  4. deform: deformable segments deflect under every contact (eq. 1), the rest recover;
+//  5. safety: finite forces only, assembled into the device command.
 // Depths are measured against each segment's rest surface (the tissue's spring), which keeps
 // force and deflection consistent: the dent follows the probe instead of pushing it out. The
 // deformed surface has its own exact structure, refitted (never rebuilt) on demand.
@@ -20,65 +19,18 @@
 
 #include "hapsim/collision/proximity_query.h"
 #include "hapsim/core/device_io.h"
+#include "hapsim/core/stopwatch.h"
 #include "hapsim/core/types.h"
-#include "hapsim/force/god_object.h"
 #include "hapsim/world/world_description.h"
+#include "hapsim/world/world_model.h"
+#include "hapsim/world/world_state.h"
 
 #include <cstdint>
-#include <memory>
-#include <span>
 #include <string>
-#include <vector>
 
 namespace hapsim {
 
-class MeshBvh;
 class VertexDeflection;
-struct PenaltySide;
-
-struct WorldOptions {
-  /// Stiffness of every material is clamped to this (the device's rated maximum keeps the
-  /// rendering stable on it); infinity: no clamp.
-  double max_stiffness_n_per_m = kInf;
-  /// God-object parameters (the radius comes from each tool).
-  double proxy_max_substep_m = 2.5e-4;
-  int proxy_max_iterations = 16;
-};
-
-/// One contact of one tool with one segment this step.
-struct WorldContact {
-  std::int32_t tool = -1;
-  std::int32_t body = -1;
-  std::int32_t segment = -1;  ///< within the body
-  Vec3 point_world = Vec3::Zero();
-  Vec3 normal_world = Vec3::Zero();  ///< unit, out of the segment towards the tool
-  double depth_m = 0.0;              ///< tool depth below the rest surface (≥ 0)
-  double force_n = 0.0;              ///< magnitude of this contact's force on the tool
-  bool proxy = false;                ///< answered by the god-object (else penalty)
-};
-
-struct ToolState {
-  Vec3 p_world = Vec3::Zero();      ///< the tool's centre, where the device puts it
-  Vec3 proxy_world = Vec3::Zero();  ///< god-object position (equals p_world when free)
-  Vec3 force_world_n = Vec3::Zero();
-  std::int32_t contact_count = 0;
-};
-
-struct StepResult {
-  double time_s = 0.0;
-  std::span<const ToolState> tools;
-  std::span<const WorldContact> contacts;
-  /// Forces for the device (not yet clamped to its rated limits: the safety layer does that).
-  DeviceCommand command;
-  /// Contacts found but not reported because the per-step buffer was full.
-  std::int32_t dropped_contacts = 0;
-  /// Tools that left a penalty segment through its far side this step (pulled through a thin
-  /// segment: must stay 0).
-  std::int32_t penalty_pop_throughs = 0;
-};
-
-/// A content hash of a world description (meshes, materials, tools), as recordings carry it.
-[[nodiscard]] std::string content_hash(const WorldDescription& description);
 
 class World {
  public:
@@ -103,13 +55,22 @@ class World {
   /// they were (after a pause, the device may have moved far: no damping spike).
   void forget_tool_motion() noexcept;
 
-  [[nodiscard]] const WorldDescription& description() const { return description_; }
-  [[nodiscard]] const StepResult& last_result() const { return result_; }
-  [[nodiscard]] std::size_t body_count() const { return description_.bodies.size(); }
+  /// The description the world was built from (materials as described: live edits are in
+  /// material_contact()).
+  [[nodiscard]] const WorldDescription& description() const { return model_.description(); }
+  [[nodiscard]] const WorldModel& model() const { return model_; }
+  /// The per-step state: only the thread that steps may read it while the world runs.
+  [[nodiscard]] const WorldState& state() const { return state_; }
+  [[nodiscard]] const StepResult& last_result() const { return state_.result; }
+  /// A material's contact parameters as edited live (set_material_contact), before the clamp.
+  [[nodiscard]] const ContactMaterial& material_contact(std::uint32_t material) const {
+    return state_.material_contact.at(material);
+  }
+  [[nodiscard]] std::size_t body_count() const { return description().bodies.size(); }
   [[nodiscard]] std::size_t segment_count(std::size_t body) const;
   /// Flat index of (body, segment) over all bodies, for per-segment statistics.
   [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const;
-  [[nodiscard]] std::size_t flat_segment_count() const { return segments_.size(); }
+  [[nodiscard]] std::size_t flat_segment_count() const { return model_.segments().size(); }
 
   /// The rest-shape query of a segment (body frame): the one step() uses.
   [[nodiscard]] const ProximityQuery& rest_query(std::size_t body, std::size_t segment) const;
@@ -132,34 +93,13 @@ class World {
   [[nodiscard]] std::string content_hash() const;
   /// Bytes of all query structures (meshes excluded).
   [[nodiscard]] std::size_t query_memory_bytes() const;
-  /// Construction time, milliseconds.
+  /// Construction time (model and state), milliseconds.
   [[nodiscard]] double build_ms() const { return build_ms_; }
 
  private:
-  struct Segment;
-  struct Tool;
-
-  void update_materials(double dt_s);
-  void step_tool(std::size_t t, const Vec3& p_world, double dt_s);
-  void add_contact(const WorldContact& contact);
-  void end_penalty_contact(PenaltySide& side);
-
-  WorldDescription description_;
-  std::unique_ptr<HandModel> hand_;  // when a glove drives the tools
-  WorldOptions options_;
-  std::vector<std::unique_ptr<Segment>> segments_;  // flat over bodies
-  std::vector<std::size_t> body_first_segment_;
-  std::vector<std::unique_ptr<Tool>> tools_;
-  std::vector<ContactMaterial> materials_;  // effective, for materials_dt_s_
-  double materials_dt_s_ = -1.0;
-  std::vector<ToolState> tool_states_;
-  std::vector<WorldContact> contacts_;  // capacity fixed at construction
-  std::size_t contact_count_ = 0;
-  std::int32_t dropped_contacts_ = 0;
-  std::int32_t pop_throughs_ = 0;
-  StepResult result_;
-  double time_s_ = 0.0;
-  bool tools_placed_ = false;
+  Stopwatch build_watch_;  // first member: started before the model and the state are built
+  WorldModel model_;
+  WorldState state_;
   double build_ms_ = 0.0;
 };
 

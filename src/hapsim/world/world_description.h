@@ -100,4 +100,7 @@ struct WorldDescription {
   double passivity_damping_factor = 1.0;
 };
 
+/// A content hash of a world description (meshes, materials, tools), as recordings carry it.
+[[nodiscard]] std::string content_hash(const WorldDescription& description);
+
 }  // namespace hapsim

@@ -1,0 +1,113 @@
+#include "hapsim/world/world_description.h"
+
+#include <cstdio>
+
+namespace hapsim {
+
+std::string_view to_string(ContactResponse response) {
+  return response == ContactResponse::kProxy ? "proxy" : "penalty";
+}
+
+std::string_view to_string(ContactMethod method) {
+  switch (method) {
+    case ContactMethod::kExact:
+      return "exact";
+    case ContactMethod::kSphereTree:
+      return "spheretree";
+    case ContactMethod::kKnee:
+      return "knee";
+  }
+  return "unknown";
+}
+
+std::optional<ContactMethod> parse_contact_method(std::string_view name) {
+  for (const ContactMethod m :
+       {ContactMethod::kExact, ContactMethod::kSphereTree, ContactMethod::kKnee}) {
+    if (name == to_string(m)) {
+      return m;
+    }
+  }
+  return std::nullopt;
+}
+
+std::string_view to_string(BodyKind kind) {
+  switch (kind) {
+    case BodyKind::kStatic:
+      return "static";
+    case BodyKind::kDynamic:
+      return "dynamic";
+    case BodyKind::kDeformable:
+      return "deformable";
+  }
+  return "unknown";
+}
+
+namespace {
+
+// FNV-1a, 64 bit: a stable content fingerprint (not a security hash).
+class Fnv64 {
+ public:
+  void bytes(const void* data, std::size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) {
+      h_ = (h_ ^ p[i]) * 1099511628211ULL;
+    }
+  }
+  void number(double x) { bytes(&x, sizeof x); }
+  void text(const std::string& s) {
+    bytes(s.data(), s.size());
+    number(static_cast<double>(s.size()));
+  }
+  [[nodiscard]] std::uint64_t value() const { return h_; }
+
+ private:
+  std::uint64_t h_ = 14695981039346656037ULL;
+};
+
+}  // namespace
+
+std::string content_hash(const WorldDescription& description) {
+  Fnv64 h;
+  h.text(description.name);
+  for (const MaterialDescription& m : description.materials) {
+    h.text(m.name);
+    const ContactMaterial& c = m.contact;
+    for (double x : {c.stiffness_n_per_m, c.max_penetration_m, c.max_force_n, c.damping_n_s_per_m,
+                     c.static_friction, c.dynamic_friction, m.deflection.elasticity_factor,
+                     m.deflection.recovery_time_constant_s, m.deflection.max_recovery_speed_m_per_s,
+                     m.deflection.max_deflection_m}) {
+      h.number(x);
+    }
+    h.number(static_cast<double>(m.response));
+  }
+  for (const BodyDescription& b : description.bodies) {
+    h.text(b.name);
+    h.number(static_cast<double>(b.kind));
+    h.number(static_cast<double>(b.method));
+    h.bytes(b.X_world_body.matrix().data(), sizeof(double) * 16);
+    for (const SegmentDescription& s : b.segments) {
+      h.text(s.name);
+      h.number(s.material);
+      h.number(s.two_sided ? 1.0 : 0.0);
+      for (const Vec3& v : s.mesh.vertices) {
+        h.bytes(v.data(), sizeof(double) * 3);
+      }
+      for (const TriangleIndices& tri : s.mesh.triangles) {
+        h.bytes(tri.data(), sizeof(std::uint32_t) * 3);
+      }
+    }
+  }
+  for (const ToolDescription& t : description.tools) {
+    h.text(t.name);
+    h.number(t.radius_m);
+    h.bytes(t.offset_device.data(), sizeof(double) * 3);
+    h.number(t.finger);
+  }
+  h.number(description.passivity_damping_factor);
+  h.number(description.has_hand ? description.hand.dip_per_pip : -1.0);
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(h.value()));
+  return buffer;
+}
+
+}  // namespace hapsim

@@ -1,0 +1,109 @@
+#include "hapsim/world/world_model.h"
+
+#include "hapsim/collision/knee_index.h"
+#include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/collision/sphere_tree.h"
+#include "hapsim/core/device_io.h"
+#include "hapsim/core/error.h"
+#include "hapsim/core/stopwatch.h"
+#include "hapsim/force/god_object.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hapsim {
+
+namespace {
+
+std::unique_ptr<ProximityQuery> make_query(ContactMethod method, const TriangleMesh& mesh) {
+  switch (method) {
+    case ContactMethod::kSphereTree:
+      return std::make_unique<SphereTree>(mesh);
+    case ContactMethod::kKnee:
+      return std::make_unique<KneeIndex>(mesh);
+    case ContactMethod::kExact:
+      break;
+  }
+  return std::make_unique<MeshBvh>(mesh);
+}
+
+void check_tool(const ToolDescription& td) {
+  if (!(td.radius_m >= 0.0) || !std::isfinite(td.radius_m) || !td.offset_device.allFinite()) {
+    throw Error("tool '" + td.name + "'", "needs a finite radius >= 0 and a finite offset");
+  }
+  if (td.finger >= kMaxFingers) {
+    throw Error("tool '" + td.name + "'",
+                "finger must be below " + std::to_string(kMaxFingers) + " (or -1)");
+  }
+}
+
+}  // namespace
+
+WorldModel::WorldModel(WorldDescription description, WorldOptions options)
+    : description_(std::move(description)), options_(options) {
+  const Stopwatch watch;
+  if (description_.has_hand) {
+    hand_ = std::make_unique<HandModel>(description_.hand);
+    for (const ToolDescription& t : description_.tools) {
+      if (t.finger < 0 || t.finger >= kHandFingers) {
+        throw Error("tool '" + t.name + "'",
+                    "a glove drives the tools: expected a finger 0 (thumb) .. 4 (little)");
+      }
+    }
+  }
+  for (const ToolDescription& t : description_.tools) {
+    max_tool_radius_m_ = std::max(max_tool_radius_m_, t.radius_m);
+  }
+  for (std::size_t b = 0; b < description_.bodies.size(); ++b) {
+    const BodyDescription& body = description_.bodies[b];
+    body_first_segment_.push_back(segments_.size());
+    if (body.segments.empty()) {
+      throw Error("body '" + body.name + "'", "has no segments");
+    }
+    for (std::size_t s = 0; s < body.segments.size(); ++s) {
+      const SegmentDescription& sd = body.segments[s];
+      const std::string where = "body '" + body.name + "' segment '" + sd.name + "'";
+      if (sd.mesh.empty()) {
+        throw Error(where, "has an empty mesh");
+      }
+      if (sd.material >= description_.materials.size()) {
+        throw Error(where, "refers to material " + std::to_string(sd.material) + " of " +
+                               std::to_string(description_.materials.size()));
+      }
+      SegmentModel seg;
+      seg.body = b;
+      seg.index_in_body = s;
+      seg.description = &sd;
+      seg.material = sd.material;
+      seg.response = description_.materials[sd.material].response;
+      seg.deformable = body.kind == BodyKind::kDeformable;
+      seg.X_world_body = body.X_world_body;
+      seg.X_body_world = body.X_world_body.inverse();
+      seg.rest_bounds_body = sd.mesh.bounds();
+      seg.rest_query = make_query(body.method, sd.mesh);
+      (seg.response == ContactResponse::kProxy ? proxy_segments_ : penalty_segments_) += 1;
+      segments_.push_back(std::move(seg));
+    }
+  }
+  if (proxy_segments_ > static_cast<std::size_t>(GodObject::kMaxSurfaces)) {
+    throw Error("world '" + description_.name + "'",
+                "has " + std::to_string(proxy_segments_) + " proxy segments; at most " +
+                    std::to_string(GodObject::kMaxSurfaces) + " are supported");
+  }
+  for (const ToolDescription& td : description_.tools) {
+    check_tool(td);
+  }
+  build_ms_ = watch.elapsed_ms();
+}
+
+WorldModel::~WorldModel() = default;
+
+std::size_t WorldModel::query_memory_bytes() const {
+  std::size_t bytes = 0;
+  for (const SegmentModel& seg : segments_) {
+    bytes += seg.rest_query->memory_bytes();
+  }
+  return bytes;
+}
+
+}  // namespace hapsim

@@ -1,0 +1,80 @@
+// The read-only half of a world (MuJoCo's mjModel): everything built once from a WorldDescription
+// — per segment its rest-shape proximity query, frame and material; the tools; the hand model when
+// a glove drives the tools — and never changed by a step. The per-step half is WorldState
+// (world_state.h); step() (world_step.h) reads this and writes that.
+#pragma once
+
+#include "hapsim/collision/proximity_query.h"
+#include "hapsim/core/types.h"
+#include "hapsim/world/world_description.h"
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace hapsim {
+
+struct WorldOptions {
+  /// Stiffness of every material is clamped to this (the device's rated maximum keeps the
+  /// rendering stable on it); infinity: no clamp.
+  double max_stiffness_n_per_m = kInf;
+  /// God-object parameters (the radius comes from each tool).
+  double proxy_max_substep_m = 2.5e-4;
+  int proxy_max_iterations = 16;
+};
+
+/// One segment of one body, flattened over all bodies (flat index = the body's first segment +
+/// the segment's index in its body).
+struct SegmentModel {
+  std::size_t body = 0;
+  std::size_t index_in_body = 0;
+  const SegmentDescription* description = nullptr;
+  std::uint32_t material = 0;
+  ContactResponse response = ContactResponse::kProxy;
+  bool deformable = false;
+  Iso3 X_world_body = Iso3::Identity();
+  Iso3 X_body_world = Iso3::Identity();
+  Box3 rest_bounds_body;
+  /// The rest surface's query in the body frame (the body's contact method): what a step uses.
+  std::unique_ptr<ProximityQuery> rest_query;
+};
+
+class WorldModel {
+ public:
+  /// Builds every query structure. Throws hapsim::Error naming the body, segment or tool on an
+  /// unusable description (empty mesh, bad material index, too many proxy segments, bad tool).
+  WorldModel(WorldDescription description, WorldOptions options);
+  ~WorldModel();
+  WorldModel(const WorldModel&) = delete;
+  WorldModel& operator=(const WorldModel&) = delete;
+
+  [[nodiscard]] const WorldDescription& description() const { return description_; }
+  [[nodiscard]] const WorldOptions& options() const { return options_; }
+  /// The hand the glove drives, or null when the tools sit at device offsets.
+  [[nodiscard]] const HandModel* hand() const { return hand_.get(); }
+  [[nodiscard]] const std::vector<SegmentModel>& segments() const { return segments_; }
+  [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const {
+    return body_first_segment_.at(body) + segment;
+  }
+  [[nodiscard]] std::size_t tool_count() const { return description_.tools.size(); }
+  [[nodiscard]] std::size_t proxy_segment_count() const { return proxy_segments_; }
+  [[nodiscard]] std::size_t penalty_segment_count() const { return penalty_segments_; }
+  [[nodiscard]] double max_tool_radius_m() const { return max_tool_radius_m_; }
+  /// Bytes of all rest-shape query structures (meshes excluded).
+  [[nodiscard]] std::size_t query_memory_bytes() const;
+  [[nodiscard]] double build_ms() const { return build_ms_; }
+
+ private:
+  WorldDescription description_;
+  WorldOptions options_;
+  std::unique_ptr<HandModel> hand_;
+  std::vector<SegmentModel> segments_;
+  std::vector<std::size_t> body_first_segment_;
+  std::size_t proxy_segments_ = 0;
+  std::size_t penalty_segments_ = 0;
+  double max_tool_radius_m_ = 0.0;
+  double build_ms_ = 0.0;
+};
+
+}  // namespace hapsim

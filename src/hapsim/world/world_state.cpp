@@ -1,0 +1,112 @@
+#include "hapsim/world/world_state.h"
+
+#include "hapsim/collision/knee_index.h"
+#include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/core/error.h"
+#include "hapsim/world/world_model.h"
+
+#include <algorithm>
+
+namespace hapsim {
+
+WorldState::WorldState(const WorldModel& model) {
+  const WorldDescription& d = model.description();
+  const std::size_t tool_count = model.tool_count();
+  const std::vector<SegmentModel>& segs = model.segments();
+  segments.resize(segs.size());
+  for (std::size_t i = 0; i < segs.size(); ++i) {
+    const SegmentModel& seg = segs[i];
+    if (!seg.deformable) {
+      continue;
+    }
+    const SegmentDescription& sd = *seg.description;
+    VertexDeflectionOptions dopt;
+    dopt.segments = {d.materials[sd.material].deflection};
+    dopt.typical_contact_radius_m = model.max_tool_radius_m();
+    if (d.bodies[seg.body].method == ContactMethod::kKnee) {
+      // The knee paper moves vertices along their group's radial direction.
+      const auto& knee = static_cast<const KneeIndex&>(*seg.rest_query);
+      dopt.directions.resize(sd.mesh.vertex_count());
+      for (std::uint32_t v = 0; v < sd.mesh.vertex_count(); ++v) {
+        dopt.directions[v] = -knee.radial_direction(v);
+      }
+    }
+    try {
+      segments[i].deflection = std::make_unique<VertexDeflection>(sd.mesh, std::move(dopt));
+    } catch (const Error& e) {
+      throw Error("body '" + d.bodies[seg.body].name + "' segment '" + sd.name + "'", e.what());
+    }
+    segments[i].pending.resize(std::max<std::size_t>(tool_count * GodObject::kMaxContacts, 1));
+  }
+  for (std::size_t t = 0; t < tool_count; ++t) {
+    GodObjectParams gp;
+    gp.radius_m = d.tools[t].radius_m;
+    gp.max_substep_m = model.options().proxy_max_substep_m;
+    gp.max_iterations = model.options().proxy_max_iterations;
+    ToolRuntime tool;
+    tool.proxy = GodObject(gp);
+    tool.hints.resize(segs.size());
+    tool.near_last_step.assign(segs.size(), 0);
+    tool.penalty_side.assign(segs.size(), PenaltySide{});
+    tool.penalty.resize(std::max<std::size_t>(model.penalty_segment_count(), 1));
+    tools.push_back(std::move(tool));
+  }
+  // The proxy surfaces point into this state's hints and materials: set up once the vectors have
+  // their final size (they never reallocate afterwards).
+  material_contact.reserve(d.materials.size());
+  for (const MaterialDescription& m : d.materials) {
+    material_contact.push_back(m.contact);
+  }
+  materials.resize(d.materials.size());
+  for (ToolRuntime& tool : tools) {
+    for (std::size_t i = 0; i < segs.size(); ++i) {
+      const SegmentModel& seg = segs[i];
+      if (seg.response != ContactResponse::kProxy) {
+        continue;
+      }
+      tool.surfaces.push_back(ProxySurface{seg.rest_query.get(), seg.X_world_body,
+                                           &materials[seg.material], seg.description->two_sided,
+                                           &tool.hints[i]});
+      tool.surface_segment.push_back(i);
+    }
+  }
+  tool_states.resize(tool_count);
+  // Per tool: at most kMaxContacts proxy contacts plus one per penalty segment.
+  contacts.resize(std::max<std::size_t>(
+      tool_count *
+          (static_cast<std::size_t>(GodObject::kMaxContacts) + model.penalty_segment_count()),
+      1));
+  result.tools = tool_states;
+  result.contacts = {contacts.data(), 0};
+}
+
+WorldState::~WorldState() = default;
+
+void WorldState::reset() {
+  tools_placed = false;
+  time_s = 0.0;
+  for (ToolRuntime& tool : tools) {
+    tool.has_previous = false;
+    for (QueryHint& h : tool.hints) {
+      h = QueryHint{};
+    }
+    for (PenaltySide& side : tool.penalty_side) {
+      side = PenaltySide{};
+    }
+  }
+  for (SegmentState& seg : segments) {
+    if (seg.deflection) {
+      seg.deflection->reset();
+      seg.deformed_dirty = true;
+    }
+  }
+  for (ToolState& state : tool_states) {
+    state = ToolState{};
+  }
+  contact_count = 0;
+  result = StepResult{};
+  result.tools = tool_states;
+  result.contacts = {contacts.data(), 0};
+}
+
+}  // namespace hapsim

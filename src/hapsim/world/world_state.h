@@ -1,0 +1,144 @@
+// The per-step half of a world (MuJoCo's mjData): everything a step reads and writes, sized once
+// from a WorldModel so that step() allocates nothing. Each field says which stage of the step
+// (world_stages.h) fills it. The model (world_model.h) is never written by a step.
+#pragma once
+
+#include "hapsim/core/device_io.h"
+#include "hapsim/core/types.h"
+#include "hapsim/deform/vertex_deflection.h"
+#include "hapsim/force/contact_material.h"
+#include "hapsim/force/god_object.h"
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace hapsim {
+
+class MeshBvh;
+class WorldModel;
+
+/// One contact of one tool with one segment this step.
+struct WorldContact {
+  std::int32_t tool = -1;
+  std::int32_t body = -1;
+  std::int32_t segment = -1;  ///< within the body
+  Vec3 point_world = Vec3::Zero();
+  Vec3 normal_world = Vec3::Zero();  ///< unit, out of the segment towards the tool
+  double depth_m = 0.0;              ///< tool depth below the rest surface (≥ 0)
+  double force_n = 0.0;              ///< magnitude of this contact's force on the tool
+  bool proxy = false;                ///< answered by the god-object (else penalty)
+};
+
+struct ToolState {
+  Vec3 p_world = Vec3::Zero();      ///< the tool's centre, where the device puts it
+  Vec3 proxy_world = Vec3::Zero();  ///< god-object position (equals p_world when free)
+  Vec3 force_world_n = Vec3::Zero();
+  std::int32_t contact_count = 0;
+};
+
+struct StepResult {
+  double time_s = 0.0;
+  std::span<const ToolState> tools;
+  std::span<const WorldContact> contacts;
+  /// Forces for the device (not yet clamped to its rated limits: the safety layer does that).
+  DeviceCommand command;
+  /// Contacts found but not reported because the per-step buffer was full.
+  std::int32_t dropped_contacts = 0;
+  /// Tools that left a penalty segment through its far side this step (pulled through a thin
+  /// segment: must stay 0).
+  std::int32_t penalty_pop_throughs = 0;
+};
+
+/// Which side of a penalty segment a tool is pressing from. A penalty contact's depth is measured
+/// to the nearest rest surface; inside a thin segment (a 2 mm plate, a membrane) the nearest
+/// surface becomes the far one once the tool passes the middle, and the spring would then pull the
+/// tool through. So a contact remembers the side it is on: the normal and surface point of its
+/// last step on that side; a normal that flips within one step (more than 90°: no sliding over a
+/// curved surface turns it that far in a millisecond) means the tool crossed the middle, and from
+/// then on the force stays along the remembered normal, with the depth below the remembered
+/// tangent plane. Leaving the segment while crossed is leaving through the far side: a
+/// pop-through.
+struct PenaltySide {
+  Vec3 n_world = Vec3::Zero();      ///< unit, out of the segment on the entry side
+  Vec3 point_world = Vec3::Zero();  ///< surface point on the entry side
+  bool in_contact = false;
+  bool crossed = false;  ///< the nearest surface is now the far one
+};
+
+/// A penalty contact found by the detection stage, answered by the response stage.
+struct PenaltyCandidate {
+  std::uint32_t segment = 0;  ///< flat segment
+  double depth_m = 0.0;       ///< below the entry side's surface
+  Vec3 n_world = Vec3::Zero();
+  Vec3 point_world = Vec3::Zero();
+};
+
+/// Per-step state of one deformable segment.
+struct SegmentState {
+  std::unique_ptr<VertexDeflection> deflection;  ///< deformable bodies only (deform stage)
+  std::unique_ptr<MeshBvh> deformed_bvh;         ///< built on first World::deformed_query()
+  bool deformed_dirty = false;                   ///< deform stage: vertices moved
+  /// This step's contacts on the segment (respond stage), capacity fixed at construction.
+  std::vector<DeflectionContact> pending;
+  std::size_t pending_count = 0;
+};
+
+/// Per-step state of one tool.
+struct ToolRuntime {
+  GodObject proxy;                           ///< respond stage
+  std::vector<ProxySurface> surfaces;        ///< one per proxy segment
+  std::vector<std::size_t> surface_segment;  ///< flat segment of each surface
+  std::vector<QueryHint> hints;              ///< per flat segment (temporal coherence)
+  /// Per flat segment: the tool was within reach of, or inside, it last step. Only then can it be
+  /// deeper than the reach now (it moves far less than a reach per cycle), so only then is the
+  /// costly deep-inside query needed (detect stage).
+  std::vector<std::uint8_t> near_last_step;
+  std::vector<PenaltySide> penalty_side;  ///< per flat segment (detect stage)
+  /// Penalty contacts of this step, in segment order (detect stage); capacity = penalty segments.
+  std::vector<PenaltyCandidate> penalty;
+  std::size_t penalty_count = 0;
+  Vec3 p_world = Vec3::Zero();  ///< place stage: where the device puts the tool this step
+  Vec3 v_world = Vec3::Zero();  ///< place stage: finite-difference velocity (zero after a jump)
+  double moved_m = kInf;        ///< place stage: distance since last step (inf: no last step)
+  Vec3 p_previous_world = Vec3::Zero();
+  bool has_previous = false;
+};
+
+struct WorldState {
+  /// Sizes every buffer for `model` and builds the deformation state of deformable segments.
+  /// Throws hapsim::Error naming the segment when its deformation cannot be built.
+  explicit WorldState(const WorldModel& model);
+  ~WorldState();
+  WorldState(const WorldState&) = delete;
+  WorldState& operator=(const WorldState&) = delete;
+
+  /// Back to rest: tools re-placed at the next input, deformation and hints cleared.
+  void reset();
+
+  /// Materials as edited live (World::set_material_contact); start as the description's.
+  std::vector<ContactMaterial> material_contact;
+  /// Effective materials (stiffness clamped, passivity damping floor) for `materials_dt_s`.
+  std::vector<ContactMaterial> materials;
+  double materials_dt_s = -1.0;
+
+  std::vector<SegmentState> segments;  ///< per flat segment
+  std::vector<ToolRuntime> tools;
+  double time_s = 0.0;
+  /// Place stage: the input was usable (healthy, finite) this step.
+  bool input_usable = false;
+  /// The proxies have been placed at a first position (reset() clears it).
+  bool tools_placed = false;
+
+  // Outputs of the step (respond and safety stages).
+  std::vector<ToolState> tool_states;
+  std::vector<WorldContact> contacts;  ///< capacity fixed at construction
+  std::size_t contact_count = 0;
+  std::int32_t dropped_contacts = 0;
+  std::int32_t pop_throughs = 0;
+  DeviceCommand command;
+  StepResult result;
+};
+
+}  // namespace hapsim

@@ -1,0 +1,64 @@
+#include "hapsim/world/world_step.h"
+
+#include "hapsim/world/world_stages.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hapsim {
+
+ContactMaterial effective_material(const WorldModel& model, const ContactMaterial& contact,
+                                   double dt_s) noexcept {
+  ContactMaterial m = contact;
+  m.stiffness_n_per_m = std::min(m.stiffness_n_per_m, model.options().max_stiffness_n_per_m);
+  const double dt = std::isfinite(dt_s) && dt_s > 0.0 ? dt_s : 0.0;
+  m.damping_n_s_per_m = std::max(
+      m.damping_n_s_per_m, model.description().passivity_damping_factor * m.stiffness_n_per_m * dt);
+  return m;
+}
+
+namespace {
+
+// The effective materials for this dt (recomputed only when dt or a material changed).
+void refresh_materials(const WorldModel& model, WorldState& state, double dt_s) noexcept {
+  if (dt_s == state.materials_dt_s) {
+    return;
+  }
+  state.materials_dt_s = dt_s;
+  for (std::size_t m = 0; m < state.materials.size(); ++m) {
+    state.materials[m] = effective_material(model, state.material_contact[m], dt_s);
+  }
+}
+
+}  // namespace
+
+// haptic path
+const StepResult& step(const WorldModel& model, WorldState& state, const DeviceInput& input,
+                       double dt_s) noexcept {
+  const double dt = std::isfinite(dt_s) && dt_s > 0.0 ? dt_s : 0.0;
+  refresh_materials(model, state, dt);
+  state.time_s += dt;
+  state.contact_count = 0;
+  state.dropped_contacts = 0;
+  state.pop_throughs = 0;
+  for (SegmentState& seg : state.segments) {
+    seg.pending_count = 0;
+  }
+
+  stage::place_tools(model, state, input, dt);
+  stage::detect_contacts(model, state);
+  stage::respond(model, state);
+  stage::deform(model, state, dt);
+  stage::safety(model, state);
+
+  StepResult& r = state.result;
+  r.time_s = state.time_s;
+  r.tools = state.tool_states;
+  r.contacts = {state.contacts.data(), state.contact_count};
+  r.command = state.command;
+  r.dropped_contacts = state.dropped_contacts;
+  r.penalty_pop_throughs = state.pop_throughs;
+  return r;
+}
+
+}  // namespace hapsim
