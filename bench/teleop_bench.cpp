@@ -3,10 +3,10 @@
 // sheet contacts, sheet update, ball dynamics), IK while tracking (last cycle's answer as seed)
 // and IK from cold, for the procedural Motoman and the GP7 when its URDF is there. The per-step
 // percentiles of the whole scene come from `hapsim run scenes/teleop.json --json FILE`.
-#include "hapsim/script/pick_and_place_trajectory.h"
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
-#include "hapsim/world/teleop_world.h"
+#include "hapsim/script/pick_and_place_trajectory.h"
+#include "hapsim/world/world.h"
 
 #include <benchmark/benchmark.h>
 
@@ -39,7 +39,7 @@ void BM_TeleopStep(benchmark::State& state) {
     state.SkipWithError("GP7 URDF not found");
     return;
   }
-  TeleopWorldDescription d;
+  TeleopRigDescription d;
   d.slave = slave(gp7);
   d.environment.floor_z_m = 0.0;
   d.environment.X_world_sheet = Iso3(Eigen::Translation3d(0.5, 0.25, 0.05));
@@ -61,13 +61,13 @@ void BM_TeleopStep(benchmark::State& state) {
   for (int k = 1; k <= steps; ++k) {
     inputs.push_back(plan.trajectory.sample_at(k * 1e-3));
   }
-  auto world = std::make_unique<TeleopWorld>(d);
+  auto world = std::make_unique<World>(rig_world(d));
   std::size_t k = 0;
   for (auto _ : state) {
     benchmark::DoNotOptimize(world->step(inputs[k], 1e-3));
     if (++k == inputs.size()) {
       state.PauseTiming();
-      world = std::make_unique<TeleopWorld>(d);
+      world = std::make_unique<World>(rig_world(d));
       k = 0;
       state.ResumeTiming();
     }

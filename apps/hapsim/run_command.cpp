@@ -250,15 +250,13 @@ void run(const RunArgs& args) {
           "while it runs; the final snapshot is written after the run)");
     }
     TeleopRunOptions teleop;
-    std::unique_ptr<RunSnapshots<TeleopWorld, TeleopScene>> snapshots;
+    std::unique_ptr<RunSnapshots<World, TeleopScene>> snapshots;
     if (!args.snapshot_path.empty()) {
-      snapshots = std::make_unique<RunSnapshots<TeleopWorld, TeleopScene>>(
-          args, [](const TeleopWorld& w) { return std::make_unique<TeleopScene>(w); }, kTeleopYaw,
+      snapshots = std::make_unique<RunSnapshots<World, TeleopScene>>(
+          args, [](const World& w) { return std::make_unique<TeleopScene>(w); }, kTeleopYaw,
           kTeleopPitch);
-      teleop.after_step = [&](const TeleopWorld& w, std::size_t step) {
-        snapshots->after_step(w, step);
-      };
-      teleop.finished = [&](const TeleopWorld& w) { snapshots->final(w); };
+      teleop.after_step = [&](const World& w, std::size_t step) { snapshots->after_step(w, step); };
+      teleop.finished = [&](const World& w) { snapshots->final(w); };
     }
     teleop.duration_s = args.duration_s;
     teleop.realtime = args.realtime;

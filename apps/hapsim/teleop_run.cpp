@@ -17,7 +17,7 @@
 #include "hapsim/runtime/session.h"
 #include "hapsim/runtime/teleop_haptic_client.h"
 #include "hapsim/scene/teleop_setup.h"
-#include "hapsim/world/teleop_world.h"
+#include "hapsim/world/world.h"
 
 #include <nlohmann/json.hpp>
 
@@ -42,12 +42,12 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
   const Vec3 target = setup.target_world;
   const std::string& device_name = setup.device_name;
   const std::string& slave_name = setup.slave_name;
-  TeleopWorld world(std::move(setup.description));
+  World world(std::move(setup.description));
   std::printf(
       "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
       "sheet %dx%d\n",
-      scene.file.string().c_str(), slave_name.c_str(), world.slave().chain().dof(),
-      world.ball().params().mass_kg * 1e3, world.ball().params().radius_m * 1e3,
+      scene.file.string().c_str(), slave_name.c_str(), world.rig()->slave->chain().dof(),
+      world.rig()->ball.params().mass_kg * 1e3, world.rig()->ball.params().radius_m * 1e3,
       scene.teleop.sheet_nodes_per_side, scene.teleop.sheet_nodes_per_side);
   std::printf("device       %s\n", device_name.c_str());
 
@@ -70,7 +70,7 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
   double deepest_sheet = 0.0;
   double slave_error = 0.0;
   std::size_t nonfinite = 0;
-  const double start_z = world.ball().p_world().z();
+  const double start_z = world.rig()->ball.p_world().z();
   const auto account = [&](const TeleopStepResult& r, double cost_us) {
     step_us.push_back(cost_us);
     if (r.gripper.grasped_now && !grasped) {
@@ -97,7 +97,7 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
     for (std::size_t k = 1; k <= steps; ++k) {
       const DeviceInput in = trajectory.sample_at(trajectory.start_time_s() + k * dt);
       const Stopwatch watch;
-      const TeleopStepResult& r = world.step(in, dt);
+      const TeleopStepResult& r = *world.step(in, dt).teleop;
       const double cost_us = watch.elapsed_s() * 1e6;
       if (options.after_step) {
         options.after_step(world, k);
@@ -132,7 +132,7 @@ void run_teleop(const SceneDescription& scene, const TeleopRunOptions& options) 
   if (options.finished) {
     options.finished(world);
   }
-  const Vec3 final_p = world.ball().p_world();
+  const Vec3 final_p = world.rig()->ball.p_world();
   const double target_error = has_target ? (final_p - target).norm() : -1.0;
   const SampleSummary cost = summarize_samples(step_us);
   const double p50 = cost.p50, p99 = cost.p99, max_us = cost.max;

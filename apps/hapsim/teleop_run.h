@@ -11,7 +11,7 @@
 #include <string>
 
 namespace hapsim {
-class TeleopWorld;
+class World;
 }
 
 namespace hapsim::app {
@@ -26,8 +26,8 @@ struct TeleopRunOptions {
   double spin_s = 200e-6;
   /// Called after every step with the world and the step index (1-based), and once at the end:
   /// headless snapshots. May be empty.
-  std::function<void(const TeleopWorld& world, std::size_t step)> after_step;
-  std::function<void(const TeleopWorld& world)> finished;
+  std::function<void(const World& world, std::size_t step)> after_step;
+  std::function<void(const World& world)> finished;
 };
 
 /// Runs the scene and prints its summary; sets exit status 1 when a pick-and-place does not end

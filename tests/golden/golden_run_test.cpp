@@ -13,7 +13,6 @@
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/scene/teleop_setup.h"
-#include "hapsim/world/teleop_world.h"
 #include "hapsim/world/world.h"
 
 #include <gtest/gtest.h>
@@ -100,7 +99,7 @@ test::GoldenTrace run_world_scene(const SceneDescription& scene, const std::stri
 test::GoldenTrace run_teleop_scene(const SceneDescription& scene, const std::string& name) {
   TeleopSetup setup = make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/false);
   const Trajectory trajectory = setup.trajectory;
-  TeleopWorld world(std::move(setup.description));
+  World world(std::move(setup.description));
   const double dt = scene.run.dt_s;
   const double duration = scene.run.duration_s > 0.0
                               ? scene.run.duration_s
@@ -117,7 +116,7 @@ test::GoldenTrace run_teleop_scene(const SceneDescription& scene, const std::str
   for (std::size_t k = 1; k <= steps; ++k) {
     const DeviceInput in =
         trajectory.sample_at(trajectory.start_time_s() + static_cast<double>(k) * dt);
-    const TeleopStepResult& r = world.step(in, dt);
+    const TeleopStepResult& r = *world.step(in, dt).teleop;
     test::GoldenCycle c;
     c.index = k - 1;
     for (std::size_t i = 0; i < 5; ++i) {

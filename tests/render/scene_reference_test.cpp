@@ -13,7 +13,7 @@
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/scene/teleop_setup.h"
-#include "hapsim/world/teleop_world.h"
+#include "hapsim/world/world.h"
 
 #include <gtest/gtest.h>
 
@@ -127,13 +127,13 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
   const SceneDescription scene =
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
   TeleopSetup setup = make_teleop_setup(scene, std::nullopt, false);
-  TeleopWorld world(setup.description);
+  World world(setup.description);
   // 6 s into the scripted pick-and-place the gripper carries the ball towards the sheet.
   const double dt = scene.run.dt_s;
   for (int k = 1; k <= 6000; ++k) {
     world.step(setup.trajectory.sample_at(setup.trajectory.start_time_s() + k * dt), dt);
   }
-  ASSERT_TRUE(world.ball().held());
+  ASSERT_TRUE(world.rig()->ball.held());
   TeleopScene view(world);
   view.update_from_world(world);
   const OrbitCamera camera =
@@ -147,7 +147,7 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
   EXPECT_GT(compare_images(pictures[0], pictures[1], kWidth, kHeight).differing_fraction, 0.01);
   EXPECT_GT(compare_images(pictures[1], pictures[2], kWidth, kHeight).differing_fraction, 0.005);
   // The ball is where the world says, in its colour (red), in the face picture.
-  const Vec3 px = camera.project(world.ball().p_world(), kWidth, kHeight);
+  const Vec3 px = camera.project(world.rig()->ball.p_world(), kWidth, kHeight);
   const auto x = static_cast<int>(px.x());
   const auto y = static_cast<int>(px.y());
   ASSERT_TRUE(x >= 0 && x < kWidth && y >= 0 && y < kHeight);

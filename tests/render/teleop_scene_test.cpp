@@ -34,7 +34,7 @@ class TeleopSceneTest : public ::testing::Test {
     scene.is_teleop = true;
     scene.device.has_pick_and_place = true;
     setup_ = std::make_unique<TeleopSetup>(make_teleop_setup(scene, std::nullopt, false));
-    world_ = std::make_unique<TeleopWorld>(setup_->description);
+    world_ = std::make_unique<World>(setup_->description);
     const Trajectory& t = setup_->trajectory;
     const double dt = 1e-3;
     const auto steps = static_cast<int>((t.end_time_s() - t.start_time_s()) / dt);
@@ -69,27 +69,27 @@ class TeleopSceneTest : public ::testing::Test {
   }
 
   static std::unique_ptr<TeleopSetup> setup_;
-  static std::unique_ptr<TeleopWorld> world_;
+  static std::unique_ptr<World> world_;
   static std::unique_ptr<OffscreenContext> context_;
   static std::unique_ptr<Renderer> renderer_;
   static std::string why_not_;
 };
 
 std::unique_ptr<TeleopSetup> TeleopSceneTest::setup_;
-std::unique_ptr<TeleopWorld> TeleopSceneTest::world_;
+std::unique_ptr<World> TeleopSceneTest::world_;
 std::unique_ptr<OffscreenContext> TeleopSceneTest::context_;
 std::unique_ptr<Renderer> TeleopSceneTest::renderer_;
 std::string TeleopSceneTest::why_not_;
 
 TEST_F(TeleopSceneTest, SheetMeshHoldsTheWorldsDentedHeights) {
-  const TeleopWorld& world = *world_;
-  ASSERT_GT(world.sheet().max_depth_m(), 1e-4) << "the ball should rest in a dent";
+  const World& world = *world_;
+  ASSERT_GT(world.rig()->sheet->max_depth_m(), 1e-4) << "the ball should rest in a dent";
   TeleopScene from_world(world);
   from_world.update_from_world(world);
   TeleopScene from_snapshot(world);
   from_snapshot.update(make_teleop_snapshot(world));
-  const auto heights = world.sheet().surface_heights();
-  const TriangleMesh& rest = world.sheet().mesh();
+  const auto heights = world.rig()->sheet->surface_heights();
+  const TriangleMesh& rest = world.rig()->sheet->mesh();
   for (const TeleopScene* scene : {&from_world, &from_snapshot}) {
     const RenderMesh& sheet = scene->scene().mesh(scene->sheet_mesh());
     ASSERT_EQ(sheet.geometry().vertices.size(), heights.size());
@@ -98,26 +98,28 @@ TEST_F(TeleopSceneTest, SheetMeshHoldsTheWorldsDentedHeights) {
       ASSERT_EQ(sheet.geometry().vertices[k].x(), rest.vertices[k].x());
       ASSERT_EQ(sheet.geometry().vertices[k].y(), rest.vertices[k].y());
     }
-    EXPECT_TRUE(sheet.X_WM.isApprox(world.description().environment.X_world_sheet, 0.0));
+    EXPECT_TRUE(sheet.X_WM.isApprox(world.description().teleop->environment.X_world_sheet, 0.0));
   }
   // The dent is under the ball: the node nearest the ball's footprint is the deepest around.
   const Vec3 ball_sheet =
-      world.description().environment.X_world_sheet.inverse() * world.ball().p_world();
-  const int n = world.sheet().nodes_per_side();
-  const double h = world.sheet().spacing_m();
-  const auto i = static_cast<int>(std::lround((ball_sheet.x() + 0.5 * world.sheet().side_m()) / h));
-  const auto j = static_cast<int>(std::lround((ball_sheet.y() + 0.5 * world.sheet().side_m()) / h));
+      world.description().teleop->environment.X_world_sheet.inverse() * world.rig()->ball.p_world();
+  const int n = world.rig()->sheet->nodes_per_side();
+  const double h = world.rig()->sheet->spacing_m();
+  const auto i =
+      static_cast<int>(std::lround((ball_sheet.x() + 0.5 * world.rig()->sheet->side_m()) / h));
+  const auto j =
+      static_cast<int>(std::lround((ball_sheet.y() + 0.5 * world.rig()->sheet->side_m()) / h));
   ASSERT_TRUE(i >= 0 && i < n && j >= 0 && j < n);
-  EXPECT_LT(heights[static_cast<std::size_t>(j * n + i)], -0.5 * world.sheet().max_depth_m());
+  EXPECT_LT(heights[static_cast<std::size_t>(j * n + i)], -0.5 * world.rig()->sheet->max_depth_m());
 }
 
 TEST_F(TeleopSceneTest, BallColourAppearsWhereItsCentreProjects) {
   require_gl();
-  const TeleopWorld& world = *world_;
+  const World& world = *world_;
   TeleopScene scene(world);
   scene.update_from_world(world);
   // Look at the ball from beyond it (the robot behind it), a little from above.
-  const Vec3 ball = world.ball().p_world();
+  const Vec3 ball = world.rig()->ball.p_world();
   OrbitCamera cam;
   cam.target_W = ball;
   cam.yaw_rad = std::atan2(ball.y(), ball.x());
@@ -141,13 +143,13 @@ TEST_F(TeleopSceneTest, BallColourAppearsWhereItsCentreProjects) {
 
 TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
   require_gl();
-  const TeleopWorld& world = *world_;
+  const World& world = *world_;
   TeleopScene scene(world);
   scene.update_from_world(world);
   // Independent geometry: the tool from the chain's FK, the pads across its y at the pad depth.
-  const Iso3 X_tool = world.slave().chain().forward(world.slave().q());
-  const ParallelGripperParams& p = world.gripper().params();
-  const double w = world.last_result().gripper.width_m;
+  const Iso3 X_tool = world.rig()->slave->chain().forward(world.rig()->slave->q());
+  const ParallelGripperParams& p = world.rig()->gripper.params();
+  const double w = world.rig()->result.gripper.width_m;
   const Vec3 pad_W[2] = {X_tool * Vec3(0.0, 0.5 * w + p.pad_half_m.y(), p.pad_depth_m),
                          X_tool * Vec3(0.0, -(0.5 * w + p.pad_half_m.y()), p.pad_depth_m)};
   for (int i = 0; i < 2; ++i) {
@@ -202,32 +204,32 @@ TEST(TeleopScene, LinkMeshesFollowTheirChainFrames) {
   g.X_frame_mesh = Iso3(Eigen::Translation3d(0.1, 0.0, 0.02));
   g.mesh = make_box(Vec3(0.1, 0.03, 0.03));
   chain.set_link_geometry({g});
-  TeleopWorldDescription d;
+  TeleopRigDescription d;
   d.slave = std::make_shared<const SerialChain>(std::move(chain));
   d.slave_start_rad = {0.3, -0.2, 0.4, 0.1, 0.5, -0.2};
-  TeleopWorld world(d);
+  World world(rig_world(d));
   TeleopScene scene(world);
   ASSERT_EQ(scene.link_meshes().size(), 1u);
   std::array<Iso3, kMaxChainJoints> frames;
-  static_cast<void>(world.slave().chain().frames(world.slave().q(), frames));
+  static_cast<void>(world.rig()->slave->chain().frames(world.rig()->slave->q(), frames));
   const RenderMesh& mesh = scene.scene().mesh(scene.link_meshes()[0]);
   EXPECT_TRUE(mesh.X_WM.isApprox(frames[2] * g.X_frame_mesh, 1e-12));
   EXPECT_EQ(mesh.geometry().vertices.size(), g.mesh.vertices.size());
   // The bounds frame the whole scene: the ball, the sheet and the master drawn beside.
   const Box3& b = scene.rest_bounds_W();
-  EXPECT_TRUE(b.contains(world.ball().p_world()));
+  EXPECT_TRUE(b.contains(world.rig()->ball.p_world()));
   EXPECT_TRUE(b.contains(scene.master_display_origin_W()));
 }
 
 TEST(TeleopScene, BoxLinksJoinTheJointOrigins) {
-  TeleopWorldDescription d;
+  TeleopRigDescription d;
   d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
   d.slave_start_rad = {0.3, -0.2, 0.4, 0.1, 0.5, -0.2};
-  TeleopWorld world(d);
+  World world(rig_world(d));
   TeleopScene scene(world);
-  const SerialChain& chain = world.slave().chain();
+  const SerialChain& chain = world.rig()->slave->chain();
   std::array<Iso3, kMaxChainJoints> frames;
-  const Iso3 tip = chain.frames(world.slave().q(), frames);
+  const Iso3 tip = chain.frames(world.rig()->slave->q(), frames);
   // A box spans one joint origin to the next (base, joints 0..n−1, tip; coinciding origins
   // get no box): its centroid is their midpoint, in chain order.
   std::vector<Vec3> origins{Vec3::Zero()};
@@ -278,12 +280,12 @@ TEST(TeleopScene, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
   const SceneDescription scene =
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop_gp7.json", o);
   const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/true);
-  const SerialChain& chain = *setup.description.slave;
+  const SerialChain& chain = *setup.description.teleop->slave;
   ASSERT_FALSE(chain.link_geometry().empty());
-  TeleopWorld world(setup.description);
+  World world(setup.description);
   TeleopScene drawn(world);
   std::array<Iso3, kMaxChainJoints> frames;
-  static_cast<void>(chain.frames(world.slave().q(), frames));
+  static_cast<void>(chain.frames(world.rig()->slave->q(), frames));
   std::size_t l = 0;
   for (const ChainLinkGeometry& g : chain.link_geometry()) {
     if (g.mesh.empty()) {

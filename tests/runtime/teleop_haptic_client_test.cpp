@@ -1,7 +1,7 @@
-// The TeleopWorld on the real-time loop: after a scripted pick-and-place start the snapshot the
-// viewer reads is the world's state exactly (ball, slave joints and tool, sheet), the world went
-// through exactly what an inline run with the same inputs goes through, a reader thread never sees
-// a torn snapshot, the haptic thread allocates nothing, and a paused client holds the world.
+// The teleoperation World on the real-time loop: after a scripted pick-and-place start the snapshot
+// the viewer reads is the world's state exactly (ball, slave joints and tool, sheet), the world
+// went through exactly what an inline run with the same inputs goes through, a reader thread never
+// sees a torn snapshot, the haptic thread allocates nothing, and a paused client holds the world.
 #include "hapsim/runtime/teleop_haptic_client.h"
 
 #include "hapsim/core/device_profile.h"
@@ -28,7 +28,7 @@ TeleopSetup pick_and_place_setup() {
 
 TEST(TeleopHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   const TeleopSetup setup = pick_and_place_setup();
-  TeleopWorld world(setup.description);
+  World world(setup.description);
   SimulatedDevice device(device_profile("simulated"), setup.trajectory);
   TeleopHapticClient client(world);
   HapticLoopOptions o;
@@ -41,16 +41,16 @@ TEST(TeleopHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   ASSERT_TRUE(buffer.update());
   const TeleopSnapshot& s = buffer.read_slot();
   EXPECT_EQ(s.cycle, 299u);
-  EXPECT_EQ(s.ball_p_world, world.ball().p_world());
-  const auto q = world.slave().q();
+  EXPECT_EQ(s.ball_p_world, world.rig()->ball.p_world());
+  const auto q = world.rig()->slave->q();
   ASSERT_EQ(s.slave_q.size(), q.size());
   for (std::size_t i = 0; i < q.size(); ++i) {
     EXPECT_EQ(s.slave_q[i], q[i]) << "joint " << i;
   }
-  EXPECT_TRUE(s.X_world_tool.isApprox(world.slave().tip_pose(), 0.0));
-  EXPECT_EQ(s.gripper_width_m, world.last_result().gripper.width_m);
-  EXPECT_EQ(s.held, world.last_result().held);
-  const auto heights = world.sheet().surface_heights();
+  EXPECT_TRUE(s.X_world_tool.isApprox(world.rig()->slave->tip_pose(), 0.0));
+  EXPECT_EQ(s.gripper_width_m, world.rig()->result.gripper.width_m);
+  EXPECT_EQ(s.held, world.rig()->result.held);
+  const auto heights = world.rig()->sheet->surface_heights();
   ASSERT_EQ(s.sheet_heights_m.size(), heights.size());
   for (std::size_t k = 0; k < heights.size(); ++k) {
     ASSERT_EQ(s.sheet_heights_m[k], heights[k]) << "node " << k;
@@ -63,21 +63,21 @@ TEST(TeleopHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   EXPECT_EQ(s.output.joint_count, 5);
 
   // The same inputs stepped inline give the same world, bit for bit.
-  TeleopWorld inline_world(setup.description);
+  World inline_world(setup.description);
   for (std::uint64_t i = 0; i < 300; ++i) {
     static_cast<void>(inline_world.step(
         setup.trajectory.sample_at(static_cast<double>(i) * o.period_s), o.period_s));
   }
-  EXPECT_EQ(inline_world.ball().p_world(), world.ball().p_world());
+  EXPECT_EQ(inline_world.rig()->ball.p_world(), world.rig()->ball.p_world());
   for (std::size_t i = 0; i < q.size(); ++i) {
-    EXPECT_EQ(inline_world.slave().q()[i], q[i]) << "joint " << i;
+    EXPECT_EQ(inline_world.rig()->slave->q()[i], q[i]) << "joint " << i;
   }
-  EXPECT_EQ(inline_world.slave().gripper_width_m(), world.slave().gripper_width_m());
+  EXPECT_EQ(inline_world.rig()->slave->gripper_width_m(), world.rig()->slave->gripper_width_m());
 }
 
 TEST(TeleopHapticClient, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllocate) {
   const TeleopSetup setup = pick_and_place_setup();
-  TeleopWorld world(setup.description);
+  World world(setup.description);
   SimulatedDevice device(device_profile("simulated"), setup.trajectory);
   TeleopHapticClient client(world);
 
@@ -117,7 +117,7 @@ TEST(TeleopHapticClient, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllo
 
 TEST(TeleopHapticClient, PausedClientHoldsTheWorldAndSendsNoTorque) {
   const TeleopSetup setup = pick_and_place_setup();
-  TeleopWorld world(setup.description);
+  World world(setup.description);
   SimulatedDevice device(device_profile("simulated"), setup.trajectory);
   TeleopHapticClient client(world);
   client.set_paused(true);
@@ -128,11 +128,11 @@ TEST(TeleopHapticClient, PausedClientHoldsTheWorldAndSendsNoTorque) {
   loop.start();
   loop.wait();
   EXPECT_EQ(client.steps(), 0u);
-  EXPECT_EQ(world.last_result().time_s, 0.0);
+  EXPECT_EQ(world.rig()->result.time_s, 0.0);
   ASSERT_TRUE(client.snapshots()->update());
   const TeleopSnapshot& s = client.snapshots()->read_slot();
   EXPECT_EQ(s.cycle, 49u);
-  EXPECT_EQ(s.ball_p_world, setup.description.ball_start_world);
+  EXPECT_EQ(s.ball_p_world, setup.description.teleop->ball_start_world);
   for (int j = 0; j < kMaxDeviceJoints; ++j) {
     EXPECT_EQ(s.output.joint_torque_nm[static_cast<std::size_t>(j)], 0.0);
   }

@@ -2,10 +2,10 @@
 // slave (procedural Motoman, and the GP7 when its URDF is there) grasps it, lifts and carries it,
 // lets go over the sheet, and the ball comes to rest on the sheet within 5 mm of the target spot,
 // the sheet dented under it.
-#include "hapsim/script/pick_and_place_trajectory.h"
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
-#include "hapsim/world/teleop_world.h"
+#include "hapsim/script/pick_and_place_trajectory.h"
+#include "hapsim/world/world.h"
 
 #include "hapsim/core/error.h"
 
@@ -28,8 +28,8 @@ struct Outcome {
   double final_kinetic_energy_j = 0.0;
 };
 
-TeleopWorldDescription scene(std::shared_ptr<const SerialChain> slave) {
-  TeleopWorldDescription d;
+TeleopRigDescription scene(std::shared_ptr<const SerialChain> slave) {
+  TeleopRigDescription d;
   d.slave = std::move(slave);
   d.environment.floor_z_m = 0.0;
   d.environment.X_world_sheet = Iso3(Eigen::Translation3d(0.5, 0.25, 0.05));  // on a frame
@@ -37,7 +37,7 @@ TeleopWorldDescription scene(std::shared_ptr<const SerialChain> slave) {
   return d;
 }
 
-Outcome run(TeleopWorldDescription d, const PickAndPlaceScript& script) {
+Outcome run(TeleopRigDescription d, const PickAndPlaceScript& script) {
   const MasterArm master(d.master);
   const PickAndPlacePlan plan =
       make_pick_and_place_plan(script, master, d.mapping, d.follower.gripper_max_width_m);
@@ -51,12 +51,12 @@ Outcome run(TeleopWorldDescription d, const PickAndPlaceScript& script) {
   d.slave_start_rad.assign(seed.size(), 0.0);
   EXPECT_TRUE(solve_ik(*d.slave, start, seed, d.slave_start_rad).reached);
   const double start_z = d.ball_start_world.z();
-  TeleopWorld world(std::move(d));
+  World world(rig_world(std::move(d)));
   Outcome o;
   const double dt = 1e-3;
   const auto steps = static_cast<int>(plan.trajectory.end_time_s() / dt);
   for (int k = 1; k <= steps; ++k) {
-    const TeleopStepResult& r = world.step(plan.trajectory.sample_at(k * dt), dt);
+    const TeleopStepResult& r = *world.step(plan.trajectory.sample_at(k * dt), dt).teleop;
     EXPECT_TRUE(r.ball_p_world.allFinite());
     if (r.gripper.grasped_now && !o.grasped) {
       o.grasped = true;
@@ -71,14 +71,14 @@ Outcome run(TeleopWorldDescription d, const PickAndPlaceScript& script) {
       EXPECT_TRUE(std::isfinite(r.command.joint_torque_nm[static_cast<std::size_t>(j)]));
     }
   }
-  o.ball_final = world.ball().p_world();
-  o.final_sheet_depth_m = world.sheet().max_depth_m();
-  o.final_kinetic_energy_j = world.ball().kinetic_energy_j();
+  o.ball_final = world.rig()->ball.p_world();
+  o.final_sheet_depth_m = world.rig()->sheet->max_depth_m();
+  o.final_kinetic_energy_j = world.rig()->ball.kinetic_energy_j();
   return o;
 }
 
 void expect_pick_and_place(std::shared_ptr<const SerialChain> slave) {
-  TeleopWorldDescription d = scene(std::move(slave));
+  TeleopRigDescription d = scene(std::move(slave));
   PickAndPlaceScript script;
   script.pick_world = d.ball_start_world;
   script.place_world = Vec3(0.5, 0.25, 0.05 + d.ball.radius_m);

@@ -54,18 +54,18 @@ Vec3 master_point_W(const Vec3& origin_W, double scale, const Vec3& p_master) {
 
 }  // namespace
 
-TeleopScene::TeleopScene(const TeleopWorld& world, TeleopSceneOptions options)
+TeleopScene::TeleopScene(const World& world, TeleopSceneOptions options)
     : world_(world), options_(std::move(options)), scratch_(make_teleop_snapshot(world)) {
   build_slave();
   build_gripper();
   // The sheet, placed by the environment; its x, y never change, z follows the heights.
-  const VirtualSheet& sheet = world_.sheet();
+  const VirtualSheet& sheet = *world_.rig()->sheet;
   sheet_ = scene_.add_mesh(sheet.mesh(), options_.colours.sheet,
-                           world_.description().environment.X_world_sheet);
+                           world_.description().teleop->environment.X_world_sheet);
   scene_.mesh(sheet_).name = "sheet";
   sheet_positions_ = sheet.mesh().vertices;
   uploaded_heights_m_.assign(sheet.surface_heights().begin(), sheet.surface_heights().end());
-  frames_.resize(static_cast<std::size_t>(world_.slave().chain().dof()));
+  frames_.resize(static_cast<std::size_t>(world_.rig()->slave->chain().dof()));
   scene_.style.line_width_px = 2.0f;
 
   const bool show_master = options_.show_master;
@@ -73,11 +73,11 @@ TeleopScene::TeleopScene(const TeleopWorld& world, TeleopSceneOptions options)
   update(scratch_);
   options_.show_master = show_master;
   Box3 bounds = scene_.bounds_W();  // slave at its start, gripper, ball, sheet
-  const BallEnvironmentOptions& env = world_.description().environment;
+  const BallEnvironmentOptions& env = world_.description().teleop->environment;
   const double floor_z = env.has_floor ? env.floor_z_m : bounds.min().z();
   bounds.extend(Vec3(bounds.min().x(), bounds.min().y(), floor_z));
   // The master stands on the floor beside the slave's −y side, clear of the ball.
-  const MasterArmGeometry& g = world_.master().geometry();
+  const MasterArmGeometry& g = world_.model().master()->geometry();
   const double master_reach =
       options_.master_display_scale * (g.upper_arm_m + g.forearm_m + g.finger_m);
   master_origin_W_ = Vec3(bounds.center().x(), bounds.min().y() - 0.6 * master_reach, floor_z);
@@ -99,7 +99,7 @@ TeleopScene::TeleopScene(const TeleopWorld& world, TeleopSceneOptions options)
 }
 
 void TeleopScene::build_slave() {
-  const SerialChain& chain = world_.slave().chain();
+  const SerialChain& chain = world_.rig()->slave->chain();
   if (!chain.link_geometry().empty()) {
     for (const ChainLinkGeometry& g : chain.link_geometry()) {
       if (g.mesh.empty()) {
@@ -151,8 +151,8 @@ void TeleopScene::build_slave() {
 }
 
 void TeleopScene::build_gripper() {
-  const ParallelGripperParams& p = world_.gripper().params();
-  const double max_width = world_.description().follower.gripper_max_width_m;
+  const ParallelGripperParams& p = world_.rig()->gripper.params();
+  const double max_width = world_.description().teleop->follower.gripper_max_width_m;
   // A palm across the pads' travel just above them, and a stem from the flange down to it.
   const double palm_half_z = 0.25 * p.pad_half_m.z();
   const double palm_z = p.pad_depth_m - p.pad_half_m.z() - palm_half_z;
@@ -211,14 +211,14 @@ void TeleopScene::update(const TeleopSnapshot& snapshot) {
   pose_from(snapshot);
 }
 
-void TeleopScene::update_from_world(const TeleopWorld& world) {
-  scratch_.time_s = world.last_result().time_s;
+void TeleopScene::update_from_world(const World& world) {
+  scratch_.time_s = world.rig()->result.time_s;
   fill_teleop_snapshot(scratch_, world);
   update(scratch_);
 }
 
 void TeleopScene::pose_from(const TeleopSnapshot& s) {
-  const SerialChain& chain = world_.slave().chain();
+  const SerialChain& chain = world_.rig()->slave->chain();
   if (s.slave_q.size() == static_cast<std::size_t>(chain.dof())) {
     chain.frames(s.slave_q, frames_);
   }
@@ -230,7 +230,7 @@ void TeleopScene::pose_from(const TeleopSnapshot& s) {
   for (const MeshId id : gripper_body_) {
     scene_.mesh(id).X_WM = s.X_world_tool;
   }
-  const ParallelGripper& gripper = world_.gripper();
+  const ParallelGripper& gripper = world_.rig()->gripper;
   for (int i = 0; i < 2; ++i) {
     RenderMesh& pad = scene_.mesh(pads_[static_cast<std::size_t>(i)]);
     pad.X_WM = Iso3::Identity();
@@ -243,7 +243,7 @@ void TeleopScene::pose_from(const TeleopSnapshot& s) {
   scene_.segments.clear();
   scene_.shadow_marks.clear();
   scene_.spheres.push_back(
-      {s.ball_p_world, world_.ball().params().radius_m, options_.colours.ball, false});
+      {s.ball_p_world, world_.rig()->ball.params().radius_m, options_.colours.ball, false});
   if (options_.show_joints) {
     for (std::size_t k = 0; k < joint_radius_m_.size() && k < frames_.size(); ++k) {
       scene_.spheres.push_back(
@@ -259,7 +259,7 @@ void TeleopScene::pose_from(const TeleopSnapshot& s) {
 }
 
 void TeleopScene::add_master_lines(const TeleopSnapshot& s) {
-  const MasterArm& master = world_.master();
+  const MasterArm& master = *world_.model().master();
   const MasterArmGeometry& g = master.geometry();
   std::array<Iso3, 3> f;
   const Iso3 hand = master.arm().frames(s.master_joint_rad, f);

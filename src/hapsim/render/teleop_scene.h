@@ -1,10 +1,11 @@
-// A TeleopWorld as the renderer sees it (000): the slave arm (its URDF collision meshes posed at
-// their chain frames, or — for a chain without meshes, like the procedural Motoman — one box per
-// link between consecutive joint origins with a sphere at each joint), the parallel gripper (a
-// palm and two pads), the ball, the virtual sheet (its surface updated from the heights), a floor
-// at the environment's floor, an 'x' shadow mark on the floor under the gripper's tool point, and
-// the master arm drawn small as lines beside the scene. Updated each frame from a TeleopSnapshot
-// (the viewer, off the haptic thread) or straight from the world (on the thread that steps it).
+// A teleoperation World as the renderer sees it (000): the slave arm (its URDF collision meshes
+// posed at their chain frames, or — for a chain without meshes, like the procedural Motoman — one
+// box per link between consecutive joint origins with a sphere at each joint), the parallel gripper
+// (a palm and two pads), the ball, the virtual sheet (its surface updated from the heights), a
+// floor at the environment's floor, an 'x' shadow mark on the floor under the gripper's tool point,
+// and the master arm drawn small as lines beside the scene. Updated each frame from a
+// TeleopSnapshot (the viewer, off the haptic thread) or straight from the world (on the thread that
+// steps it).
 #pragma once
 
 #include "hapsim/render/render_scene.h"
@@ -45,7 +46,7 @@ class TeleopScene {
   /// world's current state. `world` must outlive the scene; only its immutable parts (chain,
   /// parameters) are read after construction, so update() may run on another thread than the
   /// one stepping the world.
-  explicit TeleopScene(const TeleopWorld& world, TeleopSceneOptions options = {});
+  explicit TeleopScene(const World& world, TeleopSceneOptions options = {});
   TeleopScene(const TeleopScene&) = delete;
   TeleopScene& operator=(const TeleopScene&) = delete;
   TeleopScene(TeleopScene&&) = delete;
@@ -56,7 +57,7 @@ class TeleopScene {
   /// sheet is re-uploaded only when its heights changed.
   void update(const TeleopSnapshot& snapshot);
   /// From the world itself (only on the thread that steps it, while it is not stepping).
-  void update_from_world(const TeleopWorld& world);
+  void update_from_world(const World& world);
 
   void set_options(const TeleopSceneOptions& options);
   [[nodiscard]] const TeleopSceneOptions& options() const { return options_; }
@@ -87,7 +88,7 @@ class TeleopScene {
   void pose_from(const TeleopSnapshot& s);
   void add_master_lines(const TeleopSnapshot& s);
 
-  const TeleopWorld& world_;
+  const World& world_;
   TeleopSceneOptions options_;
   RenderScene scene_;
   std::vector<Link> links_;

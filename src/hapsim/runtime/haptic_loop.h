@@ -62,7 +62,7 @@ struct HapticCycle {
   bool healthy = true;
 };
 
-/// The simulation side of the loop (a World, a TeleopWorld, a test double).
+/// The simulation side of the loop (a World, a test double).
 class HapticClient {
  public:
   virtual ~HapticClient() = default;

@@ -2,7 +2,7 @@
 
 namespace hapsim {
 
-TeleopHapticClient::TeleopHapticClient(TeleopWorld& world, TeleopHapticClientOptions options)
+TeleopHapticClient::TeleopHapticClient(World& world, TeleopHapticClientOptions options)
     : world_(world), options_(options) {
   if (options_.publish_snapshots) {
     snapshots_ = std::make_unique<TripleBuffer<TeleopSnapshot>>(make_teleop_snapshot(world_));
@@ -32,7 +32,7 @@ const DeviceCommand& TeleopHapticClient::step(const DeviceInput& input, double d
 // haptic path
 void TeleopHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
   if (records_ && stepped_) {
-    scratch_record_.result = world_.last_result();
+    scratch_record_.result = world_.rig()->result;
     scratch_record_.output = cycle.output != nullptr ? *cycle.output : zero_command_;
     scratch_record_.cost_us = cycle.cost_us;
     if (!records_->push(scratch_record_)) {

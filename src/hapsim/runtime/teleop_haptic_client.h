@@ -1,4 +1,4 @@
-// The haptic loop's client for a TeleopWorld (000 on the real-time loop): each cycle steps the
+// The haptic loop's client for a World (000 on the real-time loop): each cycle steps the
 // world with the master's input and returns the torques for the master's motors, then publishes
 // the newest TeleopSnapshot for the viewer through a triple buffer. Every buffer is sized at
 // construction: after_cycle() allocates nothing (haptic path). Optionally every cycle's result
@@ -33,7 +33,7 @@ struct TeleopCycleRecord {
 class TeleopHapticClient final : public HapticClient {
  public:
   /// `world` must outlive the client; its description gives every size.
-  explicit TeleopHapticClient(TeleopWorld& world, TeleopHapticClientOptions options = {});
+  explicit TeleopHapticClient(World& world, TeleopHapticClientOptions options = {});
 
   /// world.step(input, dt).command, or zero while paused. haptic path
   const DeviceCommand& step(const DeviceInput& input, double dt_s) override;
@@ -51,7 +51,7 @@ class TeleopHapticClient final : public HapticClient {
   }
 
   /// Any thread: stop stepping the world (the slave and the ball freeze, zero torque) or go on.
-  /// (TeleopWorld has no reset yet, so there is no request_reset() here.)
+  /// (The viewer resets by rebuilding the world, so there is no request_reset() here yet.)
   void set_paused(bool paused) { paused_.store(paused, std::memory_order_relaxed); }
   /// haptic path: true once after a pause ends.
   bool take_soft_start() noexcept override {
@@ -65,7 +65,7 @@ class TeleopHapticClient final : public HapticClient {
   [[nodiscard]] std::uint64_t steps() const { return steps_.load(std::memory_order_relaxed); }
 
  private:
-  TeleopWorld& world_;
+  World& world_;
   TeleopHapticClientOptions options_;
   DeviceCommand zero_command_;
   std::unique_ptr<TripleBuffer<TeleopSnapshot>> snapshots_;

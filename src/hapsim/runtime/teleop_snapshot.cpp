@@ -4,34 +4,36 @@
 
 namespace hapsim {
 
-TeleopSnapshot make_teleop_snapshot(const TeleopWorld& world) {
+TeleopSnapshot make_teleop_snapshot(const World& world) {
   TeleopSnapshot s;
-  s.slave_q.assign(world.slave().q().size(), 0.0);
-  s.sheet_heights_m.assign(world.sheet().surface_heights().size(), 0.0);
-  s.time_s = world.last_result().time_s;
+  const RigState& rig = *world.rig();
+  s.slave_q.assign(rig.slave->q().size(), 0.0);
+  s.sheet_heights_m.assign(rig.sheet->surface_heights().size(), 0.0);
+  s.time_s = rig.result.time_s;
   fill_teleop_snapshot(s, world);
   return s;
 }
 
 // haptic path
-void fill_teleop_snapshot(TeleopSnapshot& s, const TeleopWorld& world) noexcept {
-  const TeleopStepResult& r = world.last_result();
+void fill_teleop_snapshot(TeleopSnapshot& s, const World& world) noexcept {
+  const RigState& rig = *world.rig();
+  const TeleopStepResult& r = rig.result;
   const bool stepped = r.time_s > 0.0;
-  const auto q = world.slave().q();
+  const auto q = rig.slave->q();
   std::copy_n(q.begin(), std::min(q.size(), s.slave_q.size()), s.slave_q.begin());
-  s.X_world_tool = world.slave().tip_pose();
+  s.X_world_tool = rig.slave->tip_pose();
   // Before the first step the gripper report is empty: the pads are where the slave holds them.
-  s.gripper_width_m = stepped ? r.gripper.width_m : world.slave().gripper_width_m();
+  s.gripper_width_m = stepped ? r.gripper.width_m : rig.slave->gripper_width_m();
   s.pad_force_n = r.gripper.pad_force_n;
   s.grasp_force_n = r.gripper.grasp_force_n();
   s.held = r.held;
-  s.ball_p_world = world.ball().p_world();
-  const auto h = world.sheet().surface_heights();
+  s.ball_p_world = rig.ball.p_world();
+  const auto h = rig.sheet->surface_heights();
   std::copy_n(h.begin(), std::min(h.size(), s.sheet_heights_m.size()), s.sheet_heights_m.begin());
-  s.sheet_depth_m = world.sheet().max_depth_m();
+  s.sheet_depth_m = rig.sheet->max_depth_m();
   s.master_joint_rad = r.master_arm_rad;
   s.master_finger_rad = r.master_finger_rad;
-  s.X_master_hand = world.master().hand_pose(r.master_arm_rad);
+  s.X_master_hand = world.model().master()->hand_pose(r.master_arm_rad);
 }
 
 }  // namespace hapsim

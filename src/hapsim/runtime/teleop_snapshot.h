@@ -1,10 +1,10 @@
-// What the viewer (and later the network) sees of a running TeleopWorld: the newest cycle's
+// What the viewer (and later the network) sees of a running teleoperation world: the newest cycle's
 // master input and command, the slave's joints and tool, the gripper, the ball and the sheet's
 // surface, published by the haptic thread through a triple buffer (teleop_haptic_client.h).
 // Sized once for a world, so filling one never allocates.
 #pragma once
 
-#include "hapsim/world/teleop_world.h"
+#include "hapsim/world/world.h"
 
 #include <array>
 #include <cstdint>
@@ -40,11 +40,11 @@ struct TeleopSnapshot {
   double sheet_depth_m = 0.0;
 };
 
-/// A snapshot sized for `world`, holding its current state.
-[[nodiscard]] TeleopSnapshot make_teleop_snapshot(const TeleopWorld& world);
+/// A snapshot sized for `world` (which must have a teleoperation rig), holding its current state.
+[[nodiscard]] TeleopSnapshot make_teleop_snapshot(const World& world);
 
 /// Copies the world's current state into `snapshot` (sized by make_teleop_snapshot for the same
 /// world); leaves cycle, time_s, input and output to the caller. haptic path (no allocation)
-void fill_teleop_snapshot(TeleopSnapshot& snapshot, const TeleopWorld& world) noexcept;
+void fill_teleop_snapshot(TeleopSnapshot& snapshot, const World& world) noexcept;
 
 }  // namespace hapsim

@@ -1,10 +1,10 @@
 #include "hapsim/scene/teleop_setup.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/script/pick_and_place_trajectory.h"
 #include "hapsim/kinematics/inverse_kinematics.h"
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
+#include "hapsim/script/pick_and_place_trajectory.h"
 
 #include <memory>
 #include <utility>
@@ -14,9 +14,9 @@ namespace hapsim {
 
 namespace {
 
-TeleopWorldDescription world_description(const SceneDescription& scene, bool load_link_meshes) {
+TeleopRigDescription rig_description(const SceneDescription& scene, bool load_link_meshes) {
   const TeleopSceneDescription& t = scene.teleop;
-  TeleopWorldDescription d;
+  TeleopRigDescription d;
   if (t.slave_urdf.empty()) {
     d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
   } else {
@@ -46,8 +46,8 @@ TeleopSetup make_teleop_setup(const SceneDescription& scene,
                               const std::optional<std::filesystem::path>& trajectory,
                               bool load_link_meshes) {
   TeleopSetup s;
-  s.description = world_description(scene, load_link_meshes);
-  TeleopWorldDescription& d = s.description;
+  s.description = rig_world(rig_description(scene, load_link_meshes));
+  TeleopRigDescription& d = *s.description.teleop;
   const MasterArm master(d.master);
   if (trajectory || !scene.device.has_pick_and_place) {
     const std::filesystem::path file = trajectory ? *trajectory : scene.device.trajectory_file;

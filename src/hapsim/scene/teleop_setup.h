@@ -1,12 +1,12 @@
-// A teleoperation scene file made runnable (000): the TeleopWorld it describes, with the slave's
+// A teleoperation scene file made runnable (000): the world and rig it describes, with the slave's
 // start joints solved so the slave begins where the master's first pose puts it, and the master
 // input that drives it (the scripted pick-and-place, or a trajectory of master joints). Shared by
 // `hapsim run` and the viewer, so both build exactly the same world.
 #pragma once
 
-#include "hapsim/script/trajectory.h"
 #include "hapsim/scene/scene_description.h"
-#include "hapsim/world/teleop_world.h"
+#include "hapsim/script/trajectory.h"
+#include "hapsim/world/world_description.h"
 
 #include <filesystem>
 #include <optional>
@@ -15,8 +15,8 @@
 namespace hapsim {
 
 struct TeleopSetup {
-  /// The world to build (slave_start_rad solved: dof() values).
-  TeleopWorldDescription description;
+  /// The world to build: its teleoperation rig (`teleop`, slave_start_rad solved: dof() values).
+  WorldDescription description;
   /// The master's input: joint_rad[0..2] arm joints, finger_rad[0..1] fingers.
   Trajectory trajectory;
   /// A pick-and-place script has a target: where the ball should come to rest (world, metres).

@@ -1,7 +1,7 @@
 #include "hapsim/ui/teleop_viewer_session.h"
 
-#include "hapsim/core/error.h"
 #include "hapsim/core/device_profile.h"
+#include "hapsim/core/error.h"
 #include "hapsim/device/interactive_device.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/render/teleop_scene.h"
@@ -115,8 +115,8 @@ class TeleopViewerSession final : public ViewerSession {
     const std::array<double, 3> first_arm{first.joint_rad[0], first.joint_rad[1],
                                           first.joint_rad[2]};
     // The cursor points at the slave's tool: the probe is its target in the world.
-    MasterHandMapping hand_mapping(world_->master(), first_arm);
-    hand_mapping.set_probe_in_slave_frame(description_.mapping);
+    MasterHandMapping hand_mapping(*world_->model().master(), first_arm);
+    hand_mapping.set_probe_in_slave_frame(description_.teleop->mapping);
     probe_start_W_ = hand_mapping.probe_for(first_arm);
     DeviceInput start;
     start.p_world = probe_start_W_;
@@ -147,7 +147,7 @@ class TeleopViewerSession final : public ViewerSession {
                   "expected mouse, sim, sim:FILE or spacemouse, got '" + config.device + "'");
     }
     title_ = scene.file.filename().string() + " — " + setup.slave_name + ", " + device_name_;
-    readout_.bar_full_scale_n = description_.gripper.max_force_n;
+    readout_.bar_full_scale_n = description_.teleop->gripper.max_force_n;
     start_loop();
   }
 
@@ -252,10 +252,10 @@ class TeleopViewerSession final : public ViewerSession {
     client_->set_paused(paused);
   }
 
-  // TeleopWorld has no reset of its own, so the world is rebuilt in place: the loop stops, a new
-  // world is made from the same description in the same storage (the TeleopScene keeps reading
-  // its immutable parts, which are identical), and a new client and loop start at cycle 0 — so
-  // the scripted master starts its script again. The probe stays where the user left it.
+  // The teleoperation client has no reset request yet, so the world is rebuilt in place: the loop
+  // stops, a new world is made from the same description in the same storage (the TeleopScene keeps
+  // reading its immutable parts, which are identical), and a new client and loop start at cycle 0 —
+  // so the scripted master starts its script again. The probe stays where the user left it.
   void reset() override {
     loop_->stop();
     loop_.reset();
@@ -289,7 +289,7 @@ class TeleopViewerSession final : public ViewerSession {
           "The probe is the master's hand (its base frame): drag to move it, wheel for depth, G "
           "closes or opens the grasp.");
     }
-    const TeleopWorldDescription& d = description_;
+    const TeleopRigDescription& d = *description_.teleop;
     ImGui::Text("mapping scale %.2f, gripper %.0f mm / %.0f N", d.mapping.scale,
                 d.follower.gripper_max_width_m * 1e3, d.gripper.max_force_n);
   }
@@ -303,9 +303,9 @@ class TeleopViewerSession final : public ViewerSession {
   }
 
   ViewerConfig config_;
-  TeleopWorldDescription description_;  // for reset()
+  WorldDescription description_;  // for reset()
   // Rebuilt in place by reset(): the render scene refers to this storage.
-  std::optional<TeleopWorld> world_;
+  std::optional<World> world_;
   std::unique_ptr<TeleopScene> view_;
   std::unique_ptr<Device> probe_;  // the mouse or 3D mouse behind device_ (null for sim)
   InteractiveDevice* mouse_ = nullptr;

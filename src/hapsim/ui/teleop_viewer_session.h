@@ -1,7 +1,8 @@
 // The viewer's session for a teleoperation scene (000, `hapsim view scenes/teleop.json`): the
-// TeleopWorld on the haptic loop, driven by the scene's scripted master (or a trajectory of master
-// joints), by the viewer's mouse probe or by a 3D mouse; its render scene (TeleopScene) updated
-// from the loop's snapshots; the slave tool, master hand, grasp and pad forces in the data area.
+// teleoperation World on the haptic loop, driven by the scene's scripted master (or a trajectory of
+// master joints), by the viewer's mouse probe or by a 3D mouse; its render scene (TeleopScene)
+// updated from the loop's snapshots; the slave tool, master hand, grasp and pad forces in the data
+// area.
 //
 // The mouse and the 3D mouse give a position, not master joints: MasterHandMapping turns the
 // probe's position (where the slave's tool should go; the master's hand through the inverse

@@ -6,13 +6,48 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 
 namespace hapsim::stage {
+
+namespace {
+
+// The rig's tool is the slave's gripper: the master's hand pose, scaled into the slave's frame,
+// is the slave's IK target; the master's grip opening is the gripper's. On an unusable input the
+// slave holds where it is.
+void place_rig(const WorldModel& model, RigState& rig, const DeviceInput& input,
+               double dt_s) noexcept {
+  const TeleopRigDescription& d = *model.description().teleop;
+  TeleopStepResult& r = rig.result;
+  const std::array<double, 3> arm{input.joint_rad[0], input.joint_rad[1], input.joint_rad[2]};
+  const std::array<double, 2> fingers{input.finger_rad[0], input.finger_rad[1]};
+  rig.input_usable = input.healthy;
+  for (const double v : {arm[0], arm[1], arm[2], fingers[0], fingers[1]}) {
+    rig.input_usable = rig.input_usable && std::isfinite(v);
+  }
+  double width_command = rig.slave->gripper_width_m();
+  if (rig.input_usable) {
+    r.master_arm_rad = arm;
+    r.master_finger_rad = fingers;
+    r.master_hand = model.master()->hand_pose(arm);
+    const Iso3 target = slave_target(d.mapping, r.master_hand.translation(), arm[0]);
+    width_command = model.slave_width_for(model.master()->grip_opening_m(fingers));
+    r.slave = rig.slave->step(target, width_command, dt_s);
+  } else {
+    r.slave = rig.slave->step(rig.slave->tip_pose(), width_command, dt_s);
+  }
+  r.slave_tool = rig.slave->tip_pose();
+}
+
+}  // namespace
 
 // haptic path
 void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& input,
                  double dt_s) noexcept {
   const WorldDescription& d = model.description();
+  if (state.rig) {
+    place_rig(model, *state.rig, input, dt_s);
+  }
   state.input_usable = input.healthy && input.p_world.allFinite() &&
                        input.q_world.coeffs().allFinite() && input.q_world.squaredNorm() > 0.5;
   if (!state.input_usable) {

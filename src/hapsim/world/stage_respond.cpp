@@ -28,7 +28,13 @@ void add_pending(SegmentState& seg, const DeflectionContact& contact) noexcept {
 }  // namespace
 
 // haptic path
-void respond(const WorldModel& model, WorldState& state) noexcept {
+void respond(const WorldModel& model, WorldState& state, double dt_s) noexcept {
+  if (state.rig) {
+    // The rig's gripper pads against the ball: grasp, hold or release.
+    RigState& rig = *state.rig;
+    rig.result.gripper =
+        rig.gripper.step(rig.result.slave_tool, rig.slave->gripper_width_m(), rig.ball, dt_s);
+  }
   if (!state.input_usable) {
     return;
   }

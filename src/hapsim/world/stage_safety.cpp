@@ -11,9 +11,47 @@
 
 namespace hapsim::stage {
 
+namespace {
+
+// The rig's forces back to the master: the pads' reaction at the slave's tool (plus, while held,
+// the ball's weight and whatever the sheet pushes on it), scaled into the master's frame and
+// turned into joint torques through the master's Jᵀ; the grasp force on both fingers.
+void rig_command(const WorldModel& model, RigState& rig) noexcept {
+  TeleopStepResult& r = rig.result;
+  r.command = DeviceCommand{};
+  if (!rig.input_usable) {
+    return;
+  }
+  const TeleopRigDescription& d = *model.description().teleop;
+  Vec3 at_tool = -r.gripper.force_on_ball_world_n;
+  if (r.held) {
+    at_tool = rig.ball.params().mass_kg * rig.ball.params().gravity_m_per_s2 +
+              r.ball_contacts.sheet_force_world_n + r.ball_contacts.floor_force_world_n;
+  }
+  const Vec3 at_master = d.mapping.X_slave_master.linear().transpose() * at_tool * d.force_scale;
+  const MasterTorques t =
+      model.master()->torques(r.master_arm_rad, at_master, r.gripper.grasp_force_n());
+  for (std::size_t i = 0; i < 3; ++i) {
+    r.command.joint_torque_nm[i] = t.arm_n_m[i];
+  }
+  r.command.joint_torque_nm[3] = t.fingers_n_m[0];
+  r.command.joint_torque_nm[4] = t.fingers_n_m[1];
+  r.command.joint_count = 5;
+  r.command.finger_force_n[0] = r.gripper.grasp_force_n();
+  r.command.finger_force_n[1] = r.gripper.grasp_force_n();
+  r.command.finger_count = 2;
+}
+
+}  // namespace
+
 // haptic path
 void safety(const WorldModel& model, WorldState& state) noexcept {
   state.command = DeviceCommand{};
+  if (state.rig) {
+    // A rig's master gets the rig's torques and grasp (its scenes have no probe tools).
+    rig_command(model, *state.rig);
+    state.command = state.rig->result.command;
+  }
   if (!state.input_usable) {
     for (ToolState& out : state.tool_states) {
       out.force_world_n.setZero();

@@ -67,6 +67,9 @@ class World {
     return state_.material_contact.at(material);
   }
   [[nodiscard]] std::size_t body_count() const { return description().bodies.size(); }
+  /// The teleoperation rig's state (slave, gripper, ball, sheet, last step), or null when the
+  /// world has none. Only the thread that steps may read it while the world runs.
+  [[nodiscard]] const RigState* rig() const { return state_.rig.get(); }
   [[nodiscard]] std::size_t segment_count(std::size_t body) const;
   /// Flat index of (body, segment) over all bodies, for per-segment statistics.
   [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const;

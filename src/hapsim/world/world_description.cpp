@@ -42,6 +42,13 @@ std::string_view to_string(BodyKind kind) {
   return "unknown";
 }
 
+WorldDescription rig_world(TeleopRigDescription rig, std::string name) {
+  WorldDescription d;
+  d.name = std::move(name);
+  d.teleop = std::move(rig);
+  return d;
+}
+
 namespace {
 
 // FNV-1a, 64 bit: a stable content fingerprint (not a security hash).
@@ -105,6 +112,23 @@ std::string content_hash(const WorldDescription& description) {
   }
   h.number(description.passivity_damping_factor);
   h.number(description.has_hand ? description.hand.dip_per_pip : -1.0);
+  if (const auto& rig = description.teleop) {
+    // What makes two rigs step differently: the slave, its start, the mapping, the ball, the sheet.
+    h.number(rig->slave ? rig->slave->dof() : -1);
+    for (const double q : rig->slave_start_rad) {
+      h.number(q);
+    }
+    h.number(rig->mapping.scale);
+    h.bytes(rig->mapping.X_slave_master.matrix().data(), sizeof(double) * 16);
+    for (const double x :
+         {rig->ball.mass_kg, rig->ball.radius_m, rig->gripper.max_force_n,
+          rig->follower.gripper_max_width_m, rig->sheet.side_m, rig->force_scale}) {
+      h.number(x);
+    }
+    h.bytes(rig->ball_start_world.data(), sizeof(double) * 3);
+    h.number(rig->sheet.nodes_per_side);
+    h.bytes(rig->environment.X_world_sheet.matrix().data(), sizeof(double) * 16);
+  }
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%016llx", static_cast<unsigned long long>(h.value()));
   return buffer;

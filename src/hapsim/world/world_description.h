@@ -6,11 +6,19 @@
 
 #include "hapsim/core/types.h"
 #include "hapsim/deform/vertex_deflection.h"
+#include "hapsim/deform/virtual_sheet.h"
+#include "hapsim/dynamics/ball_environment.h"
+#include "hapsim/dynamics/parallel_gripper.h"
+#include "hapsim/dynamics/rigid_ball.h"
 #include "hapsim/force/contact_material.h"
 #include "hapsim/geometry/triangle_mesh.h"
 #include "hapsim/kinematics/hand_model.h"
+#include "hapsim/kinematics/master_arm.h"
+#include "hapsim/kinematics/serial_chain.h"
+#include "hapsim/kinematics/slave_follower.h"
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -85,6 +93,28 @@ struct ToolDescription {
   int finger = -1;
 };
 
+/// A teleoperation rig (paper 000): a 5-DOF master arm (the device: joint_rad[0..2] arm,
+/// finger_rad[0..1] grasp) drives a slave robot with a parallel gripper through IK; the gripper
+/// picks a rigid ball, which rests on a virtual sheet (or the floor) and imprints it. Forces come
+/// back to the master as joint torques (the pads' reaction at the slave's tool, scaled, through
+/// Jᵀ) and finger torques (the grasp force).
+struct TeleopRigDescription {
+  MasterArmGeometry master;
+  /// The slave arm (procedural Motoman or the GP7 URDF) and its start joints (dof() values;
+  /// empty: all zero, clamped into the limits).
+  std::shared_ptr<const SerialChain> slave;
+  std::vector<double> slave_start_rad;
+  TeleopMapping mapping;
+  SlaveFollowerOptions follower;
+  ParallelGripperParams gripper;
+  RigidBallParams ball;
+  Vec3 ball_start_world = Vec3(0.55, -0.25, 0.03);
+  VirtualSheetOptions sheet;
+  BallEnvironmentOptions environment;
+  /// How the contact force at the slave's tool is scaled back onto the master's hand.
+  double force_scale = 1.0;
+};
+
 struct WorldDescription {
   std::string name;
   std::vector<MaterialDescription> materials;
@@ -98,7 +128,12 @@ struct WorldDescription {
   /// Floor on the normal damping of every contact: b ≥ factor · k · dt. Sampling a spring at
   /// period T makes it active (Colgate & Schenkel); b > k·T/2 restores passivity, 1 gives margin.
   double passivity_damping_factor = 1.0;
+  /// A teleoperation rig driven by the device (the master arm), when the scene has one.
+  std::optional<TeleopRigDescription> teleop;
 };
+
+/// A world made of a teleoperation rig alone (the teleoperation scenes).
+[[nodiscard]] WorldDescription rig_world(TeleopRigDescription rig, std::string name = "teleop");
 
 /// A content hash of a world description (meshes, materials, tools), as recordings carry it.
 [[nodiscard]] std::string content_hash(const WorldDescription& description);

@@ -27,6 +27,20 @@ std::unique_ptr<ProximityQuery> make_query(ContactMethod method, const TriangleM
   return std::make_unique<MeshBvh>(mesh);
 }
 
+void check_rig(const TeleopRigDescription& d) {
+  if (!d.slave) {
+    throw Error("teleop", "no slave arm");
+  }
+  if (!d.slave_start_rad.empty() &&
+      d.slave_start_rad.size() != static_cast<std::size_t>(d.slave->dof())) {
+    throw Error("teleop", "slave start has " + std::to_string(d.slave_start_rad.size()) +
+                              " joint values; the slave has " + std::to_string(d.slave->dof()));
+  }
+  if (!d.ball_start_world.allFinite() || !std::isfinite(d.force_scale) || d.force_scale < 0.0) {
+    throw Error("teleop", "ball start must be finite and the force scale >= 0");
+  }
+}
+
 void check_tool(const ToolDescription& td) {
   if (!(td.radius_m >= 0.0) || !std::isfinite(td.radius_m) || !td.offset_device.allFinite()) {
     throw Error("tool '" + td.name + "'", "needs a finite radius >= 0 and a finite offset");
@@ -93,10 +107,24 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
   for (const ToolDescription& td : description_.tools) {
     check_tool(td);
   }
+  if (description_.teleop) {
+    check_rig(*description_.teleop);
+    master_ = std::make_unique<MasterArm>(description_.teleop->master);
+  }
   build_ms_ = watch.elapsed_ms();
 }
 
 WorldModel::~WorldModel() = default;
+
+double WorldModel::slave_width_for(double master_opening_m) const noexcept {
+  if (!master_) {
+    return 0.0;
+  }
+  const MasterArmGeometry& g = master_->geometry();
+  const double widest = 2.0 * g.finger_m * std::sin(g.finger_open_limit_rad);
+  const double u = std::clamp((master_opening_m - g.finger_gap_m) / widest, 0.0, 1.0);
+  return u * description_.teleop->follower.gripper_max_width_m;
+}
 
 std::size_t WorldModel::query_memory_bytes() const {
   std::size_t bytes = 0;

@@ -53,6 +53,8 @@ class WorldModel {
   [[nodiscard]] const WorldOptions& options() const { return options_; }
   /// The hand the glove drives, or null when the tools sit at device offsets.
   [[nodiscard]] const HandModel* hand() const { return hand_.get(); }
+  /// The teleoperation rig's master arm (the device), or null when the scene has no rig.
+  [[nodiscard]] const MasterArm* master() const { return master_.get(); }
   [[nodiscard]] const std::vector<SegmentModel>& segments() const { return segments_; }
   [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const {
     return body_first_segment_.at(body) + segment;
@@ -61,6 +63,9 @@ class WorldModel {
   [[nodiscard]] std::size_t proxy_segment_count() const { return proxy_segments_; }
   [[nodiscard]] std::size_t penalty_segment_count() const { return penalty_segments_; }
   [[nodiscard]] double max_tool_radius_m() const { return max_tool_radius_m_; }
+  /// The rig's slave gripper opening for a master grip opening: the master's range mapped
+  /// linearly onto the slave's. 0 without a rig.
+  [[nodiscard]] double slave_width_for(double master_opening_m) const noexcept;
   /// Bytes of all rest-shape query structures (meshes excluded).
   [[nodiscard]] std::size_t query_memory_bytes() const;
   [[nodiscard]] double build_ms() const { return build_ms_; }
@@ -69,6 +74,7 @@ class WorldModel {
   WorldDescription description_;
   WorldOptions options_;
   std::unique_ptr<HandModel> hand_;
+  std::unique_ptr<MasterArm> master_;
   std::vector<SegmentModel> segments_;
   std::vector<std::size_t> body_first_segment_;
   std::size_t proxy_segments_ = 0;

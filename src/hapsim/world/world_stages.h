@@ -3,18 +3,21 @@
 // says which stage fills what). All are haptic path: no allocation, no lock, no I/O.
 //
 //   place_tools      device input → each tool's position and velocity (probe: device pose × offset;
-//                    glove: the hand's fingertips); an unusable input holds the tools
+//                    glove: the hand's fingertips; a teleoperation rig's master arm: the slave
+//                    follows the master's hand through IK, its gripper opening the master's grip);
+//                    an unusable input holds the tools
 //   detect_contacts  penalty segments: each tool against each segment's rest surface, which side
 //                    it presses from (never pulled through a thin segment)
 //   respond          proxy segments: the god-object moves its proxy and the spring gives the force;
-//                    penalty segments: F = k·x with damping; contacts reported, deformation fed
+//                    penalty segments: F = k·x with damping; contacts reported, deformation fed;
+//                    the rig's gripper pads against the ball (contact springs, grasp and release)
+//   integrate        rigid bodies: the ball under gravity and the pads' force, on the virtual
+//                    sheet (which takes its imprint, Gaussian profile) or the floor
 //   deform           deformable segments deflect under this step's contacts (eq. 1), the rest
 //                    recover
 //   safety           what leaves the world is finite: per-tool forces, then the device command
-//                    (finger channels and tip force); zero for an unusable input
-//
-// Rigid-body integration (the grasped ball) and the virtual sheet still step inside TeleopWorld
-// (teleop_world.h) until the teleoperation scene joins this world.
+//                    (finger channels and tip force; for the rig the master's joint and finger
+//                    torques through Jᵀ); zero for an unusable input
 #pragma once
 
 #include "hapsim/core/device_io.h"
@@ -29,7 +32,8 @@ namespace stage {
 void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& input,
                  double dt_s) noexcept;
 void detect_contacts(const WorldModel& model, WorldState& state) noexcept;
-void respond(const WorldModel& model, WorldState& state) noexcept;
+void respond(const WorldModel& model, WorldState& state, double dt_s) noexcept;
+void integrate(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void deform(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void safety(const WorldModel& model, WorldState& state) noexcept;
 

@@ -9,6 +9,36 @@
 
 namespace hapsim {
 
+namespace {
+
+std::vector<double> start_joints(const TeleopRigDescription& d) {
+  return d.slave_start_rad.empty() ? std::vector<double>(static_cast<std::size_t>(d.slave->dof()))
+                                   : d.slave_start_rad;
+}
+
+}  // namespace
+
+RigState::RigState(const TeleopRigDescription& rig)
+    : description(&rig),
+      slave(std::make_unique<SlaveFollower>(*rig.slave, start_joints(rig), rig.follower)),
+      gripper(rig.gripper),
+      ball(rig.ball, rig.ball_start_world),
+      sheet(std::make_unique<VirtualSheet>(rig.sheet)),
+      environment(std::make_unique<BallEnvironment>(*sheet, rig.environment)) {}
+
+void RigState::reset() {
+  const TeleopRigDescription& d = *description;
+  slave = std::make_unique<SlaveFollower>(*d.slave, start_joints(d), d.follower);
+  gripper = ParallelGripper(d.gripper);
+  ball = RigidBall(d.ball, d.ball_start_world);
+  sheet = std::make_unique<VirtualSheet>(d.sheet);
+  environment = std::make_unique<BallEnvironment>(*sheet, d.environment);
+  input_usable = false;
+  result = TeleopStepResult{};
+}
+
+RigState::~RigState() = default;
+
 WorldState::WorldState(const WorldModel& model) {
   const WorldDescription& d = model.description();
   const std::size_t tool_count = model.tool_count();
@@ -76,8 +106,12 @@ WorldState::WorldState(const WorldModel& model) {
       tool_count *
           (static_cast<std::size_t>(GodObject::kMaxContacts) + model.penalty_segment_count()),
       1));
+  if (d.teleop) {
+    rig = std::make_unique<RigState>(*d.teleop);
+  }
   result.tools = tool_states;
   result.contacts = {contacts.data(), 0};
+  result.teleop = rig ? &rig->result : nullptr;
 }
 
 WorldState::~WorldState() = default;
@@ -103,10 +137,14 @@ void WorldState::reset() {
   for (ToolState& state : tool_states) {
     state = ToolState{};
   }
+  if (rig) {
+    rig->reset();
+  }
   contact_count = 0;
   result = StepResult{};
   result.tools = tool_states;
   result.contacts = {contacts.data(), 0};
+  result.teleop = rig ? &rig->result : nullptr;
 }
 
 }  // namespace hapsim

@@ -6,9 +6,16 @@
 #include "hapsim/core/device_io.h"
 #include "hapsim/core/types.h"
 #include "hapsim/deform/vertex_deflection.h"
+#include "hapsim/deform/virtual_sheet.h"
+#include "hapsim/dynamics/ball_environment.h"
+#include "hapsim/dynamics/parallel_gripper.h"
+#include "hapsim/dynamics/rigid_ball.h"
 #include "hapsim/force/contact_material.h"
 #include "hapsim/force/god_object.h"
+#include "hapsim/kinematics/slave_follower.h"
+#include "hapsim/world/world_description.h"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -38,6 +45,25 @@ struct ToolState {
   std::int32_t contact_count = 0;
 };
 
+/// What a teleoperation rig did this step (world_description.h: TeleopRigDescription).
+struct TeleopStepResult {
+  double time_s = 0.0;
+  /// What the master's motors get (arm joint torques, finger torques as joints 3 and 4).
+  DeviceCommand command;
+  /// The master's arm joints (base, shoulder, elbow) and fingers, radians, and its hand pose in
+  /// its base frame: from the last usable input (held through an unusable one).
+  std::array<double, 3> master_arm_rad{};
+  std::array<double, 2> master_finger_rad{};
+  Iso3 master_hand = Iso3::Identity();
+  Iso3 slave_tool = Iso3::Identity();
+  SlaveStep slave;
+  GripperReport gripper;
+  BallContactReport ball_contacts;
+  Vec3 ball_p_world = Vec3::Zero();
+  bool held = false;
+  double sheet_depth_m = 0.0;
+};
+
 struct StepResult {
   double time_s = 0.0;
   std::span<const ToolState> tools;
@@ -49,6 +75,8 @@ struct StepResult {
   /// Tools that left a penalty segment through its far side this step (pulled through a thin
   /// segment: must stay 0).
   std::int32_t penalty_pop_throughs = 0;
+  /// The teleoperation rig's step, or null when the world has no rig.
+  const TeleopStepResult* teleop = nullptr;
 };
 
 /// Which side of a penalty segment a tool is pressing from. A penalty contact's depth is measured
@@ -106,6 +134,30 @@ struct ToolRuntime {
   bool has_previous = false;
 };
 
+/// Per-step state of a teleoperation rig: the slave following the master (place stage), the
+/// gripper (respond stage), the ball and the sheet under it (integrate stage).
+struct RigState {
+  /// Throws hapsim::Error on unusable slave, gripper, ball or sheet settings.
+  explicit RigState(const TeleopRigDescription& rig);
+  ~RigState();
+  RigState(const RigState&) = delete;
+  RigState& operator=(const RigState&) = delete;
+  /// Back to the start: slave at its start joints with the gripper open, the ball where it
+  /// started, the sheet flat. Rebuilds the parts (allocates): a user's reset, not a cycle's work.
+  void reset();
+
+  const TeleopRigDescription* description = nullptr;  ///< the model's; outlives this state
+
+  std::unique_ptr<SlaveFollower> slave;
+  ParallelGripper gripper;
+  RigidBall ball;
+  std::unique_ptr<VirtualSheet> sheet;
+  std::unique_ptr<BallEnvironment> environment;
+  /// Place stage: the master's input was usable (healthy, finite joints).
+  bool input_usable = false;
+  TeleopStepResult result;
+};
+
 struct WorldState {
   /// Sizes every buffer for `model` and builds the deformation state of deformable segments.
   /// Throws hapsim::Error naming the segment when its deformation cannot be built.
@@ -125,6 +177,7 @@ struct WorldState {
 
   std::vector<SegmentState> segments;  ///< per flat segment
   std::vector<ToolRuntime> tools;
+  std::unique_ptr<RigState> rig;  ///< when the world has a teleoperation rig
   double time_s = 0.0;
   /// Place stage: the input was usable (healthy, finite) this step.
   bool input_usable = false;

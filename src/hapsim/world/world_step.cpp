@@ -47,7 +47,8 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
 
   stage::place_tools(model, state, input, dt);
   stage::detect_contacts(model, state);
-  stage::respond(model, state);
+  stage::respond(model, state, dt);
+  stage::integrate(model, state, dt);
   stage::deform(model, state, dt);
   stage::safety(model, state);
 
@@ -58,6 +59,10 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   r.command = state.command;
   r.dropped_contacts = state.dropped_contacts;
   r.penalty_pop_throughs = state.pop_throughs;
+  if (state.rig) {
+    state.rig->result.time_s = state.time_s;
+    r.teleop = &state.rig->result;
+  }
   return r;
 }
 

@@ -1,0 +1,76 @@
+// A teleoperation rig inside the one World: the step's stages move the slave, the ball and the
+// sheet; reset() puts all three back where the description starts them; an unusable master input
+// holds the slave and sends no torque.
+#include "hapsim/world/world.h"
+
+#include "hapsim/kinematics/procedural_motoman.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+namespace hapsim {
+namespace {
+
+WorldDescription rig() {
+  TeleopRigDescription d;
+  d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
+  d.environment.floor_z_m = 0.0;
+  d.environment.X_world_sheet = Iso3(Eigen::Translation3d(0.5, 0.25, 0.05));
+  d.ball_start_world = Vec3(0.5, 0.25, 0.2);  // above the sheet: it falls onto it
+  return rig_world(std::move(d));
+}
+
+DeviceInput master(double base_rad) {
+  DeviceInput in;
+  in.joint_rad[0] = base_rad;
+  in.joint_rad[1] = 0.3;
+  in.joint_rad[2] = 0.6;
+  in.joint_count = 3;
+  in.finger_count = 2;
+  return in;
+}
+
+TEST(WorldRig, BallFallsOnTheSheetAndResetPutsEverythingBack) {
+  World world(rig());
+  ASSERT_NE(world.rig(), nullptr);
+  const Vec3 start = world.rig()->ball.p_world();
+  const auto q0 =
+      std::vector<double>(world.rig()->slave->q().begin(), world.rig()->slave->q().end());
+  for (int k = 0; k < 1500; ++k) {
+    const StepResult& r = world.step(master(0.2), 1e-3);
+    ASSERT_NE(r.teleop, nullptr);
+    ASSERT_TRUE(r.teleop->ball_p_world.allFinite());
+  }
+  // Fallen and resting on the dented sheet (sheet at z = 0.05, ball radius 0.03).
+  EXPECT_LT(world.rig()->ball.p_world().z(), 0.08 + 1e-3);
+  EXPECT_GT(world.rig()->sheet->max_depth_m(), 0.0);
+  EXPECT_NEAR(world.last_result().time_s, 1.5, 1e-9);
+  world.reset();
+  EXPECT_EQ(world.rig()->ball.p_world(), start);
+  EXPECT_EQ(world.rig()->sheet->max_depth_m(), 0.0);
+  const auto q = world.rig()->slave->q();
+  EXPECT_TRUE(std::equal(q.begin(), q.end(), q0.begin()));
+  EXPECT_EQ(world.last_result().teleop, &world.rig()->result);
+}
+
+TEST(WorldRig, UnusableMasterInputHoldsTheSlaveAndSendsNoTorque) {
+  World world(rig());
+  for (int k = 0; k < 50; ++k) {
+    (void)world.step(master(0.2), 1e-3);
+  }
+  const Iso3 tool = world.rig()->slave->tip_pose();
+  DeviceInput bad = master(std::numeric_limits<double>::quiet_NaN());
+  const StepResult& r = world.step(bad, 1e-3);
+  EXPECT_EQ(r.command.joint_count, 0);
+  EXPECT_EQ(r.command.finger_count, 0);
+  EXPECT_TRUE(world.rig()->slave->tip_pose().isApprox(tool, 1e-12));
+  bad = master(0.2);
+  bad.healthy = false;
+  EXPECT_EQ(world.step(bad, 1e-3).command.joint_count, 0);
+}
+
+}  // namespace
+}  // namespace hapsim
