@@ -4,7 +4,6 @@
 #include "commands.h"
 #include "progress_printer.h"
 #include "realtime_json.h"
-#include "teleop_run.h"
 
 #include "hapsim/core/error.h"
 #include "hapsim/core/stopwatch.h"
@@ -15,6 +14,7 @@
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
+#include "hapsim/scene/teleop_setup.h"
 
 #include <nlohmann/json.hpp>
 
@@ -78,13 +78,21 @@ std::pair<int, int> parse_size(const std::string& text) {
   return {w, h};
 }
 
-// Headless pictures of a run: the same scene the viewer shows (WorldScene or TeleopScene),
-// drawn offscreen, every N steps and at the end. The scene is built on first use (a teleop world
-// exists only inside its run) with `make_scene`.
-template <class WorldT, class SceneT>
-class RunSnapshots {
+// Headless pictures of a run, every N steps and at the end.
+class SnapshotSink {
  public:
-  using MakeScene = std::function<std::unique_ptr<SceneT>(const WorldT&)>;
+  virtual ~SnapshotSink() = default;
+  /// `step` counts from 1: the picture after that many steps.
+  virtual void after_step(const World& world, std::size_t step) = 0;
+  virtual void final(const World& world) = 0;
+};
+
+// The same scene the viewer shows (WorldScene, or TeleopScene for a rig), drawn offscreen. The
+// scene is built on first use with `make_scene`.
+template <class SceneT>
+class RunSnapshots final : public SnapshotSink {
+ public:
+  using MakeScene = std::function<std::unique_ptr<SceneT>(const World&)>;
 
   RunSnapshots(const RunArgs& args, MakeScene make_scene, double yaw_rad, double pitch_rad)
       : args_(args), make_scene_(std::move(make_scene)), yaw_rad_(yaw_rad), pitch_rad_(pitch_rad) {
@@ -92,13 +100,12 @@ class RunSnapshots {
     writer_ = std::make_unique<SnapshotWriter>(w, h);
   }
 
-  /// `step` counts from 1: the picture after that many steps.
-  void after_step(const WorldT& world, std::size_t step) {
+  void after_step(const World& world, std::size_t step) override {
     if (args_.snapshot_every > 0 && step % args_.snapshot_every == 0) {
       write(world, numbered_path(args_.snapshot_path, step));
     }
   }
-  void final(const WorldT& world) {
+  void final(const World& world) override {
     write(world, args_.snapshot_path);
     std::printf("snapshot     %s (%s, %s", args_.snapshot_path.c_str(), args_.size.c_str(),
                 args_.display_mode.c_str());
@@ -109,7 +116,7 @@ class RunSnapshots {
   }
 
  private:
-  void write(const WorldT& world, const std::string& path) {
+  void write(const World& world, const std::string& path) {
     if (!scene_) {
       scene_ = make_scene_(world);
       scene_->scene().style.display_mode = parse_display_mode(args_.display_mode);
@@ -209,6 +216,16 @@ void run(const RunArgs& args) {
       throw CommandError("--json " + args.json_path + ": cannot open for writing");
     }
   }
+  // Options that cannot work are refused before anything is loaded or printed.
+  if (!std::isnan(args.duration_s) &&
+      (!(args.duration_s > 0.0) || !std::isfinite(args.duration_s))) {
+    throw CommandError("--duration: expected seconds > 0");
+  }
+  if (args.realtime && args.snapshot_every > 0) {
+    throw CommandError(
+        "--snapshot-every: not with --realtime (the haptic thread owns the world "
+        "while it runs; the final snapshot is written after the run)");
+  }
   if (!args.snapshot_path.empty()) {
     // Fail before the run, not after it: the folder must be there.
     const std::filesystem::path folder = std::filesystem::path(args.snapshot_path).parent_path();
@@ -238,69 +255,65 @@ void run(const RunArgs& args) {
   load_options.progress = progress;
   const Stopwatch load_watch;
   SceneDescription scene = load_scene(args.scene, load_options);
-  if (scene.is_teleop) {
-    if (!args.replay_path.empty() || !args.record_path.empty() || !args.method.empty()) {
-      throw CommandError(args.scene +
-                         ": --record, --replay and --method are not available for "
-                         "teleoperation scenes yet");
-    }
-    if (args.realtime && args.snapshot_every > 0) {
-      throw CommandError(
-          "--snapshot-every: not with --realtime (the haptic thread owns the world "
-          "while it runs; the final snapshot is written after the run)");
-    }
-    TeleopRunOptions teleop;
-    std::unique_ptr<RunSnapshots<World, TeleopScene>> snapshots;
-    if (!args.snapshot_path.empty()) {
-      snapshots = std::make_unique<RunSnapshots<World, TeleopScene>>(
-          args, [](const World& w) { return std::make_unique<TeleopScene>(w); }, kTeleopYaw,
-          kTeleopPitch);
-      teleop.after_step = [&](const World& w, std::size_t step) { snapshots->after_step(w, step); };
-      teleop.finished = [&](const World& w) { snapshots->final(w); };
-    }
-    teleop.duration_s = args.duration_s;
-    teleop.realtime = args.realtime;
-    teleop.spin_s = 1e-6 * args.spin_us;
-    teleop.trajectory = trajectory;
-    teleop.json_path = args.json_path;
-    teleop.progress = progress;
-    json_out.reset();  // run_teleop writes the file itself
-    run_teleop(scene, teleop);
-    return;
-  }
   if (!args.method.empty()) {
+    if (scene.world.bodies.empty()) {
+      throw CommandError("--method: " + args.scene +
+                         " has no bodies whose contact method it could change");
+    }
     for (BodyDescription& b : scene.world.bodies) {
       b.method = parse_method(args.method);
     }
   }
-  const DeviceProfile& profile = device_profile(scene.device.profile);
-  WorldOptions world_options;
-  // Render no stiffer than the device stays stable at (CHAI3D's published maxima).
-  world_options.max_stiffness_n_per_m = profile.max_stiffness_n_per_m;
-  report_progress(progress, "building contact structures", 0.0);
-  World world(scene.world, world_options);
-  std::size_t vertices = 0;
-  std::size_t segments = 0;
-  for (const BodyDescription& b : scene.world.bodies) {
-    for (const SegmentDescription& s : b.segments) {
-      vertices += s.mesh.vertex_count();
-      ++segments;
-    }
-  }
-  std::printf(
-      "scene        %s: %zu bodies, %zu segments, %zu vertices, %zu tool(s); loaded and "
-      "built in %.2f s (world %.0f ms, %.1f MB of query structures)\n",
-      args.scene.c_str(), scene.world.bodies.size(), segments, vertices, scene.world.tools.size(),
-      load_watch.elapsed_s(), world.build_ms(),
-      static_cast<double>(world.query_memory_bytes()) / 1e6);
-
+  // The world and the device the scene asks for: a haptic world with its palpation script or
+  // trajectory, or a teleoperation rig with its scripted master (scene/teleop_setup.h).
+  std::unique_ptr<World> world;
   std::unique_ptr<Device> device;
   std::string device_name;
   double duration_s = scene.run.duration_s;
+  std::optional<Vec3> teleop_target;
+  std::optional<TeleopSetup> teleop;
+  const DeviceProfile& profile =
+      device_profile(scene.is_teleop ? std::string("simulated") : scene.device.profile);
+  if (scene.is_teleop) {
+    report_progress(progress, "building the teleoperation rig", 0.0);
+    teleop = make_teleop_setup(scene, trajectory, /*load_link_meshes=*/false);
+    world = std::make_unique<World>(teleop->description);
+    const RigState& rig = *world->rig();
+    std::printf(
+        "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
+        "sheet %dx%d\n",
+        scene.file.string().c_str(), teleop->slave_name.c_str(), rig.slave->chain().dof(),
+        rig.ball.params().mass_kg * 1e3, rig.ball.params().radius_m * 1e3,
+        scene.teleop.sheet_nodes_per_side, scene.teleop.sheet_nodes_per_side);
+    if (teleop->has_target) {
+      teleop_target = teleop->target_world;
+    }
+  } else {
+    WorldOptions world_options;
+    // Render no stiffer than the device stays stable at (CHAI3D's published maxima).
+    world_options.max_stiffness_n_per_m = profile.max_stiffness_n_per_m;
+    report_progress(progress, "building contact structures", 0.0);
+    world = std::make_unique<World>(scene.world, world_options);
+    std::size_t vertices = 0;
+    std::size_t segments = 0;
+    for (const BodyDescription& b : scene.world.bodies) {
+      for (const SegmentDescription& seg : b.segments) {
+        vertices += seg.mesh.vertex_count();
+        ++segments;
+      }
+    }
+    std::printf(
+        "scene        %s: %zu bodies, %zu segments, %zu vertices, %zu tool(s); loaded and "
+        "built in %.2f s (world %.0f ms, %.1f MB of query structures)\n",
+        args.scene.c_str(), scene.world.bodies.size(), segments, vertices, scene.world.tools.size(),
+        load_watch.elapsed_s(), world->build_ms(),
+        static_cast<double>(world->query_memory_bytes()) / 1e6);
+  }
+
   std::optional<Recording> replayed;
   if (!args.replay_path.empty()) {
     replayed = read_recording(args.replay_path);
-    if (replayed->header.scene_hash != world.content_hash()) {
+    if (replayed->header.scene_hash != world->content_hash()) {
       throw CommandError("--replay " + args.replay_path +
                          ": recorded on a different scene (content hash differs)");
     }
@@ -310,8 +323,21 @@ void run(const RunArgs& args) {
     duration_s = static_cast<double>(replayed->frames.size()) * scene.run.dt_s;
     device = std::make_unique<ReplayDevice>(profile, replayed->frames);
     device_name = "replay of " + args.replay_path;
+  } else if (teleop) {
+    // Cycle i plays the master's trajectory at start + (i + 1)·dt: the first step already moves.
+    const Trajectory& played = teleop->trajectory;
+    const double dt = scene.run.dt_s;
+    const double length_s = played.end_time_s() - played.start_time_s();
+    device = std::make_unique<SimulatedDevice>(
+        profile,
+        [&played, dt](double t_s) { return played.sample_at(played.start_time_s() + t_s + dt); },
+        length_s);
+    if (!(duration_s > 0.0)) {
+      duration_s = length_s;
+    }
+    device_name = teleop->device_name;
   } else {
-    auto sim = make_scene_device(scene, world, trajectory);
+    auto sim = make_scene_device(scene, *world, trajectory);
     if (!(duration_s > 0.0)) {
       duration_s = sim->duration_end_s();
     }
@@ -322,10 +348,7 @@ void run(const RunArgs& args) {
     device = std::move(sim);
   }
   if (!std::isnan(args.duration_s)) {
-    if (!(args.duration_s > 0.0) || !std::isfinite(args.duration_s)) {
-      throw CommandError("--duration: expected seconds > 0");
-    }
-    duration_s = args.duration_s;
+    duration_s = args.duration_s;  // checked above
   }
   if (!(duration_s > 0.0) || !std::isfinite(duration_s)) {
     throw CommandError(args.scene + ": the run has no length (give --duration S)");
@@ -343,48 +366,73 @@ void run(const RunArgs& args) {
   }
   std::unique_ptr<SessionRecorder> recorder;
   if (!record_path.empty()) {
-    recorder = std::make_unique<SessionRecorder>(record_path, world.content_hash(), 8192);
+    recorder = std::make_unique<SessionRecorder>(record_path, world->content_hash(), 8192);
   }
 
-  std::unique_ptr<RunSnapshots<World, WorldScene>> snapshots;
+  std::unique_ptr<SnapshotSink> snapshots;
   if (!args.snapshot_path.empty()) {
-    if (args.realtime && args.snapshot_every > 0) {
-      throw CommandError(
-          "--snapshot-every: not with --realtime (the haptic thread owns the world "
-          "while it runs; the final snapshot is written after the run)");
+    if (teleop) {
+      snapshots = std::make_unique<RunSnapshots<TeleopScene>>(
+          args, [](const World& w) { return std::make_unique<TeleopScene>(w); }, kTeleopYaw,
+          kTeleopPitch);
+    } else {
+      snapshots = std::make_unique<RunSnapshots<WorldScene>>(
+          args,
+          [&args](const World& w) {
+            WorldSceneOptions o;
+            o.colouring = parse_colouring(args.colours);
+            o.sphere_tree_level = args.sphere_tree_level;
+            return std::make_unique<WorldScene>(w, o);
+          },
+          kKneeYaw, kKneePitch);
     }
-    snapshots = std::make_unique<RunSnapshots<World, WorldScene>>(
-        args,
-        [&args](const World& w) {
-          WorldSceneOptions o;
-          o.colouring = parse_colouring(args.colours);
-          o.sphere_tree_level = args.sphere_tree_level;
-          return std::make_unique<WorldScene>(w, o);
-        },
-        kKneeYaw, kKneePitch);
   }
 
   SessionOptions options;
   options.duration_s = duration_s;
   if (snapshots && args.snapshot_every > 0) {
-    options.after_cycle = [&](std::size_t cycle) { snapshots->after_step(world, cycle + 1); };
+    options.after_cycle = [&](std::size_t cycle) { snapshots->after_step(*world, cycle + 1); };
   }
   options.dt_s = scene.run.dt_s;
   options.realtime = args.realtime;
   options.loop.spin_s = 1e-6 * args.spin_us;
   options.recorder = recorder.get();
   options.progress = progress;
-  const SessionSummary summary = run_session(world, *device, options);
+  options.teleop_target_world = teleop_target;
+  const SessionSummary summary = run_session(*world, *device, options);
   if (recorder) {
     recorder->close();
   }
   std::cout << format_session_summary(summary);
   if (snapshots) {
-    snapshots->final(world);
+    snapshots->final(*world);
   }
 
   bool failed = false;
-  nlohmann::json j = summary_json(scene, world, summary, device_name);
+  nlohmann::json j = summary_json(scene, *world, summary, device_name);
+  if (summary.teleop) {
+    const TeleopSummary& t = *summary.teleop;
+    j["slave"] = teleop ? teleop->slave_name : std::string();
+    j["grasped"] = t.grasped;
+    j["grasp_time_s"] = t.grasped ? nlohmann::json(t.grasp_time_s) : nlohmann::json(nullptr);
+    j["release_time_s"] =
+        t.release_time_s >= 0.0 ? nlohmann::json(t.release_time_s) : nlohmann::json(nullptr);
+    j["ball_lift_m"] = t.ball_lift_m;
+    j["ball_final_position_m"] = {t.ball_final_world.x(), t.ball_final_world.y(),
+                                  t.ball_final_world.z()};
+    j["ball_target_error_m"] =
+        t.target_error_m ? nlohmann::json(*t.target_error_m) : nlohmann::json(nullptr);
+    j["peak_grasp_force_n"] = t.peak_grasp_force_n;
+    j["max_sheet_deflection_m"] = t.max_sheet_deflection_m;
+    j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
+    // A scripted pick-and-place must end with the ball within 5 mm of its target (a replay of one
+    // is judged by its bit-for-bit comparison instead).
+    if (t.target_error_m && !replayed && !t.placed()) {
+      std::printf(
+          "FAILED: the pick-and-place did not end with the ball within 5 mm of the target\n");
+      failed = true;
+    }
+  }
   if (replayed) {
     const Recording again = read_recording(record_path);
     const RecordingDifference d = compare_recordings(*replayed, again);

@@ -21,6 +21,10 @@ void fill_cycle_record(CycleRecord& record, std::uint64_t cycle, const DeviceInp
   record.dropped_contacts = std::max(0, result.dropped_contacts) +
                             static_cast<std::int32_t>(result.contacts.size() - contacts);
   record.penalty_pop_throughs = result.penalty_pop_throughs;
+  record.has_teleop = result.teleop != nullptr;
+  if (record.has_teleop) {
+    record.teleop = *result.teleop;
+  }
   record.cost_us = cost_us;
 }
 

@@ -30,6 +30,9 @@ struct CycleRecord {
   std::int32_t dropped_contacts = 0;
   /// Tools pulled through a penalty segment this cycle (StepResult::penalty_pop_throughs).
   std::int32_t penalty_pop_throughs = 0;
+  /// The teleoperation rig's step (when the world has a rig: has_teleop).
+  bool has_teleop = false;
+  TeleopStepResult teleop;
   double cost_us = 0.0;
 };
 

@@ -104,6 +104,10 @@ class SessionAccountant {
     if (options.check_pop_through) {
       checks_ = make_proxy_checks(world);
     }
+    if (world.rig() != nullptr) {
+      summary_.teleop.emplace();
+      ball_start_z_ = world.rig()->ball.p_world().z();
+    }
     cost_us_.reserve(steps);
     touched_.assign(summary_.segments.size() * desc.tools.size(), 0);
   }
@@ -162,6 +166,9 @@ class SessionAccountant {
         }
       }
     }
+    if (r.has_teleop) {
+      account_teleop(r.teleop);
+    }
     if (options_.recorder != nullptr) {
       if (!options_.recorder->record(to_recorded_frame(r))) {
         ++summary_.recording_dropped_frames;
@@ -174,6 +181,22 @@ class SessionAccountant {
       }
     }
     ++summary_.steps;
+  }
+
+  void account_teleop(const TeleopStepResult& r) {
+    TeleopSummary& t = *summary_.teleop;
+    if (r.gripper.grasped_now && !t.grasped) {
+      t.grasped = true;
+      t.grasp_time_s = r.time_s;
+    }
+    if (r.gripper.released_now && t.grasped && t.release_time_s < 0.0) {
+      t.release_time_s = r.time_s;
+    }
+    t.ball_lift_m = std::max(t.ball_lift_m, r.ball_p_world.z() - ball_start_z_);
+    t.peak_grasp_force_n = std::max(t.peak_grasp_force_n, r.gripper.grasp_force_n());
+    t.max_sheet_deflection_m = std::max(t.max_sheet_deflection_m, r.sheet_depth_m);
+    t.max_slave_tracking_error_m = std::max(t.max_slave_tracking_error_m, r.slave.position_error_m);
+    t.nonfinite_ball_steps += r.ball_p_world.allFinite() ? 0 : 1;
   }
 
   void note_deflection(std::size_t flat_segment, double deflection_m) {
@@ -193,6 +216,14 @@ class SessionAccountant {
           ts.contact_steps > 0 ? force_sum_[t] / static_cast<double>(ts.contact_steps) : 0.0;
     }
     summary_.step_us = summarize_samples(cost_us_);
+    if (summary_.teleop) {
+      // The run has ended: the world is this thread's again.
+      TeleopSummary& t = *summary_.teleop;
+      t.ball_final_world = world_.rig()->ball.p_world();
+      if (options_.teleop_target_world) {
+        t.target_error_m = (t.ball_final_world - *options_.teleop_target_world).norm();
+      }
+    }
     return std::move(summary_);
   }
 
@@ -206,6 +237,7 @@ class SessionAccountant {
   std::vector<double> cost_us_;
   // Per-segment touch flags of one step, so a tool-step counts once per segment.
   std::vector<std::uint8_t> touched_;
+  double ball_start_z_ = 0.0;
 };
 
 SessionSummary run_inline(World& world, Device& device, const SessionOptions& options,
@@ -344,6 +376,11 @@ SessionSummary run_session(World& world, Device& device, const SessionOptions& o
                           : run_inline(world, device, options, steps);
 }
 
+bool TeleopSummary::placed() const {
+  return nonfinite_ball_steps == 0 && grasped && release_time_s >= 0.0 &&
+         (!target_error_m || *target_error_m <= 0.005);
+}
+
 std::string format_session_summary(const SessionSummary& s) {
   std::ostringstream out;
   char line[256];
@@ -360,7 +397,37 @@ std::string format_session_summary(const SessionSummary& s) {
                   t.name.c_str(), t.peak_force_n, t.mean_force_n, t.contact_steps);
     out << line;
   }
-  out << "segments touched (tool-steps in contact, peak force, largest deflection):\n";
+  if (s.teleop) {
+    const TeleopSummary& t = *s.teleop;
+    if (t.grasped) {
+      std::snprintf(
+          line, sizeof line,
+          "grasp        achieved at %.3f s, peak grasp force %.2f N, ball lifted %.1f mm\n",
+          t.grasp_time_s, t.peak_grasp_force_n, t.ball_lift_m * 1e3);
+    } else {
+      std::snprintf(line, sizeof line, "grasp        never achieved\n");
+    }
+    out << line;
+    if (t.release_time_s >= 0.0) {
+      std::snprintf(line, sizeof line, "release      at %.3f s\n", t.release_time_s);
+      out << line;
+    }
+    std::snprintf(line, sizeof line, "ball         ends at (%.4f, %.4f, %.4f) m",
+                  t.ball_final_world.x(), t.ball_final_world.y(), t.ball_final_world.z());
+    out << line;
+    if (t.target_error_m) {
+      std::snprintf(line, sizeof line, ", %.2f mm from the target spot", *t.target_error_m * 1e3);
+      out << line;
+    }
+    std::snprintf(line, sizeof line,
+                  "\nsheet        deepest dent %.3f mm\nslave        largest tip error while "
+                  "tracking %.3f mm\n",
+                  t.max_sheet_deflection_m * 1e3, t.max_slave_tracking_error_m * 1e3);
+    out << line;
+  }
+  if (!s.segments.empty()) {
+    out << "segments touched (tool-steps in contact, peak force, largest deflection):\n";
+  }
   std::size_t untouched = 0;
   for (const SegmentSummary& g : s.segments) {
     if (g.contacts == 0 && g.max_deflection_m == 0.0) {

@@ -35,6 +35,9 @@ struct SessionOptions {
   bool check_pop_through = true;
   /// Receives every cycle (input, command after safety, contacts). Not owned; may be null.
   SessionRecorder* recorder = nullptr;
+  /// A teleoperation rig's pick-and-place target: where the ball should come to rest (the
+  /// summary then reports how far from it the ball ended).
+  std::optional<Vec3> teleop_target_world;
   ProgressFn progress;
   /// Inline runs only: called after every cycle's bookkeeping with the cycle index (between
   /// cycles, on the stepping thread: may read the world, e.g. to render a snapshot).
@@ -79,6 +82,23 @@ struct RealtimeSummary {
   std::size_t dropped_records = 0;
 };
 
+/// What a teleoperation rig did over the run (the pick-and-place of paper 000).
+struct TeleopSummary {
+  bool grasped = false;
+  double grasp_time_s = -1.0;    ///< first grasp (-1: never)
+  double release_time_s = -1.0;  ///< first release after it (-1: never)
+  double ball_lift_m = 0.0;      ///< highest the ball rose above its start
+  double peak_grasp_force_n = 0.0;
+  double max_sheet_deflection_m = 0.0;
+  double max_slave_tracking_error_m = 0.0;
+  std::size_t nonfinite_ball_steps = 0;
+  Vec3 ball_final_world = Vec3::Zero();
+  /// With SessionOptions::teleop_target_world: the ball's final distance from it.
+  std::optional<double> target_error_m;
+  /// Grasped, released, the ball finite and (with a target) within 5 mm of it.
+  [[nodiscard]] bool placed() const;
+};
+
 struct SessionSummary {
   std::size_t steps = 0;
   double simulated_s = 0.0;
@@ -103,6 +123,8 @@ struct SessionSummary {
   /// Realtime only: periods longer than two nominal periods.
   std::size_t missed_deadlines = 0;
   std::optional<RealtimeSummary> realtime;
+  /// Worlds with a teleoperation rig.
+  std::optional<TeleopSummary> teleop;
 };
 
 /// Runs `world` with `device` for options.duration_s. Throws hapsim::Error on bad options.

@@ -1,6 +1,7 @@
-// What the viewer (and later the network) sees of a running teleoperation world: the newest cycle's
-// master input and command, the slave's joints and tool, the gripper, the ball and the sheet's
-// surface, published by the haptic thread through a triple buffer (teleop_haptic_client.h).
+// What the viewer (and later the network) sees of a teleoperation rig: the newest cycle's master
+// input and command, the slave's joints and tool, the gripper, the ball and the sheet's surface;
+// the rig's part of a WorldSnapshot, published by the world's haptic client through its triple
+// buffer (world_haptic_client.h).
 // Sized once for a world, so filling one never allocates.
 #pragma once
 

@@ -142,6 +142,14 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
                               : r.tools[t].force_world_n.norm() * tip_scale;
     }
   }
+  if (s.teleop && world_.rig() != nullptr) {
+    TeleopSnapshot& t = *s.teleop;
+    t.cycle = s.cycle;
+    t.time_s = s.time_s;
+    t.input = s.input;
+    t.output = s.output;
+    fill_teleop_snapshot(t, world_);
+  }
   for (DeformableSegment& seg : deformable_) {
     std::vector<std::uint32_t>& pending = seg.pending[slot];
     std::vector<std::uint8_t>& flag = seg.is_pending[slot];

@@ -33,6 +33,9 @@ WorldSnapshot make_world_snapshot(const World& world) {
       s.deflection_m[world.flat_segment(b, seg)] = deflection->max_deflection_m();
     }
   }
+  if (world.rig() != nullptr) {
+    s.teleop = make_teleop_snapshot(world);
+  }
   return s;
 }
 

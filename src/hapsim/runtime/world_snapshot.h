@@ -3,6 +3,7 @@
 // buffer (world_haptic_client.h). Sized once for a world, so publishing never allocates.
 #pragma once
 
+#include "hapsim/runtime/teleop_snapshot.h"
 #include "hapsim/world/world.h"
 
 #include <cstdint>
@@ -31,6 +32,8 @@ struct WorldSnapshot {
   std::vector<double> deflection_m;
   /// Per flat segment: bumped whenever positions_body changed, so a reader re-uploads only then.
   std::vector<std::uint64_t> positions_version;
+  /// The teleoperation rig (slave, gripper, ball, sheet, master), when the world has one.
+  std::optional<TeleopSnapshot> teleop;
 };
 
 /// A snapshot sized for `world`, holding its current state (rest surfaces at start).

@@ -5,7 +5,7 @@
 #include "hapsim/device/interactive_device.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/render/teleop_scene.h"
-#include "hapsim/runtime/teleop_haptic_client.h"
+#include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/scene/scene_description.h"
 #include "hapsim/scene/teleop_setup.h"
 #if defined(HAPSIM_WITH_SPNAV)
@@ -160,9 +160,9 @@ class TeleopViewerSession final : public ViewerSession {
   TeleopViewerSession& operator=(TeleopViewerSession&&) = delete;
 
   void update() override {
-    TripleBuffer<TeleopSnapshot>& snapshots = *client_->snapshots();
+    TripleBuffer<WorldSnapshot>& snapshots = *client_->snapshots();
     snapshots.update();
-    const TeleopSnapshot& s = snapshots.read_slot();
+    const TeleopSnapshot& s = *snapshots.read_slot().teleop;
     view_->update(s);
 
     SessionReadout& r = readout_;
@@ -296,7 +296,7 @@ class TeleopViewerSession final : public ViewerSession {
 
  private:
   void start_loop() {
-    client_ = std::make_unique<TeleopHapticClient>(*world_);
+    client_ = std::make_unique<WorldHapticClient>(*world_);
     client_->set_paused(paused_);
     loop_ = std::make_unique<HapticLoop>(*device_, *client_);
     loop_->start();
@@ -310,7 +310,7 @@ class TeleopViewerSession final : public ViewerSession {
   std::unique_ptr<Device> probe_;  // the mouse or 3D mouse behind device_ (null for sim)
   InteractiveDevice* mouse_ = nullptr;
   std::unique_ptr<Device> device_;
-  std::unique_ptr<TeleopHapticClient> client_;
+  std::unique_ptr<WorldHapticClient> client_;
   std::unique_ptr<HapticLoop> loop_;
   SessionReadout readout_;
   Vec3 probe_start_W_ = Vec3::Zero();

@@ -1,8 +1,9 @@
-// The teleoperation World on the real-time loop: after a scripted pick-and-place start the snapshot
-// the viewer reads is the world's state exactly (ball, slave joints and tool, sheet), the world
-// went through exactly what an inline run with the same inputs goes through, a reader thread never
-// sees a torn snapshot, the haptic thread allocates nothing, and a paused client holds the world.
-#include "hapsim/runtime/teleop_haptic_client.h"
+// A teleoperation World on the real-time loop through the one world client: after a scripted
+// pick-and-place start the snapshot the viewer reads is the world's state exactly (ball, slave
+// joints and tool, sheet), the world went through exactly what an inline run with the same inputs
+// goes through, a reader thread never sees a torn snapshot, the haptic thread allocates nothing,
+// and a paused client holds the world.
+#include "hapsim/runtime/world_haptic_client.h"
 
 #include "hapsim/core/device_profile.h"
 #include "hapsim/device/simulated_device.h"
@@ -26,20 +27,21 @@ TeleopSetup pick_and_place_setup() {
   return make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/false);
 }
 
-TEST(TeleopHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
+TEST(WorldHapticClientRig, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   const TeleopSetup setup = pick_and_place_setup();
   World world(setup.description);
   SimulatedDevice device(device_profile("simulated"), setup.trajectory);
-  TeleopHapticClient client(world);
+  WorldHapticClient client(world);
   HapticLoopOptions o;
   o.max_cycles = 300;
   HapticLoop loop(device, client, o);
   loop.start();
   loop.wait();
-  EXPECT_EQ(client.steps(), 300u);
-  TripleBuffer<TeleopSnapshot>& buffer = *client.snapshots();
+  EXPECT_NEAR(world.last_result().time_s, 300 * o.period_s, 1e-9);  // 300 steps
+  TripleBuffer<WorldSnapshot>& buffer = *client.snapshots();
   ASSERT_TRUE(buffer.update());
-  const TeleopSnapshot& s = buffer.read_slot();
+  ASSERT_TRUE(buffer.read_slot().teleop.has_value());
+  const TeleopSnapshot& s = *buffer.read_slot().teleop;
   EXPECT_EQ(s.cycle, 299u);
   EXPECT_EQ(s.ball_p_world, world.rig()->ball.p_world());
   const auto q = world.rig()->slave->q();
@@ -75,11 +77,11 @@ TEST(TeleopHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   EXPECT_EQ(inline_world.rig()->slave->gripper_width_m(), world.rig()->slave->gripper_width_m());
 }
 
-TEST(TeleopHapticClient, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllocate) {
+TEST(WorldHapticClientRig, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllocate) {
   const TeleopSetup setup = pick_and_place_setup();
   World world(setup.description);
   SimulatedDevice device(device_profile("simulated"), setup.trajectory);
-  TeleopHapticClient client(world);
+  WorldHapticClient client(world);
 
   // Counts the haptic thread's allocations around the real client (step and after_cycle).
   test::AllocationCountingClient counting(client);
@@ -94,7 +96,7 @@ TEST(TeleopHapticClient, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllo
     std::uint64_t last_cycle = 0;
     while (loop.running()) {
       if (client.snapshots()->update()) {
-        const TeleopSnapshot& s = client.snapshots()->read_slot();
+        const TeleopSnapshot& s = *client.snapshots()->read_slot().teleop;
         // One cycle's data: the master joints the world followed are that cycle's input.
         if (s.master_joint_rad[0] != s.input.joint_rad[0] ||
             s.master_joint_rad[2] != s.input.joint_rad[2] || s.cycle < last_cycle ||
@@ -115,11 +117,11 @@ TEST(TeleopHapticClient, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllo
   EXPECT_GT(snapshots.load(), 10);
 }
 
-TEST(TeleopHapticClient, PausedClientHoldsTheWorldAndSendsNoTorque) {
+TEST(WorldHapticClientRig, PausedClientHoldsTheWorldAndSendsNoTorque) {
   const TeleopSetup setup = pick_and_place_setup();
   World world(setup.description);
   SimulatedDevice device(device_profile("simulated"), setup.trajectory);
-  TeleopHapticClient client(world);
+  WorldHapticClient client(world);
   client.set_paused(true);
   EXPECT_TRUE(client.paused());
   HapticLoopOptions o;
@@ -127,10 +129,9 @@ TEST(TeleopHapticClient, PausedClientHoldsTheWorldAndSendsNoTorque) {
   HapticLoop loop(device, client, o);
   loop.start();
   loop.wait();
-  EXPECT_EQ(client.steps(), 0u);
-  EXPECT_EQ(world.rig()->result.time_s, 0.0);
+  EXPECT_EQ(world.rig()->result.time_s, 0.0);  // never stepped
   ASSERT_TRUE(client.snapshots()->update());
-  const TeleopSnapshot& s = client.snapshots()->read_slot();
+  const TeleopSnapshot& s = *client.snapshots()->read_slot().teleop;
   EXPECT_EQ(s.cycle, 49u);
   EXPECT_EQ(s.ball_p_world, setup.description.teleop->ball_start_world);
   for (int j = 0; j < kMaxDeviceJoints; ++j) {
