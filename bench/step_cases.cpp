@@ -1,9 +1,8 @@
 #include "bench/step_cases.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/core/device_profile.h"
 #include "hapsim/runtime/session.h"
-#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/world/world.h"
 
@@ -58,21 +57,14 @@ std::vector<StepRow> run_step_bench(const StepBenchOptions& options) {
     std::size_t first_row = rows.size();
     for (const std::string& method : methods) {
       report_progress(options.progress, c.name + " / " + method, static_cast<double>(done) / total);
-      WorldDescription description = scene.world;
-      for (BodyDescription& b : description.bodies) {
-        b.method = method_from_name(method);
-      }
-      const DeviceProfile& profile = device_profile(scene.device.profile);
-      WorldOptions world_options;
-      world_options.max_stiffness_n_per_m = profile.max_stiffness_n_per_m;
-      World world(std::move(description), world_options);
-      auto device = make_scene_device(scene, world);
+      RunSetupOptions setup_options;
+      setup_options.method = method_from_name(method);
+      RunSetup setup = make_run_setup(scene, DeviceChoice::scene_script(), setup_options);
+      const World& world = *setup.world;
       SessionOptions session;
       session.dt_s = scene.run.dt_s;
-      session.duration_s = options.duration_s > 0.0     ? options.duration_s
-                           : scene.run.duration_s > 0.0 ? scene.run.duration_s
-                                                        : device->duration_end_s();
-      const SessionSummary s = run_session(world, *device, session);
+      session.duration_s = options.duration_s > 0.0 ? options.duration_s : setup.duration_s;
+      const SessionSummary s = run_session(*setup.world, *setup.device, session);
 
       StepRow row;
       row.case_name = c.name;

@@ -12,9 +12,8 @@
 #include "hapsim/render/teleop_scene.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/session.h"
-#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
-#include "hapsim/scene/teleop_setup.h"
 
 #include <nlohmann/json.hpp>
 
@@ -254,46 +253,46 @@ void run(const RunArgs& args) {
   }
   load_options.progress = progress;
   const Stopwatch load_watch;
-  SceneDescription scene = load_scene(args.scene, load_options);
-  if (!args.method.empty()) {
-    if (scene.world.bodies.empty()) {
-      throw CommandError("--method: " + args.scene +
-                         " has no bodies whose contact method it could change");
-    }
-    for (BodyDescription& b : scene.world.bodies) {
-      b.method = parse_method(args.method);
-    }
+  SceneDescription loaded = load_scene(args.scene, load_options);
+  if (!args.method.empty() && loaded.world.bodies.empty()) {
+    throw CommandError("--method: " + args.scene +
+                       " has no bodies whose contact method it could change");
   }
-  // The world and the device the scene asks for: a haptic world with its palpation script or
-  // trajectory, or a teleoperation rig with its scripted master (scene/teleop_setup.h).
-  std::unique_ptr<World> world;
-  std::unique_ptr<Device> device;
-  std::string device_name;
-  double duration_s = scene.run.duration_s;
-  std::optional<Vec3> teleop_target;
-  std::optional<TeleopSetup> teleop;
-  const DeviceProfile& profile =
-      device_profile(scene.is_teleop ? std::string("simulated") : scene.device.profile);
-  if (scene.is_teleop) {
-    report_progress(progress, "building the teleoperation rig", 0.0);
-    teleop = make_teleop_setup(scene, trajectory, /*load_link_meshes=*/false);
-    world = std::make_unique<World>(teleop->description);
+  const DeviceChoice choice = !args.replay_path.empty() ? DeviceChoice::replay(args.replay_path)
+                              : trajectory              ? DeviceChoice::trajectory(*trajectory)
+                                                        : DeviceChoice::scene_script();
+  RunSetupOptions setup_options;
+  if (!args.method.empty()) {
+    setup_options.method = parse_method(args.method);
+  }
+  report_progress(progress, "building the world", 0.0);
+  RunSetup setup = [&] {
+    try {
+      return make_run_setup(std::move(loaded), choice, setup_options);
+    } catch (const Error& e) {
+      // A bad recording is a bad --replay argument: say so.
+      if (choice.kind == DeviceChoice::Kind::kReplay &&
+          std::string(e.where()) == args.replay_path) {
+        throw CommandError("--replay " + args.replay_path + ": " + e.what());
+      }
+      throw;
+    }
+  }();
+  const SceneDescription& scene = setup.scene;
+  std::unique_ptr<World>& world = setup.world;
+  std::unique_ptr<Device>& device = setup.device;
+  const std::string& device_name = setup.device_name;
+  const std::optional<Recording>& replayed = setup.replayed;
+  const bool teleop = world->rig() != nullptr;
+  if (teleop) {
     const RigState& rig = *world->rig();
     std::printf(
         "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
         "sheet %dx%d\n",
-        scene.file.string().c_str(), teleop->slave_name.c_str(), rig.slave->chain().dof(),
+        scene.file.string().c_str(), setup.slave_name.c_str(), rig.slave->chain().dof(),
         rig.ball.params().mass_kg * 1e3, rig.ball.params().radius_m * 1e3,
         scene.teleop.sheet_nodes_per_side, scene.teleop.sheet_nodes_per_side);
-    if (teleop->has_target) {
-      teleop_target = teleop->target_world;
-    }
   } else {
-    WorldOptions world_options;
-    // Render no stiffer than the device stays stable at (CHAI3D's published maxima).
-    world_options.max_stiffness_n_per_m = profile.max_stiffness_n_per_m;
-    report_progress(progress, "building contact structures", 0.0);
-    world = std::make_unique<World>(scene.world, world_options);
     std::size_t vertices = 0;
     std::size_t segments = 0;
     for (const BodyDescription& b : scene.world.bodies) {
@@ -309,44 +308,7 @@ void run(const RunArgs& args) {
         load_watch.elapsed_s(), world->build_ms(),
         static_cast<double>(world->query_memory_bytes()) / 1e6);
   }
-
-  std::optional<Recording> replayed;
-  if (!args.replay_path.empty()) {
-    replayed = read_recording(args.replay_path);
-    if (replayed->header.scene_hash != world->content_hash()) {
-      throw CommandError("--replay " + args.replay_path +
-                         ": recorded on a different scene (content hash differs)");
-    }
-    if (replayed->frames.empty()) {
-      throw CommandError("--replay " + args.replay_path + ": the recording has no frames");
-    }
-    duration_s = static_cast<double>(replayed->frames.size()) * scene.run.dt_s;
-    device = std::make_unique<ReplayDevice>(profile, replayed->frames);
-    device_name = "replay of " + args.replay_path;
-  } else if (teleop) {
-    // Cycle i plays the master's trajectory at start + (i + 1)·dt: the first step already moves.
-    const Trajectory& played = teleop->trajectory;
-    const double dt = scene.run.dt_s;
-    const double length_s = played.end_time_s() - played.start_time_s();
-    device = std::make_unique<SimulatedDevice>(
-        profile,
-        [&played, dt](double t_s) { return played.sample_at(played.start_time_s() + t_s + dt); },
-        length_s);
-    if (!(duration_s > 0.0)) {
-      duration_s = length_s;
-    }
-    device_name = teleop->device_name;
-  } else {
-    auto sim = make_scene_device(scene, *world, trajectory);
-    if (!(duration_s > 0.0)) {
-      duration_s = sim->duration_end_s();
-    }
-    device_name = "simulated " + profile.name +
-                  (trajectory                   ? " playing " + trajectory->string()
-                   : scene.device.has_palpation ? " (palpation script)"
-                                                : " (scene trajectory)");
-    device = std::move(sim);
-  }
+  double duration_s = setup.duration_s;
   if (!std::isnan(args.duration_s)) {
     duration_s = args.duration_s;  // checked above
   }
@@ -398,7 +360,7 @@ void run(const RunArgs& args) {
   options.loop.spin_s = 1e-6 * args.spin_us;
   options.recorder = recorder.get();
   options.progress = progress;
-  options.teleop_target_world = teleop_target;
+  options.teleop_target_world = setup.teleop_target_world;
   const SessionSummary summary = run_session(*world, *device, options);
   if (recorder) {
     recorder->close();
@@ -412,7 +374,7 @@ void run(const RunArgs& args) {
   nlohmann::json j = summary_json(scene, *world, summary, device_name);
   if (summary.teleop) {
     const TeleopSummary& t = *summary.teleop;
-    j["slave"] = teleop ? teleop->slave_name : std::string();
+    j["slave"] = setup.slave_name;
     j["grasped"] = t.grasped;
     j["grasp_time_s"] = t.grasped ? nlohmann::json(t.grasp_time_s) : nlohmann::json(nullptr);
     j["release_time_s"] =

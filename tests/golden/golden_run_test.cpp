@@ -10,9 +10,8 @@
 #include "hapsim/core/device_profile.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/runtime/session.h"
-#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
-#include "hapsim/scene/teleop_setup.h"
 #include "hapsim/world/world.h"
 
 #include <gtest/gtest.h>
@@ -47,26 +46,26 @@ std::optional<SceneLoadOptions> load_options(const std::string& data_folder) {
   return o;
 }
 
-// A haptic-world scene as `hapsim run` assembles it: the world no stiffer than the device's
-// rating, the scene's scripted device, the session with the safety layer, every cycle recorded.
-test::GoldenTrace run_world_scene(const SceneDescription& scene, const std::string& name) {
-  const DeviceProfile& profile = device_profile(scene.device.profile);
-  WorldOptions world_options;
-  world_options.max_stiffness_n_per_m = profile.max_stiffness_n_per_m;
-  World world(scene.world, world_options);
-  auto device = make_scene_device(scene, world);
-  const double duration_s =
-      scene.run.duration_s > 0.0 ? scene.run.duration_s : device->duration_end_s();
+// A scene as `hapsim run` runs it: assembled by make_run_setup (the world no stiffer than the
+// device's rating, the scene's scripted device), stepped by run_session with the safety layer,
+// every cycle recorded; for a teleoperation rig also the rig's own step after each cycle.
+test::GoldenTrace run_scene(SceneDescription scene, const std::string& name) {
+  RunSetup setup = make_run_setup(std::move(scene), DeviceChoice::scene_script());
+  World& world = *setup.world;
   const fs::path rec =
       fs::temp_directory_path() / ("hapsim_golden_" + std::to_string(::getpid()) + ".rec");
+  std::vector<TeleopStepResult> rig_steps;
   std::vector<RecordedFrame> frames;
   {
     SessionRecorder recorder(rec, world.content_hash(), 8192);
     SessionOptions options;
-    options.duration_s = duration_s;
-    options.dt_s = scene.run.dt_s;
+    options.duration_s = setup.duration_s;
+    options.dt_s = setup.scene.run.dt_s;
     options.recorder = &recorder;
-    (void)run_session(world, *device, options);
+    if (world.rig() != nullptr) {
+      options.after_cycle = [&](std::size_t) { rig_steps.push_back(world.rig()->result); };
+    }
+    (void)run_session(world, *setup.device, options);
     recorder.close();
     frames = read_recording(rec).frames;
   }
@@ -74,51 +73,36 @@ test::GoldenTrace run_world_scene(const SceneDescription& scene, const std::stri
 
   test::GoldenTrace trace;
   trace.scene = name;
-  trace.columns = {"force_x_n", "force_y_n", "force_z_n", "finger0_n",
-                   "finger1_n", "finger2_n", "finger3_n", "finger4_n"};
   trace.cycle_count = frames.size();
-  for (const RecordedFrame& f : frames) {
-    test::GoldenCycle c;
-    c.index = f.cycle_index;
-    const DeviceCommand& cmd = f.command;
-    c.values = {cmd.force_world_n.x(), cmd.force_world_n.y(), cmd.force_world_n.z()};
-    for (int i = 0; i < kMaxFingers; ++i) {
-      c.values.push_back(cmd.finger_force_n[static_cast<std::size_t>(i)]);
+  if (world.rig() == nullptr) {
+    trace.columns = {"force_x_n", "force_y_n", "force_z_n", "finger0_n",
+                     "finger1_n", "finger2_n", "finger3_n", "finger4_n"};
+    for (const RecordedFrame& f : frames) {
+      test::GoldenCycle c;
+      c.index = f.cycle_index;
+      const DeviceCommand& cmd = f.command;
+      c.values = {cmd.force_world_n.x(), cmd.force_world_n.y(), cmd.force_world_n.z()};
+      for (int i = 0; i < kMaxFingers; ++i) {
+        c.values.push_back(cmd.finger_force_n[static_cast<std::size_t>(i)]);
+      }
+      for (int i = 0; i < f.contact_count; ++i) {
+        const RecordedContact& k = f.contacts[static_cast<std::size_t>(i)];
+        c.contacts.push_back({k.tool_index, k.body_index, k.segment_index, k.force_n});
+      }
+      test::append_cycle(trace, std::move(c));
     }
-    for (int i = 0; i < f.contact_count; ++i) {
-      const RecordedContact& k = f.contacts[static_cast<std::size_t>(i)];
-      c.contacts.push_back({k.tool_index, k.body_index, k.segment_index, k.force_n});
-    }
-    test::append_cycle(trace, std::move(c));
+    return trace;
   }
-  return trace;
-}
-
-// A teleoperation scene as `hapsim run` steps it inline: the master trajectory sampled at
-// start + k·dt, the world's command straight to the master.
-test::GoldenTrace run_teleop_scene(const SceneDescription& scene, const std::string& name) {
-  TeleopSetup setup = make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/false);
-  const Trajectory trajectory = setup.trajectory;
-  World world(std::move(setup.description));
-  const double dt = scene.run.dt_s;
-  const double duration = scene.run.duration_s > 0.0
-                              ? scene.run.duration_s
-                              : trajectory.end_time_s() - trajectory.start_time_s();
-  const auto steps = static_cast<std::size_t>(std::llround(duration / dt));
-  test::GoldenTrace trace;
-  trace.scene = name;
+  // The rig: the world's own step (torques before the safety layer, pads, sheet, floor, ball).
   trace.columns = {"torque0_nm",   "torque1_nm",   "torque2_nm",  "torque3_nm", "torque4_nm",
                    "finger0_n",    "finger1_n",    "pad0_n",      "pad1_n",     "sheet_x_n",
                    "sheet_y_n",    "sheet_z_n",    "floor_x_n",   "floor_y_n",  "floor_z_n",
                    "ball_x_m",     "ball_y_m",     "ball_z_m",    "held",       "sheet_depth_m",
                    "slave_tool_x", "slave_tool_y", "slave_tool_z"};
-  trace.cycle_count = steps;
-  for (std::size_t k = 1; k <= steps; ++k) {
-    const DeviceInput in =
-        trajectory.sample_at(trajectory.start_time_s() + static_cast<double>(k) * dt);
-    const TeleopStepResult& r = *world.step(in, dt).teleop;
+  for (std::size_t k = 0; k < rig_steps.size(); ++k) {
+    const TeleopStepResult& r = rig_steps[k];
     test::GoldenCycle c;
-    c.index = k - 1;
+    c.index = k;
     for (std::size_t i = 0; i < 5; ++i) {
       c.values.push_back(r.command.joint_torque_nm[i]);
     }
@@ -151,9 +135,8 @@ void check_scene(const std::string& name, const std::string& data_folder = {}) {
     GTEST_SKIP() << "real data '" << data_folder << "' not found under " << HAPSIM_TEST_DATA_DIR
                  << " (tests with real data skip)";
   }
-  const SceneDescription scene = load_scene(kScenes / (name + ".json"), *options);
   const test::GoldenTrace actual =
-      scene.is_teleop ? run_teleop_scene(scene, name) : run_world_scene(scene, name);
+      run_scene(load_scene(kScenes / (name + ".json"), *options), name);
   const fs::path golden = kGolden / (name + ".trace.gz");
   const char* update = std::getenv("HAPSIM_UPDATE_GOLDEN");
   if (update != nullptr && std::string(update) == "1") {

@@ -6,8 +6,8 @@
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/render/teleop_scene.h"
 #include "hapsim/runtime/world_haptic_client.h"
+#include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_description.h"
-#include "hapsim/scene/teleop_setup.h"
 #if defined(HAPSIM_WITH_SPNAV)
 #include "hapsim/device/spacenav_device.h"
 #endif
@@ -104,26 +104,32 @@ class TeleopViewerSession final : public ViewerSession {
     if (config.device.rfind("sim:", 0) == 0 && config.device.size() > 4) {
       trajectory = config.device.substr(4);
     }
-    TeleopSetup setup = make_teleop_setup(scene, trajectory, /*load_link_meshes=*/true);
-    description_ = setup.description;
-    world_.emplace(std::move(setup.description));
+    RunSetupOptions setup_options;
+    setup_options.load_link_meshes = true;  // the slave is drawn with its own meshes
+    RunSetup setup = make_run_setup(scene,
+                                    !sim         ? DeviceChoice::external()
+                                    : trajectory ? DeviceChoice::trajectory(*trajectory)
+                                                 : DeviceChoice::scene_script(),
+                                    setup_options);
+    world_ = std::move(setup.world);
+    const TeleopRigDescription& rig = *world_->description().teleop;
     view_ = std::make_unique<TeleopScene>(*world_);
 
-    // The probe starts where the master's hand is at the trajectory's first sample, so the slave
-    // starts still (make_teleop_setup solved its start joints for that pose).
-    const DeviceInput first = setup.trajectory.sample_at(setup.trajectory.start_time_s());
+    // The probe starts where the master's hand is at the script's first sample, so the slave
+    // starts still (the run setup solved its start joints for that pose).
+    const DeviceInput& first = setup.script_start;
     const std::array<double, 3> first_arm{first.joint_rad[0], first.joint_rad[1],
                                           first.joint_rad[2]};
     // The cursor points at the slave's tool: the probe is its target in the world.
     MasterHandMapping hand_mapping(*world_->model().master(), first_arm);
-    hand_mapping.set_probe_in_slave_frame(description_.teleop->mapping);
+    hand_mapping.set_probe_in_slave_frame(rig.mapping);
     probe_start_W_ = hand_mapping.probe_for(first_arm);
     DeviceInput start;
     start.p_world = probe_start_W_;
 
-    const DeviceProfile& profile = device_profile("simulated");
+    const DeviceProfile& profile = *setup.profile;
     if (sim) {
-      device_ = std::make_unique<SimulatedDevice>(profile, std::move(setup.trajectory));
+      device_ = std::move(setup.device);
       device_name_ = setup.device_name;
     } else if (config.device == "mouse") {
       auto mouse = std::make_unique<InteractiveDevice>(
@@ -147,7 +153,7 @@ class TeleopViewerSession final : public ViewerSession {
                   "expected mouse, sim, sim:FILE or spacemouse, got '" + config.device + "'");
     }
     title_ = scene.file.filename().string() + " — " + setup.slave_name + ", " + device_name_;
-    readout_.bar_full_scale_n = description_.teleop->gripper.max_force_n;
+    readout_.bar_full_scale_n = rig.gripper.max_force_n;
     start_loop();
   }
 
@@ -252,15 +258,14 @@ class TeleopViewerSession final : public ViewerSession {
     client_->set_paused(paused);
   }
 
-  // The teleoperation client has no reset request yet, so the world is rebuilt in place: the loop
-  // stops, a new world is made from the same description in the same storage (the TeleopScene keeps
-  // reading its immutable parts, which are identical), and a new client and loop start at cycle 0 —
-  // so the scripted master starts its script again. The probe stays where the user left it.
+  // The loop stops, the world goes back to its start (slave, ball and sheet as the scene starts
+  // them) and a new client and loop start at cycle 0 — so the scripted master starts its script
+  // again, in step with the slave. The probe stays where the user left it.
   void reset() override {
     loop_->stop();
     loop_.reset();
     client_.reset();
-    world_.emplace(description_);
+    world_->reset();
     start_loop();
   }
 
@@ -289,7 +294,7 @@ class TeleopViewerSession final : public ViewerSession {
           "The probe is the master's hand (its base frame): drag to move it, wheel for depth, G "
           "closes or opens the grasp.");
     }
-    const TeleopRigDescription& d = *description_.teleop;
+    const TeleopRigDescription& d = *world_->description().teleop;
     ImGui::Text("mapping scale %.2f, gripper %.0f mm / %.0f N", d.mapping.scale,
                 d.follower.gripper_max_width_m * 1e3, d.gripper.max_force_n);
   }
@@ -303,9 +308,7 @@ class TeleopViewerSession final : public ViewerSession {
   }
 
   ViewerConfig config_;
-  WorldDescription description_;  // for reset()
-  // Rebuilt in place by reset(): the render scene refers to this storage.
-  std::optional<World> world_;
+  std::unique_ptr<World> world_;  // the render scene refers to it
   std::unique_ptr<TeleopScene> view_;
   std::unique_ptr<Device> probe_;  // the mouse or 3D mouse behind device_ (null for sim)
   InteractiveDevice* mouse_ = nullptr;

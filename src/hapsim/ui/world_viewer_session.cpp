@@ -6,7 +6,7 @@
 #include "hapsim/kinematics/hand_model.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/world_haptic_client.h"
-#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 #if defined(HAPSIM_WITH_SPNAV)
 #include "hapsim/device/spacenav_device.h"
@@ -36,24 +36,29 @@ std::string format_mm(const Vec3& p_m) {
 
 class WorldViewerSession final : public ViewerSession {
  public:
-  WorldViewerSession(const ViewerConfig& config, SceneDescription scene)
-      : config_(config), scene_(std::move(scene)) {
+  WorldViewerSession(const ViewerConfig& config, SceneDescription scene) : config_(config) {
+    RunSetupOptions setup_options;
     if (!config.method.empty()) {
-      for (BodyDescription& b : scene_.world.bodies) {
-        b.method = method_from(config.method);
-      }
+      setup_options.method = method_from(config.method);
     }
     if (config.deformation == "none") {
-      for (BodyDescription& b : scene_.world.bodies) {
-        b.kind = b.kind == BodyKind::kDeformable ? BodyKind::kStatic : b.kind;
-      }
+      setup_options.rigid = true;
     } else if (config.deformation != "deflection") {
       throw Error("deformation", "expected deflection or none, got '" + config.deformation + "'");
     }
-    const DeviceProfile& profile = device_profile(scene_.device.profile);
-    WorldOptions wo;
-    wo.max_stiffness_n_per_m = profile.max_stiffness_n_per_m;
-    world_ = std::make_unique<World>(scene_.world, wo);
+    const bool sim = config.device == "sim" || config.device.rfind("sim:", 0) == 0;
+    std::optional<std::filesystem::path> trajectory;
+    if (sim && config.device.size() > 4) {
+      trajectory = config.device.substr(4);
+    }
+    RunSetup setup = make_run_setup(std::move(scene),
+                                    !sim         ? DeviceChoice::external()
+                                    : trajectory ? DeviceChoice::trajectory(*trajectory)
+                                                 : DeviceChoice::scene_script(),
+                                    setup_options);
+    scene_ = std::move(setup.scene);
+    world_ = std::move(setup.world);
+    const DeviceProfile& profile = *setup.profile;
     view_ = std::make_unique<WorldScene>(*world_);
     materials_.reserve(scene_.world.materials.size());
     for (const MaterialDescription& m : scene_.world.materials) {
@@ -85,12 +90,8 @@ class WorldViewerSession final : public ViewerSession {
       mouse_ = mouse.get();
       device_ = std::move(mouse);
       device_name_ = "mouse probe (" + profile.name + " limits)";
-    } else if (config.device == "sim" || config.device.rfind("sim:", 0) == 0) {
-      std::optional<std::filesystem::path> trajectory;
-      if (config.device.size() > 4) {
-        trajectory = config.device.substr(4);
-      }
-      device_ = make_scene_device(scene_, *world_, trajectory);
+    } else if (sim) {
+      device_ = std::move(setup.device);
       const std::string what = trajectory ? "trajectory " + trajectory->string() : "scene script";
       device_name_ = profile.name == "simulated" ? what + " (simulated device)"
                                                  : what + " (simulated " + profile.name + ")";

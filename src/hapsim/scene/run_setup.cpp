@@ -1,0 +1,98 @@
+#include "hapsim/scene/run_setup.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/device/simulated_device.h"
+#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/teleop_setup.h"
+
+#include <utility>
+
+namespace hapsim {
+
+RunSetup make_run_setup(SceneDescription scene, const DeviceChoice& choice,
+                        const RunSetupOptions& options) {
+  for (BodyDescription& b : scene.world.bodies) {
+    if (options.method) {
+      b.method = *options.method;
+    }
+    if (options.rigid && b.kind == BodyKind::kDeformable) {
+      b.kind = BodyKind::kStatic;
+    }
+  }
+  RunSetup r;
+  const std::optional<std::filesystem::path> trajectory =
+      choice.kind == DeviceChoice::Kind::kTrajectoryFile
+          ? std::optional<std::filesystem::path>(choice.file)
+          : std::nullopt;
+  std::optional<TeleopSetup> teleop;
+  if (scene.is_teleop) {
+    // The master arm: the world is the rig; the slave starts where the master's first pose puts
+    // it (make_teleop_setup solves that once).
+    teleop = make_teleop_setup(scene, trajectory, options.load_link_meshes);
+    r.profile = &device_profile("simulated");
+    r.world = std::make_unique<World>(teleop->description);
+    r.slave_name = teleop->slave_name;
+    if (teleop->has_target) {
+      r.teleop_target_world = teleop->target_world;
+    }
+    r.script_start = teleop->trajectory.sample_at(teleop->trajectory.start_time_s());
+  } else {
+    r.profile = &device_profile(scene.device.profile);
+    WorldOptions world_options;
+    // Render no stiffer than the device stays stable at (CHAI3D's published maxima).
+    world_options.max_stiffness_n_per_m = r.profile->max_stiffness_n_per_m;
+    r.world = std::make_unique<World>(scene.world, world_options);
+  }
+  double device_length_s = 0.0;
+  switch (choice.kind) {
+    case DeviceChoice::Kind::kReplay: {
+      r.replayed = read_recording(choice.file);
+      if (r.replayed->header.scene_hash != r.world->content_hash()) {
+        throw Error(choice.file.string(), "recorded on a different scene (content hash differs)");
+      }
+      if (r.replayed->frames.empty()) {
+        throw Error(choice.file.string(), "the recording has no frames");
+      }
+      device_length_s = static_cast<double>(r.replayed->frames.size()) * scene.run.dt_s;
+      r.script_start = r.replayed->frames.front().input;
+      r.device = std::make_unique<ReplayDevice>(*r.profile, r.replayed->frames);
+      r.device_name = "replay of " + choice.file.string();
+      break;
+    }
+    case DeviceChoice::Kind::kExternal:
+      if (!teleop) {
+        r.script_start = DeviceInput{};
+      }
+      break;
+    case DeviceChoice::Kind::kSceneScript:
+    case DeviceChoice::Kind::kTrajectoryFile:
+      if (teleop) {
+        // Cycle i plays the master's trajectory at start + (i + 1)·dt: the first step moves.
+        auto played = std::make_shared<const Trajectory>(std::move(teleop->trajectory));
+        const double dt = scene.run.dt_s;
+        device_length_s = played->end_time_s() - played->start_time_s();
+        r.device = std::make_unique<SimulatedDevice>(
+            *r.profile,
+            [played, dt](double t_s) {
+              return played->sample_at(played->start_time_s() + t_s + dt);
+            },
+            device_length_s);
+        r.device_name = teleop->device_name;
+      } else {
+        auto sim = make_scene_device(scene, *r.world, trajectory);
+        device_length_s = sim->duration_end_s();
+        r.script_start = sim->read(0.0);
+        r.device_name = "simulated " + r.profile->name +
+                        (trajectory                   ? " playing " + trajectory->string()
+                         : scene.device.has_palpation ? " (palpation script)"
+                                                      : " (scene trajectory)");
+        r.device = std::move(sim);
+      }
+      break;
+  }
+  r.duration_s = scene.run.duration_s > 0.0 ? scene.run.duration_s : device_length_s;
+  r.scene = std::move(scene);
+  return r;
+}
+
+}  // namespace hapsim
