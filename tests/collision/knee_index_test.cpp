@@ -496,7 +496,7 @@ TEST(KneeIndex, QueriesVisitFewGroupsAndScanFewVertices) {
 // Deformation: vertices moved along their radial directions, then refitted.
 
 // Moves every vertex within `radius_m` of `centre` along its radial direction by
-// depth·(cos(π d / radius) + 1)/2 (the SPEC's eq. 1 profile; depth < 0 pushes in).
+// depth·(cos(π d / radius) + 1)/2 (the the knee paper's eq. 1 profile; depth < 0 pushes in).
 std::vector<std::uint32_t> dent(TriangleMesh& mesh, const KneeIndex& knee, const Vec3& centre,
                                 double radius_m, double depth_m) {
   std::vector<std::uint32_t> moved;

@@ -1,5 +1,5 @@
 // Automatic construction of the knee method's vertex groups (Burdea et al., "knee palpation",
-// AI in Medicine 1994, §3.1.1; SPEC §2): a body's surface is cut into segments (connected
+// AI in Medicine 1994, §3.1.1; architecture.md#contact): a body's surface is cut into segments (connected
 // components), each segment's vertices into groups of adjacent vertices, and each group gets a
 // centroid inside the body about which its surface patch is star-shaped, so that a vertex is
 // well described by spherical coordinates (direction, radius) about that centroid.

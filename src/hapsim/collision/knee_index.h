@@ -1,4 +1,4 @@
-// The knee method (Burdea et al. 1994, §3.1.1; SPEC §2) as a selectable ProximityQuery:
+// The knee method (Burdea et al. 1994, §3.1.1; architecture.md#contact) as a selectable ProximityQuery:
 //   segment bounding sphere → groups whose sphere of influence holds the point, deepest first →
 //   the group's vertices in spherical coordinates about its centroid → the three vertices
 //   closest in angle to the point → the plane through them → if the point is on the centroid's

@@ -1,4 +1,4 @@
-// A lock-free single-producer / single-consumer triple buffer (SPEC §7): the haptic thread
+// A lock-free single-producer / single-consumer triple buffer (architecture.md#real-time): the haptic thread
 // publishes a snapshot every cycle without ever waiting, and a slower reader (the viewer, the
 // network) always gets the newest complete one, never a torn mix of two cycles.
 //

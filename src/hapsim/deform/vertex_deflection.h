@@ -12,7 +12,7 @@
 //  * Pressing is immediate (the surface follows the probe); releasing follows the recovery law:
 //    the gap to the target shrinks as exp(−dt/τ) and by at most v_max·dt per step, and snaps to the
 //    target below `rest_tolerance_m`, so it never overshoots and reaches rest in bounded time.
-//  * The paper's eq. 1 prints d_p/2 as the amplitude; SPEC §4 reads x/2 (δ(0) = x), used here.
+//  * The paper's eq. 1 prints d_p/2 as the amplitude; architecture.md#deformation reads x/2 (δ(0) = x), used here.
 #pragma once
 
 #include "hapsim/core/types.h"

@@ -1,4 +1,4 @@
-// Device safety (SPEC §3): a command never exceeds the device's rated limits, never carries a
+// Device safety (architecture.md#force-and-safety): a command never exceeds the device's rated limits, never carries a
 // NaN or inf, and ramps to zero within a bounded time when the simulation stalls or the device
 // link drops. Pure functions of their arguments (testable without threads or clocks), plus a
 // small per-cycle watchdog that strings them together for the haptic loop.

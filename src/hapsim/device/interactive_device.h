@@ -1,4 +1,4 @@
-// A device driven by another thread of the same program (SPEC §6): the viewer's mouse and
+// A device driven by another thread of the same program (architecture.md#devices): the viewer's mouse and
 // keyboard probe, a 3D mouse's reader thread, a script in a notebook. That thread sets the input
 // whenever it likes; the haptic thread's read() takes the newest one, and the command the loop
 // wrote is handed back so the viewer can show the force the device would render. Both hand-overs

@@ -1,5 +1,5 @@
 // A 3D mouse (3Dconnexion SpaceMouse and the like) through libspnav and the spacenavd daemon
-// (SPEC §6): the puck's deflection is a velocity, integrated into the tool pose by a reader
+// (architecture.md#devices): the puck's deflection is a velocity, integrated into the tool pose by a reader
 // thread and handed to the haptic thread through InteractiveDevice's lock-free buffer. A 3D
 // mouse renders no force; the viewer shows the force the tool would feel.
 //

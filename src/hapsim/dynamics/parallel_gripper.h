@@ -1,4 +1,4 @@
-// The slave's two-finger parallel gripper and the grasp (000 §1, SPEC §5): two box pads that close
+// The slave's two-finger parallel gripper and the grasp (000 §1, architecture.md#kinematics): two box pads that close
 // along the tool's y axis below the flange (tool z points out of the flange). A pad touching the
 // ball pushes it with a contact spring (and friction); the ball is *held* when both pads press it
 // from opposite sides hard enough that friction carries its weight — μ·(N₁ + N₂) ≥ safety·m·g —

@@ -1,4 +1,4 @@
-// A procedurally generated left knee for the palpation scene (SPEC §10; Burdea et al. 1994 used a
+// A procedurally generated left knee for the palpation scene (architecture.md#scenes; Burdea et al. 1994 used a
 // ~13.5k-vertex model): bones, muscles, tendon, collateral ligaments and a skin layer, each its own
 // closed mesh built from CSG solids and polygonised. Deterministic: same options, same meshes.
 //

@@ -1,4 +1,4 @@
-// Pictures with no display (SPEC §9 "headless rendering to PNG"): an offscreen context and a
+// Pictures with no display (architecture.md#viewer "headless rendering to PNG"): an offscreen context and a
 // renderer that draw a RenderScene from a camera and write a PNG, for `hapsim run --snapshot`,
 // reference-image tests, reports and CI.
 #pragma once

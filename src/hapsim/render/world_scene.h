@@ -1,4 +1,4 @@
-// A World as the renderer sees it (SPEC §9): one mesh per segment, coloured by tissue (bone,
+// A World as the renderer sees it (architecture.md#viewer): one mesh per segment, coloured by tissue (bone,
 // cartilage, ligament, muscle, skin) or per segment / per vertex group (the knee paper's Fig. 3),
 // the tools as spheres with their god-object proxies and force arrows, an 'x' shadow mark on the
 // floor under each tool, and optionally the sphere tree's spheres at one level. Updated each

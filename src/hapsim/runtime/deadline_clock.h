@@ -1,4 +1,4 @@
-// The haptic loop's clock (SPEC §7): absolute deadlines every period on CLOCK_MONOTONIC, so a
+// The haptic loop's clock (architecture.md#real-time): absolute deadlines every period on CLOCK_MONOTONIC, so a
 // late cycle does not shift every later one (clock_nanosleep with TIMER_ABSTIME), and real-time
 // scheduling when the system allows it.
 //

@@ -1,4 +1,4 @@
-// The real-time haptic loop (SPEC §7, issue 5): a thread that runs one haptic cycle every period
+// The real-time haptic loop (architecture.md#real-time, issue 5): a thread that runs one haptic cycle every period
 // (1 ms) on an absolute-deadline clock — read the device, step the simulation, make the command
 // safe, write the device, publish — plus a supervisor thread that takes over the device output
 // when a cycle stalls.
@@ -8,7 +8,7 @@
 // and atomics, and the client publishes its snapshots through lock-free buffers
 // (triple_buffer.h, spsc_ring.h) in after_cycle().
 //
-// Safety (SPEC §3): every command goes through ForceWatchdog (clamped to the device profile, NaN
+// Safety (architecture.md#force-and-safety): every command goes through ForceWatchdog (clamped to the device profile, NaN
 // -> zero, ramp to zero when the device reports itself unhealthy). When no cycle completes for
 // ramp.stale_timeout_s (the step overran, stalled, or the device read hung) the supervisor ramps
 // the last good command to zero so that the output is zero by ramp.zero_by_s() (10 ms by

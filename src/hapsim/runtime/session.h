@@ -1,4 +1,4 @@
-// One unattended run of a world driven by a device (SPEC §7, §10): the deterministic step at a
+// One unattended run of a world driven by a device (architecture.md#real-time, architecture.md#scenes): the deterministic step at a
 // fixed dt, as fast as it goes (offline) or on an absolute 1 kHz deadline (--realtime), with the
 // device safety layer between the world and the device, an optional recorder, and the figures a
 // user wants at the end: contacts and deflection per segment, forces per tool, pop-throughs,

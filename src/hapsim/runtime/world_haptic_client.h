@@ -1,4 +1,4 @@
-// The haptic loop's client for a World (SPEC §7): each cycle steps the world, then publishes
+// The haptic loop's client for a World (architecture.md#real-time): each cycle steps the world, then publishes
 // - the newest snapshot for the viewer through a triple buffer (deformed vertices copied by
 //   delta: only the ones that moved since that slot was last written, so the copy costs about
 //   what the step's own deformation update did), and

@@ -1,5 +1,5 @@
 // The device a scene asks for: a simulated device playing the scene's trajectory file, or a
-// scripted palpation aimed at named segments of the world (SPEC §10: the knee runs unattended).
+// scripted palpation aimed at named segments of the world (architecture.md#scenes: the knee runs unattended).
 #pragma once
 
 #include "hapsim/script/palpation_trajectory.h"

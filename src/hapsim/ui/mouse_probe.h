@@ -1,4 +1,4 @@
-// The viewer's mouse-and-keyboard haptic device (SPEC §6, issue 5): a probe the user moves with
+// The viewer's mouse-and-keyboard haptic device (architecture.md#devices, issue 5): a probe the user moves with
 // the mouse — dragging moves it in the view plane so it stays under the cursor, the wheel moves
 // it towards or away from the viewer — and fingers curled with keys (a glove scene's hand) or a
 // grasp opened and closed (teleoperation). Pure math on pixel deltas and the camera, so tests

@@ -1,4 +1,4 @@
-// `hapsim view SCENE` (SPEC §9, issue 5): a window with the 3D view (Gouraud shading, lights,
+// `hapsim view SCENE` (architecture.md#viewer, issue 5): a window with the 3D view (Gouraud shading, lights,
 // point/line/face modes, rotate/pan/zoom, the floor with the tool's 'x' shadow mark), a control
 // area (display, scene, device, contact and deformation method, segments, stiffness and limits,
 // pause/reset, record), a data area (tool and device coordinates in mm, force per finger, haptic

@@ -1,4 +1,4 @@
-// What the viewer runs and shows (SPEC §9): one scene on the real-time haptic loop with its
+// What the viewer runs and shows (architecture.md#viewer): one scene on the real-time haptic loop with its
 // device, a render scene kept up to date from the loop's snapshots, and the figures of the data
 // area. A knee-type World and a teleoperation world each have one; the viewer rebuilds the
 // session when the user picks another scene, device, contact method or deformation method.

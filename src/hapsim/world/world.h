@@ -1,4 +1,4 @@
-// The simulated world (SPEC §3, §4, §7): device input in, per-tool forces, contacts and
+// The simulated world (architecture.md#force-and-safety, architecture.md#deformation, architecture.md#real-time): device input in, per-tool forces, contacts and
 // deformation out. A World holds the read-only model (world_model.h, built once from a
 // WorldDescription) and the per-step state (world_state.h, sized at construction), and steps them
 // with the deterministic, allocation-free step() of world_step.h: the same inputs replay to the

@@ -46,7 +46,7 @@ enum class ContactMethod : std::uint8_t {
 enum class BodyKind : std::uint8_t {
   kStatic,      ///< never moves, never deforms
   kDynamic,     ///< rigid with mass (later issue: grasping)
-  kDeformable,  ///< vertices deflect under contact and recover (SPEC §4)
+  kDeformable,  ///< vertices deflect under contact and recover (architecture.md#deformation)
 };
 
 [[nodiscard]] std::string_view to_string(ContactResponse response);
