@@ -11,6 +11,8 @@
 #include "hapsim/scene/scene_description.h"
 #include "hapsim/world/world.h"
 
+#include "support/replay_check.h"
+
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -109,6 +111,10 @@ TEST(WorldViewerSession, RecordingWritesEveryCycleWithTheWorldsHash) {
   }
   World reference(soft_sphere_scene().world);
   EXPECT_EQ(r.header.scene_hash, reference.content_hash());
+  // It starts at the scene's start (cycle 0) and replays on a fresh world bit for bit (a viewer
+  // recording used to fail at frame 0: its cycles were numbered from the session's start).
+  EXPECT_EQ(r.frames.front().cycle_index, 0u);
+  EXPECT_TRUE(test::replays_bit_for_bit(soft_sphere_scene(), path));
   std::filesystem::remove(path);
   const std::filesystem::path bad = "/nonexistent/dir/x.rec";
   EXPECT_FALSE(session->set_recording(&bad, error));

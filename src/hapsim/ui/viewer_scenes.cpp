@@ -1,16 +1,12 @@
 #include "hapsim/ui/viewer_scenes.h"
 
 #include "hapsim/scene/scene_description.h"
-#include "hapsim/ui/teleop_viewer_session.h"
 #include "hapsim/ui/world_viewer_session.h"
 
 namespace hapsim {
 
 std::unique_ptr<ViewerSession> make_viewer_session(const ViewerConfig& config,
                                                    const SceneDescription& scene) {
-  if (scene.is_teleop) {
-    return make_teleop_viewer_session(config, scene);
-  }
   return make_world_viewer_session(config, scene);
 }
 

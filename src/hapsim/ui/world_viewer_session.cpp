@@ -2,8 +2,10 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/device/interactive_device.h"
+#include "hapsim/device/master_probe_device.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/kinematics/hand_model.h"
+#include "hapsim/render/teleop_scene.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/scene/run_setup.h"
@@ -16,6 +18,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <numbers>
 
 namespace hapsim {
 namespace {
@@ -34,10 +37,35 @@ std::string format_mm(const Vec3& p_m) {
   return text;
 }
 
+// In front of the scene from the default camera (+Y, a little −X), a finger's width clear. For a
+// glove the probe is the tracker: placed so that the fingertip nearest the scene (straight
+// fingers, the device's orientation) lands on that spot and the others are farther out: the hand
+// starts clear of the body.
+Vec3 probe_start_for(const WorldDescription& world, const Box3& bounds_W) {
+  const Vec3 towards_viewer = Vec3(-0.2, 1.0, 0.0).normalized();
+  Vec3 p = bounds_W.center() + towards_viewer * (0.5 * bounds_W.sizes().head<2>().norm() + 0.03);
+  if (world.has_hand) {
+    const HandModel hand(world.hand);
+    const auto tips = hand.fingertips_world(GloveReading{});
+    Vec3 nearest = tips[0];
+    for (const Vec3& tip : tips) {
+      nearest = tip.dot(towards_viewer) < nearest.dot(towards_viewer) ? tip : nearest;
+    }
+    p -= nearest;
+  }
+  return p;
+}
+
+// The viewer's session for every scene (architecture.md#viewer): the World on the real-time
+// haptic loop with its device (the viewer's mouse probe, the scene's script or a trajectory, a 3D
+// mouse; for a teleoperation rig the probe is the slave tool's target, turned into master joints by
+// MasterProbeDevice); one client, one snapshot, one recorder. What is drawn and read out differs
+// per kind of thing: bodies and tools (WorldScene), a rig (TeleopScene).
 class WorldViewerSession final : public ViewerSession {
  public:
   WorldViewerSession(const ViewerConfig& config, SceneDescription scene) : config_(config) {
     RunSetupOptions setup_options;
+    setup_options.load_link_meshes = true;  // a URDF slave is drawn with its own meshes
     if (!config.method.empty()) {
       setup_options.method = method_from(config.method);
     }
@@ -59,48 +87,46 @@ class WorldViewerSession final : public ViewerSession {
     scene_ = std::move(setup.scene);
     world_ = std::move(setup.world);
     const DeviceProfile& profile = *setup.profile;
-    view_ = std::make_unique<WorldScene>(*world_);
     materials_.reserve(scene_.world.materials.size());
     for (const MaterialDescription& m : scene_.world.materials) {
       materials_.push_back(m.contact);
     }
-
-    const Box3 b = view_->rest_bounds_W();
-    // In front of the scene from the default camera (+Y, a little −X), a finger's width clear.
-    probe_start_W_ =
-        b.center() + Vec3(-0.2, 1.0, 0.0).normalized() * (0.5 * b.sizes().head<2>().norm() + 0.03);
-    if (scene_.world.has_hand) {
-      // A glove drives a hand: the probe is the tracker. Place it so that the fingertip nearest
-      // the scene (straight fingers, the device's orientation) lands on that spot and the others
-      // are farther out: the hand starts clear of the body.
-      const HandModel hand(scene_.world.hand);
-      const Vec3 towards_viewer = Vec3(-0.2, 1.0, 0.0).normalized();
-      const auto tips = hand.fingertips_world(GloveReading{});
-      Vec3 nearest = tips[0];
-      for (const Vec3& tip : tips) {
-        nearest = tip.dot(towards_viewer) < nearest.dot(towards_viewer) ? tip : nearest;
-      }
-      probe_start_W_ -= nearest;
+    // The position a mouse or 3D mouse starts at, and what turns it into the device's input.
+    std::optional<MasterHandMapping> hand_mapping;
+    if (world_->rig() != nullptr) {
+      rig_view_ = std::make_unique<TeleopScene>(*world_);
+      // The probe starts where the master's hand is at the script's first sample, so the slave
+      // starts still (the run setup solved its start joints for that pose). The cursor points at
+      // the slave's tool: the probe is its target in the world.
+      const DeviceInput& first = setup.script_start;
+      const std::array<double, 3> first_arm{first.joint_rad[0], first.joint_rad[1],
+                                            first.joint_rad[2]};
+      hand_mapping.emplace(*world_->model().master(), first_arm);
+      hand_mapping->set_probe_in_slave_frame(world_->description().teleop->mapping);
+      probe_start_W_ = hand_mapping->probe_for(first_arm);
+    } else {
+      view_ = std::make_unique<WorldScene>(*world_);
+      probe_start_W_ = probe_start_for(scene_.world, view_->rest_bounds_W());
     }
+    const std::string target = hand_mapping ? " as the slave tool's target" : "";
     if (config.device == "mouse") {
       DeviceInput start;
       start.p_world = probe_start_W_;
       auto mouse = std::make_unique<InteractiveDevice>(
           profile, start, InteractiveDeviceOptions{.position_smoothing_s = 0.01});
       mouse_ = mouse.get();
-      device_ = std::move(mouse);
-      device_name_ = "mouse probe (" + profile.name + " limits)";
+      probe_ = std::move(mouse);
+      device_name_ = "mouse probe" + target + " (" + profile.name + " limits" +
+                     (hand_mapping ? "; G: grasp)" : ")");
     } else if (sim) {
       device_ = std::move(setup.device);
-      const std::string what = trajectory ? "trajectory " + trajectory->string() : "scene script";
-      device_name_ = profile.name == "simulated" ? what + " (simulated device)"
-                                                 : what + " (simulated " + profile.name + ")";
+      device_name_ = setup.device_name;
     } else if (config.device == "spacemouse") {
 #if defined(HAPSIM_WITH_SPNAV)
       SpacenavOptions so;
       so.start_p_world = probe_start_W_;
-      device_ = std::make_unique<SpacenavDevice>(profile, so);
-      device_name_ = "3D mouse (spacenavd)";
+      probe_ = std::make_unique<SpacenavDevice>(profile, so);
+      device_name_ = "3D mouse (spacenavd)" + target;
 #else
       throw Error("3D mouse", "this build has no 3D mouse support (libspnav was not found)");
 #endif
@@ -108,17 +134,25 @@ class WorldViewerSession final : public ViewerSession {
       throw Error("device",
                   "expected mouse, sim, sim:FILE or spacemouse, got '" + config.device + "'");
     }
-    WorldHapticClientOptions co;
-    co.record_capacity = 1024;  // drained every frame: 1 s of slack at 1 fps
-    client_ = std::make_unique<WorldHapticClient>(*world_, co);
-    loop_ = std::make_unique<HapticLoop>(*device_, *client_);
-    title_ = scene_.file.filename().string() + " — " + device_name_;
-    readout_.bar_full_scale_n = profile.finger_count > 0 && profile.max_finger_force_n > 0.0
-                                    ? std::max(profile.max_finger_force_n, profile.max_force_n)
-                                    : profile.max_force_n;
-    loop_->start();
+    if (probe_) {
+      // A rig's master wants joints: the probe's position goes through the master's IK.
+      if (hand_mapping) {
+        device_ = std::make_unique<MasterProbeDevice>(*probe_, *hand_mapping);
+      } else {
+        device_ = std::move(probe_);
+      }
+    }
+    title_ = scene_.file.filename().string() + " — " +
+             (setup.slave_name.empty() ? "" : setup.slave_name + ", ") + device_name_;
+    if (world_->rig() != nullptr) {
+      readout_.bar_full_scale_n = world_->description().teleop->gripper.max_force_n;
+    } else {
+      readout_.bar_full_scale_n = profile.finger_count > 0 && profile.max_finger_force_n > 0.0
+                                      ? std::max(profile.max_finger_force_n, profile.max_force_n)
+                                      : profile.max_force_n;
+    }
+    start_loop();
   }
-
   ~WorldViewerSession() override {
     loop_->stop();
     if (recorder_) {
@@ -152,6 +186,10 @@ class WorldViewerSession final : public ViewerSession {
     TripleBuffer<WorldSnapshot>& snapshots = *client_->snapshots();
     snapshots.update();
     const WorldSnapshot& s = snapshots.read_slot();
+    if (rig_view_) {
+      update_rig(*s.teleop);
+      return;
+    }
     view_->update(s);
     const WorldDescription& d = world_->description();
     readout_.time_s = s.time_s;
@@ -188,10 +226,10 @@ class WorldViewerSession final : public ViewerSession {
   }
 
   RenderScene& render_scene() override {
-    return view_->scene();
+    return rig_view_ ? rig_view_->scene() : view_->scene();
   }
   Box3 bounds_W() const override {
-    return view_->rest_bounds_W();
+    return rig_view_ ? rig_view_->rest_bounds_W() : view_->rest_bounds_W();
   }
   const SessionReadout& readout() const override {
     return readout_;
@@ -212,10 +250,25 @@ class WorldViewerSession final : public ViewerSession {
     return title_;
   }
   void set_paused(bool paused) override {
+    paused_ = paused;
     client_->set_paused(paused);
   }
+  // The loop stops, the world goes back to its start (tools, deformation; a rig's slave, ball and
+  // sheet) and a new client and loop start at cycle 0 — so a scripted device starts its script
+  // again, in step with the world. The probe stays where the user left it.
   void reset() override {
-    client_->request_reset();
+    loop_->stop();
+    if (recorder_) {
+      // Cycles after a reset would not replay on one world: the recording ends here.
+      drain_records();
+      recorder_->close();
+      recorder_.reset();
+    }
+    drain_records();
+    loop_.reset();
+    client_.reset();
+    world_->reset();
+    start_loop();
   }
 
   bool set_recording(const std::filesystem::path* path, std::string& error) override {
@@ -228,14 +281,17 @@ class WorldViewerSession final : public ViewerSession {
       return true;
     }
     try {
-      // The hash of what the haptic thread runs: the scene with the materials as edited here
-      // (computed from this thread's copy; the world's own is the haptic thread's).
-      WorldDescription running = scene_.world;
+      // The hash of what the haptic thread runs: the world's description (immutable) with the
+      // materials as edited here (this thread's copy; the world's own is the haptic thread's).
+      WorldDescription running = world_->description();
       for (std::size_t m = 0; m < materials_.size(); ++m) {
         running.materials[m].contact = materials_[m];
       }
-      drain_records();  // start with the next cycle
-      recorder_ = std::make_unique<SessionRecorder>(*path, content_hash(running), 8192);
+      auto recorder = std::make_unique<SessionRecorder>(*path, content_hash(running), 8192);
+      // A recording starts from the scene's start (the world reset, cycle 0), so that replaying
+      // it on a fresh world (hapsim run --replay) reproduces it bit for bit.
+      reset();
+      recorder_ = std::move(recorder);
       recorded_dropped_ = 0;
       return true;
     } catch (const std::exception& e) {
@@ -257,6 +313,10 @@ class WorldViewerSession final : public ViewerSession {
   }
 
   void draw_controls() override {
+    if (rig_view_) {
+      draw_rig_controls();
+      return;
+    }
     WorldSceneOptions o = view_->options();
     bool changed = false;
     int colouring = static_cast<int>(o.colouring);
@@ -313,10 +373,100 @@ class WorldViewerSession final : public ViewerSession {
   }
 
  private:
+  void start_loop() {
+    WorldHapticClientOptions co;
+    co.record_capacity = 1024;  // drained every frame: 1 s of slack at 1 fps
+    client_ = std::make_unique<WorldHapticClient>(*world_, co);
+    client_->set_paused(paused_);
+    loop_ = std::make_unique<HapticLoop>(*device_, *client_);
+    loop_->start();
+  }
+
+  // The rig's readout: the slave tool and the master hand, grasp and pad forces, ball, gripper,
+  // the sheet's dent, the slave's and the master's joints and the torques sent.
+  void update_rig(const TeleopSnapshot& s) {
+    rig_view_->update(s);
+    SessionReadout& r = readout_;
+    r.time_s = s.time_s;
+    r.cycle = s.cycle;
+    r.tools.resize(2);
+    ToolReadout& tool = r.tools[0];
+    tool.name = "slave tool";
+    tool.p_world = s.X_world_tool.translation();
+    tool.proxy_world = tool.p_world;  // no proxy: the same point (the data area hides it)
+    tool.force_n = s.output.force_world_n.allFinite() ? s.output.force_world_n.norm() : 0.0;
+    tool.contacts = (s.pad_force_n[0] > 0.0 ? 1 : 0) + (s.pad_force_n[1] > 0.0 ? 1 : 0);
+    ToolReadout& hand = r.tools[1];
+    hand.name = "master hand";
+    hand.p_world = s.X_master_hand.translation();  // the master's base frame
+    hand.proxy_world = hand.p_world;
+    hand.force_n = 0.0;
+    hand.contacts = 0;
+    r.contact_count = static_cast<std::size_t>(tool.contacts);
+
+    r.bars.clear();
+    r.bars.emplace_back("grasp", s.grasp_force_n);
+    r.bars.emplace_back("pad 1", s.pad_force_n[0]);
+    r.bars.emplace_back("pad 2", s.pad_force_n[1]);
+    // The sheet's deepest dent (≥ 0: a node resting a hair above its rest height is no dent).
+    const double dent_m = s.sheet_depth_m > 0.0 ? s.sheet_depth_m : 0.0;
+    r.max_deflection_m = dent_m;
+
+    char text[160];
+    r.lines.clear();
+    r.lines.emplace_back("ball (mm)", format_mm(s.ball_p_world) + (s.held ? "  held" : "  free"));
+    std::snprintf(text, sizeof text, "%.1f mm, grasp %.2f N", s.gripper_width_m * 1e3,
+                  s.grasp_force_n);
+    r.lines.emplace_back("gripper", text);
+    std::snprintf(text, sizeof text, "%.2f", dent_m * 1e3);
+    r.lines.emplace_back("sheet deepest dent (mm)", text);
+    std::string joints;
+    for (const double q : s.slave_q) {
+      std::snprintf(text, sizeof text, "%s%.1f", joints.empty() ? "" : " ",
+                    q * 180.0 / std::numbers::pi);
+      joints += text;
+    }
+    r.lines.emplace_back("slave joints (deg)", joints);
+    std::snprintf(text, sizeof text, "%.1f %.1f %.1f, fingers %.1f %.1f",
+                  s.master_joint_rad[0] * 180.0 / std::numbers::pi,
+                  s.master_joint_rad[1] * 180.0 / std::numbers::pi,
+                  s.master_joint_rad[2] * 180.0 / std::numbers::pi,
+                  s.master_finger_rad[0] * 180.0 / std::numbers::pi,
+                  s.master_finger_rad[1] * 180.0 / std::numbers::pi);
+    r.lines.emplace_back("master joints (deg)", text);
+    std::string torques;
+    for (int j = 0; j < s.output.joint_count; ++j) {
+      std::snprintf(text, sizeof text, "%s%.3f", torques.empty() ? "" : " ",
+                    s.output.joint_torque_nm[static_cast<std::size_t>(j)]);
+      torques += text;
+    }
+    r.lines.emplace_back("master torques (N·m)", torques.empty() ? "-" : torques);
+  }
+
+  void draw_rig_controls() {
+    TeleopSceneOptions o = rig_view_->options();
+    bool changed = ImGui::Checkbox("master arm", &o.show_master);
+    ImGui::SameLine();
+    changed |= ImGui::Checkbox("joints", &o.show_joints);
+    if (changed) {
+      rig_view_->set_options(o);
+    }
+    if (mouse_ != nullptr) {
+      ImGui::TextWrapped(
+          "The probe is the master's hand (its base frame): drag to move it, wheel for depth, G "
+          "closes or opens the grasp.");
+    }
+    const TeleopRigDescription& d = *world_->description().teleop;
+    ImGui::Text("mapping scale %.2f, gripper %.0f mm / %.0f N", d.mapping.scale,
+                d.follower.gripper_max_width_m * 1e3, d.gripper.max_force_n);
+  }
+
   ViewerConfig config_;
   SceneDescription scene_;
   std::unique_ptr<World> world_;
-  std::unique_ptr<WorldScene> view_;
+  std::unique_ptr<WorldScene> view_;       // bodies and tools
+  std::unique_ptr<TeleopScene> rig_view_;  // or a teleoperation rig
+  std::unique_ptr<Device> probe_;          // a mouse or 3D mouse behind a rig's MasterProbeDevice
   std::unique_ptr<Device> device_;
   InteractiveDevice* mouse_ = nullptr;
   std::unique_ptr<WorldHapticClient> client_;
@@ -328,6 +478,7 @@ class WorldViewerSession final : public ViewerSession {
   Vec3 probe_start_W_ = Vec3::Zero();
   std::string device_name_;
   std::string title_;
+  bool paused_ = false;
 };
 
 }  // namespace

@@ -127,6 +127,7 @@ void WorldState::reset() {
     for (PenaltySide& side : tool.penalty_side) {
       side = PenaltySide{};
     }
+    std::fill(tool.near_last_step.begin(), tool.near_last_step.end(), std::uint8_t{0});
   }
   for (SegmentState& seg : segments) {
     if (seg.deflection) {

@@ -1,14 +1,8 @@
-// The viewer's session for a teleoperation scene (000, `hapsim view scenes/teleop.json`): the
-// teleoperation World on the haptic loop, driven by the scene's scripted master (or a trajectory of
-// master joints), by the viewer's mouse probe or by a 3D mouse; its render scene (TeleopScene)
-// updated from the loop's snapshots; the slave tool, master hand, grasp and pad forces in the data
-// area.
-//
-// The mouse and the 3D mouse give a position, not master joints: MasterHandMapping turns the
-// probe's position (where the slave's tool should go; the master's hand through the inverse
-// teleoperation mapping) into the master's arm
-// joints with the master's own position IK — as the scripted pick-and-place does — and the grasp
-// button into the two finger joints. It runs inside the device's read() on the haptic thread
+// A position device (the viewer's mouse probe, a 3D mouse) driving a teleoperation rig's 5-DOF
+// master arm, which wants joints: MasterHandMapping turns the probe's position (where the slave's
+// tool should go; the master's hand through the inverse teleoperation mapping) into the master's
+// arm joints with the master's own position IK — as the scripted pick-and-place does — and the
+// grasp button into the two finger joints. It runs inside the device's read() on the haptic thread
 // (MasterProbeDevice): solve_ik allocates nothing, the answer is cached (IK runs only when the
 // probe moved, i.e. at most once per viewer frame) and bounded (tracked from the last answer, a
 // few restarts), and the same adapter serves the mouse and the 3D mouse, whose reader thread hands
@@ -19,15 +13,11 @@
 #include "hapsim/kinematics/inverse_kinematics.h"
 #include "hapsim/kinematics/master_arm.h"
 #include "hapsim/kinematics/slave_follower.h"
-#include "hapsim/ui/viewer_session.h"
 
 #include <array>
-#include <memory>
 #include <utility>
 
 namespace hapsim {
-
-struct SceneDescription;
 
 /// A probe's input → the 5-DOF master's input: `p_world` is where the master's hand should be
 /// (the master's base frame, metres); buttons bit 0 closes the grasp.
@@ -92,10 +82,5 @@ class MasterProbeDevice final : public Device {
   Device& probe_;
   MasterHandMapping mapping_;
 };
-
-/// Throws hapsim::Error (bad scene, URDF or trajectory, no 3D mouse …); the viewer shows the
-/// message. Precondition: scene.is_teleop.
-[[nodiscard]] std::unique_ptr<ViewerSession> make_teleop_viewer_session(
-    const ViewerConfig& config, const SceneDescription& scene);
 
 }  // namespace hapsim
