@@ -5,6 +5,7 @@
 #include "hapsim/world/world.h"
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/core/error.h"
+#include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/geometry/procedural.h"
 
 #include "support/allocation_counter.h"
@@ -180,6 +181,113 @@ TEST(World, SlidingRoundAPenaltySphereIsNotAPopThrough) {
   }
   world.step(at(Vec3(-0.05, 0.0, 0.0)), 1e-3);  // out through the side it came from
   EXPECT_EQ(pop_throughs + world.last_result().penalty_pop_throughs, 0);
+}
+
+// Two fingertips on one deformable penalty block (top face z = 0, k = 500 N/m, eq. 1's d0 =
+// x·elasticity for point tools): the second sits 4 mm beside the first and `second_dz_m` above it
+// (negative: deeper).
+WorldDescription two_finger_block(double second_dz_m, double elasticity) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kDeformable, 0.0);
+  w.materials[0].contact.max_penetration_m = 0.02;
+  w.materials[0].contact.max_force_n = 20.0;
+  w.materials[0].deflection.elasticity_factor = elasticity;
+  w.materials[0].deflection.recovery_time_constant_s = 0.05;
+  w.tools[0].finger = 0;
+  ToolDescription second = w.tools[0];
+  second.name = "second";
+  second.finger = 1;
+  second.offset_device = Vec3(0.004, 0.0, second_dz_m);
+  w.tools.push_back(second);
+  return w;
+}
+
+// Eq. 1 (point tools): the dent a press of depth x leaves 4 mm away.
+double dent_4mm_away(double x, double elasticity) {
+  return VertexDeflection::deflection_profile_m(0.004, x, elasticity * x);
+}
+
+// Deformation changes what a later contact feels: each fingertip feels the surface as the other
+// one's dent left it, not the rest surface — F = k·(own depth − the other's eq. 1 dent there).
+TEST(World, EachFingertipFeelsTheOthersDent) {
+  World world(two_finger_block(-0.001, 2.5));  // the second 1 mm deeper
+  for (int i = 0; i < 50; ++i) {
+    world.step(at(Vec3(0.0, 0.0, -0.003)), 1e-3);  // first 3 mm in, second 4 mm
+  }
+  const StepResult& r = world.last_result();
+  EXPECT_NEAR(r.command.finger_force_n[0], 500.0 * (0.003 - dent_4mm_away(0.004, 2.5)), 1e-9);
+  EXPECT_NEAR(r.command.finger_force_n[1], 500.0 * (0.004 - dent_4mm_away(0.003, 2.5)), 1e-9);
+  EXPECT_LT(r.command.finger_force_n[1], 500.0 * 0.004 * 0.7);  // well below the rest surface's
+}
+
+// A fingertip inside the rest surface but clear of the other's dent feels nothing.
+TEST(World, AFingertipHoveringInADentFeelsNothing) {
+  World world(two_finger_block(0.0025, 2.5));  // the second 2.5 mm higher
+  // Down from 1 mm above to 5 mm in (0.1 mm a step), then hold: the second, 2.5 mm higher,
+  // stays inside the first's dent all the way (at 3, 4 and 5 mm: 1.3, 2.6 and 3.8 mm deep there).
+  for (int i = 0; i <= 260; ++i) {
+    const double depth = std::min(0.005, -0.001 + 1e-4 * i);
+    world.step(at(Vec3(0.0, 0.0, -depth)), 1e-3);
+  }
+  ASSERT_GT(dent_4mm_away(0.005, 2.5), 0.0025);  // the dent there is deeper than the second
+  const StepResult& r = world.last_result();
+  EXPECT_EQ(r.command.finger_force_n[1], 0.0);
+  EXPECT_EQ(r.tools[1].contact_count, 0);
+  EXPECT_NEAR(r.command.finger_force_n[0], 500.0 * 0.005, 1e-9);
+}
+
+// As a dent forms and recovers the other fingertip's force changes smoothly: no step above one
+// just-noticeable difference (7 %) per millisecond, over a press, a hold and a release.
+TEST(World, ForceStaysContinuousAsDentsFormAndRecover) {
+  World world(two_finger_block(-0.001, 1.5));
+  std::array<double, 2> last{0.0, 0.0};
+  double steepest = 0.0;
+  for (int k = 0; k < 600; ++k) {
+    const double t = 1e-3 * k;
+    // Down 6 mm over 150 ms, hold 150 ms, back up over 300 ms.
+    const double depth = t < 0.15 ? 0.04 * t - 0.001 : t < 0.3 ? 0.005 : 0.005 - 0.02 * (t - 0.3);
+    const StepResult& r = world.step(at(Vec3(0.0, 0.0, -depth)), 1e-3);
+    for (std::size_t f = 0; f < 2; ++f) {
+      const double now = r.command.finger_force_n[f];
+      const double larger = std::max(now, last[f]);
+      if (larger > 0.5) {  // a press at 40 mm/s adds 0.02 N a step: 4 % of 0.5 N
+        steepest = std::max(steepest, std::abs(now - last[f]) / larger);
+      }
+      last[f] = now;
+    }
+  }
+  EXPECT_LT(steepest, 0.07);
+}
+
+// A press that comes back to a dent still recovering feels the dented surface: less force at
+// first, rising smoothly to the rest surface's k·x as the tissue recovers under the finger.
+TEST(World, AReturningPressFeelsTheRecoveringDent) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kDeformable, 0.0);
+  w.bodies[0].X_world_body = Iso3::Identity();
+  w.bodies[0].segments[0].mesh = make_uv_sphere(0.05, 256, 128);  // ~1.2 mm vertex spacing
+  w.materials[0].contact.max_penetration_m = 0.02;
+  w.materials[0].deflection.recovery_time_constant_s = 0.05;
+  World world(std::move(w));
+  const auto depth_at = [](double d) { return at(Vec3(0.05 - d, 0.0, 0.0)); };
+  for (int i = 0; i < 100; ++i) {
+    world.step(depth_at(std::min(0.005, 1e-4 * i)), 1e-3);  // press 5 mm and hold
+  }
+  world.step(at(Vec3(0.08, 0.0, 0.0)), 1e-3);  // off for 3 ms: the dent starts recovering
+  world.step(at(Vec3(0.08, 0.0, 0.0)), 1e-3);
+  world.step(at(Vec3(0.08, 0.0, 0.0)), 1e-3);
+  double force = world.step(depth_at(0.003), 1e-3).tools[0].force_world_n.norm();
+  EXPECT_LT(force, 0.5 * 500.0 * 0.003) << "the dent (about 4.7 mm deep) is still there";
+  double previous = force;
+  double steepest = 0.0;
+  for (int i = 0; i < 500; ++i) {
+    force = world.step(depth_at(0.003), 1e-3).tools[0].force_world_n.norm();
+    EXPECT_GE(force, previous - 1e-12);  // the tissue comes back, never gives way
+    if (force > 0.5) {
+      steepest = std::max(steepest, (force - previous) / force);
+    }
+    previous = force;
+  }
+  EXPECT_NEAR(force, 500.0 * 0.003, 1e-3);  // recovered: the rest surface's spring again
+  EXPECT_LT(steepest, 0.07);
 }
 
 TEST(World, NaNAndUnhealthyInputGiveZeroForce) {

@@ -254,8 +254,12 @@ void VertexDeflection::next_moved_stamp() {
 
 // haptic path
 double VertexDeflection::recovered_gap_m(std::uint32_t segment, double gap_m, double dt_s) const {
-  const DeflectionParams& p = segments_[segment];
-  double next_m = gap_m * decay_per_segment_[segment];
+  return recover_gap_m(segments_[segment], decay_per_segment_[segment], gap_m, dt_s);
+}
+
+double VertexDeflection::recover_gap_m(const DeflectionParams& p, double decay, double gap_m,
+                                       double dt_s) {
+  double next_m = gap_m * decay;
   // The speed cap slows recovery down, never speeds it past the target.
   next_m = std::max(next_m, gap_m - p.max_recovery_speed_m_per_s * dt_s);
   next_m = std::clamp(next_m, 0.0, gap_m);

@@ -12,7 +12,8 @@
 //  * Pressing is immediate (the surface follows the probe); releasing follows the recovery law:
 //    the gap to the target shrinks as exp(−dt/τ) and by at most v_max·dt per step, and snaps to the
 //    target below `rest_tolerance_m`, so it never overshoots and reaches rest in bounded time.
-//  * The paper's eq. 1 prints d_p/2 as the amplitude; architecture.md#deformation reads x/2 (δ(0) = x), used here.
+//  * The paper's eq. 1 prints d_p/2 as the amplitude; architecture.md#deformation reads x/2 (δ(0) =
+//  x), used here.
 #pragma once
 
 #include "hapsim/core/types.h"
@@ -106,6 +107,11 @@ class VertexDeflection {
   [[nodiscard]] static double deflection_profile_from_squared_m(double distance_sq_m2,
                                                                 double penetration_m,
                                                                 double zero_distance_m);
+  /// The recovery law step() applies to a released vertex's gap to its target over `dt_s`: the
+  /// gap shrinks by `decay` = exp(−dt/τ) and by at most v_max·dt, and snaps to 0 below
+  /// rest_tolerance_m. haptic path
+  [[nodiscard]] static double recover_gap_m(const DeflectionParams& params, double decay,
+                                            double gap_m, double dt_s);
   /// d0 = (x + r_eff) · elasticity_factor.
   [[nodiscard]] static double zero_deflection_distance_m(double penetration_m,
                                                          double contact_radius_m,

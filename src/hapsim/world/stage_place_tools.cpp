@@ -56,6 +56,7 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
       for (PenaltySide& side : tool.penalty_side) {
         side = PenaltySide{};  // the tool may come back anywhere
       }
+      std::fill(tool.pressing.begin(), tool.pressing.end(), std::uint8_t{0});
     }
     return;
   }

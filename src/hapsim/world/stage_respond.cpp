@@ -84,8 +84,13 @@ void respond(const WorldModel& model, WorldState& state, double dt_s) noexcept {
                                       static_cast<std::int32_t>(seg.index_in_body), c.point_world,
                                       c.n_world, c.depth_m, f.norm(), false});
       ++out.contact_count;
-      add_pending(state.segments[c.segment],
-                  DeflectionContact{seg.X_body_world * c.point_world, c.depth_m, radius, 0});
+      // The surface deflects to reach the tool: eq. 1 about the rest point, to the rest depth.
+      SegmentState& seg_state = state.segments[c.segment];
+      add_pending(seg_state, DeflectionContact{c.rest_point_body, c.rest_depth_m, radius, 0});
+      if (seg_state.deflection) {
+        tool.own_dent[c.segment] =
+            OwnDent{c.rest_point_body, c.rest_depth_m, radius, state.step_index};
+      }
     }
     out.force_world_n = total;
   }

@@ -7,7 +7,8 @@
 //                    follows the master's hand through IK, its gripper opening the master's grip);
 //                    an unusable input holds the tools
 //   detect_contacts  penalty segments: each tool against each segment's rest surface, which side
-//                    it presses from (never pulled through a thin segment)
+//                    it presses from (never pulled through a thin segment), less the dent others
+//                    left under it (other tools' presses, an earlier press still recovering)
 //   respond          proxy segments: the god-object moves its proxy and the spring gives the force;
 //                    penalty segments: F = k·x with damping; contacts reported, deformation fed;
 //                    the rig's gripper pads against the ball (contact springs, grasp and release)
@@ -31,7 +32,7 @@ namespace stage {
 
 void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& input,
                  double dt_s) noexcept;
-void detect_contacts(const WorldModel& model, WorldState& state) noexcept;
+void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void respond(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void integrate(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void deform(const WorldModel& model, WorldState& state, double dt_s) noexcept;

@@ -78,6 +78,9 @@ WorldState::WorldState(const WorldModel& model) {
     tool.hints.resize(segs.size());
     tool.near_last_step.assign(segs.size(), 0);
     tool.penalty_side.assign(segs.size(), PenaltySide{});
+    tool.own_dent.assign(segs.size(), OwnDent{});
+    tool.felt_dent_m.assign(segs.size(), 0.0);
+    tool.pressing.assign(segs.size(), 0);
     tool.penalty.resize(std::max<std::size_t>(model.penalty_segment_count(), 1));
     tools.push_back(std::move(tool));
   }
@@ -119,6 +122,7 @@ WorldState::~WorldState() = default;
 void WorldState::reset() {
   tools_placed = false;
   time_s = 0.0;
+  step_index = 0;
   for (ToolRuntime& tool : tools) {
     tool.has_previous = false;
     for (QueryHint& h : tool.hints) {
@@ -128,6 +132,9 @@ void WorldState::reset() {
       side = PenaltySide{};
     }
     std::fill(tool.near_last_step.begin(), tool.near_last_step.end(), std::uint8_t{0});
+    std::fill(tool.own_dent.begin(), tool.own_dent.end(), OwnDent{});
+    std::fill(tool.felt_dent_m.begin(), tool.felt_dent_m.end(), 0.0);
+    std::fill(tool.pressing.begin(), tool.pressing.end(), std::uint8_t{0});
   }
   for (SegmentState& seg : segments) {
     if (seg.deflection) {

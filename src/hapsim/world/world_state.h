@@ -98,9 +98,22 @@ struct PenaltySide {
 /// A penalty contact found by the detection stage, answered by the response stage.
 struct PenaltyCandidate {
   std::uint32_t segment = 0;  ///< flat segment
-  double depth_m = 0.0;       ///< below the entry side's surface
+  /// Below the surface the tool feels: the rest surface, less the dent other contacts left there.
+  double depth_m = 0.0;
+  /// Below the rest surface: how far this contact itself deflects the surface (eq. 1's x).
+  double rest_depth_m = 0.0;
   Vec3 n_world = Vec3::Zero();
-  Vec3 point_world = Vec3::Zero();
+  Vec3 point_world = Vec3::Zero();      ///< on the surface the tool feels
+  Vec3 rest_point_body = Vec3::Zero();  ///< the contact point on the rest surface, body frame
+};
+
+/// The dent a tool's contact made on a segment last step (eq. 1 about its rest point): what the
+/// other tools feel of it.
+struct OwnDent {
+  Vec3 p_body = Vec3::Zero();
+  double penetration_m = 0.0;
+  double contact_radius_m = 0.0;
+  std::uint64_t step = 0;  ///< WorldState::step_index of the step that made it (0: none)
 };
 
 /// Per-step state of one deformable segment.
@@ -124,6 +137,13 @@ struct ToolRuntime {
   /// costly deep-inside query needed (detect stage).
   std::vector<std::uint8_t> near_last_step;
   std::vector<PenaltySide> penalty_side;  ///< per flat segment (detect stage)
+  std::vector<OwnDent> own_dent;          ///< per flat segment (respond stage)
+  /// Per flat segment: how deep the surface under the tool is dented by others — other tools'
+  /// presses, or an earlier press still recovering (detect stage). Found when the tool starts
+  /// pressing (the deformed surface there), then it follows the other tools' dents and recovers
+  /// at the tissue's rate, never jumping; the tool's own press is its spring and does not count.
+  std::vector<double> felt_dent_m;
+  std::vector<std::uint8_t> pressing;  ///< per flat segment: in contact last step
   /// Penalty contacts of this step, in segment order (detect stage); capacity = penalty segments.
   std::vector<PenaltyCandidate> penalty;
   std::size_t penalty_count = 0;
@@ -179,6 +199,8 @@ struct WorldState {
   std::vector<ToolRuntime> tools;
   std::unique_ptr<RigState> rig;  ///< when the world has a teleoperation rig
   double time_s = 0.0;
+  /// Steps taken since construction or reset (the first step is 1).
+  std::uint64_t step_index = 0;
   /// Place stage: the input was usable (healthy, finite) this step.
   bool input_usable = false;
   /// The proxies have been placed at a first position (reset() clears it).

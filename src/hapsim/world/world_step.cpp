@@ -38,6 +38,7 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   const double dt = std::isfinite(dt_s) && dt_s > 0.0 ? dt_s : 0.0;
   refresh_materials(model, state, dt);
   state.time_s += dt;
+  ++state.step_index;
   state.contact_count = 0;
   state.dropped_contacts = 0;
   state.pop_throughs = 0;
@@ -46,7 +47,7 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   }
 
   stage::place_tools(model, state, input, dt);
-  stage::detect_contacts(model, state);
+  stage::detect_contacts(model, state, dt);
   stage::respond(model, state, dt);
   stage::integrate(model, state, dt);
   stage::deform(model, state, dt);
