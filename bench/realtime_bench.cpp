@@ -92,7 +92,7 @@ void BM_KneeFrame1280x720(benchmark::State& state) {
     return;
   }
   WorldScene view(k.world);
-  const OrbitCamera camera = framed_camera(view.rest_bounds_W(), 1280.0 / 720.0, 1.95, 0.3);
+  const OrbitCamera camera = framed_camera(view.rest_bounds_world(), 1280.0 / 720.0, 1.95, 0.3);
   view.update_from_world(k.world);
   for (auto _ : state) {
     benchmark::DoNotOptimize(writer->render(view.scene(), camera).data());

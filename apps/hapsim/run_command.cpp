@@ -119,7 +119,7 @@ class RunSnapshots final : public SnapshotSink {
     if (!scene_) {
       scene_ = make_scene_(world);
       scene_->scene().style.display_mode = parse_display_mode(args_.display_mode);
-      camera_ = framed_camera(scene_->rest_bounds_W(),
+      camera_ = framed_camera(scene_->rest_bounds_world(),
                               static_cast<double>(writer_->width()) / writer_->height(), yaw_rad_,
                               pitch_rad_);
     }

@@ -15,7 +15,7 @@ constexpr int kH = 480;
 
 OrbitCamera make_camera() {
   OrbitCamera cam;
-  cam.target_W = Vec3(0.1, -0.2, 0.3);
+  cam.target_world = Vec3(0.1, -0.2, 0.3);
   cam.yaw_rad = 0.7;
   cam.pitch_rad = 0.4;
   cam.distance_m = 0.8;
@@ -25,12 +25,12 @@ OrbitCamera make_camera() {
 
 TEST(OrbitCamera, TargetProjectsToViewportCentre) {
   const OrbitCamera cam = make_camera();
-  const Vec3 p = cam.project(cam.target_W, kW, kH);
+  const Vec3 p = cam.project(cam.target_world, kW, kH);
   EXPECT_NEAR(p.x(), kW / 2.0, 1e-9);
   EXPECT_NEAR(p.y(), kH / 2.0, 1e-9);
   EXPECT_GT(p.z(), 0.0);
   EXPECT_LT(p.z(), 1.0);
-  EXPECT_NEAR((cam.eye_W() - cam.target_W).norm(), cam.distance_m, 1e-12);
+  EXPECT_NEAR((cam.eye_world() - cam.target_world).norm(), cam.distance_m, 1e-12);
 }
 
 TEST(OrbitCamera, ZIsUpOnScreenAndRightHanded) {
@@ -44,21 +44,21 @@ TEST(OrbitCamera, ZIsUpOnScreenAndRightHanded) {
 
 TEST(OrbitCamera, FullTurnOfYawReturnsTheEye) {
   OrbitCamera cam = make_camera();
-  const Vec3 eye0 = cam.eye_W();
+  const Vec3 eye0 = cam.eye_world();
   const double rad_per_px = 0.005;
   const double full_turn_px = 2.0 * std::numbers::pi / rad_per_px;
   cam.rotate(full_turn_px / 3.0, 0.0, rad_per_px);
-  EXPECT_GT((cam.eye_W() - eye0).norm(), 0.5 * cam.distance_m);  // it did move
+  EXPECT_GT((cam.eye_world() - eye0).norm(), 0.5 * cam.distance_m);  // it did move
   cam.rotate(2.0 * full_turn_px / 3.0, 0.0, rad_per_px);
-  EXPECT_LT((cam.eye_W() - eye0).norm(), 1e-9);
+  EXPECT_LT((cam.eye_world() - eye0).norm(), 1e-9);
 }
 
 TEST(OrbitCamera, DragRightMovesTheEyeLeftAndPitchIsClamped) {
   OrbitCamera cam = make_camera();
-  const Vec3 eye0 = cam.eye_W();
-  const Vec3 right0 = cam.right_W();
+  const Vec3 eye0 = cam.eye_world();
+  const Vec3 right0 = cam.right_world();
   cam.rotate(10.0, 0.0);
-  EXPECT_LT((cam.eye_W() - eye0).dot(right0), 0.0);
+  EXPECT_LT((cam.eye_world() - eye0).dot(right0), 0.0);
   cam.rotate(0.0, 1e6);
   EXPECT_LE(cam.pitch_rad, OrbitCamera::kMaxPitch);
   EXPECT_FALSE(cam.view_matrix().hasNaN());
@@ -67,12 +67,12 @@ TEST(OrbitCamera, DragRightMovesTheEyeLeftAndPitchIsClamped) {
 TEST(OrbitCamera, PanKeepsThePointUnderTheCursor) {
   OrbitCamera cam = make_camera();
   // A point off-centre on the plane through the target facing the camera.
-  const Vec3 p_W = cam.target_W + 0.05 * cam.right_W() - 0.03 * cam.up_W();
-  const Vec3 before = cam.project(p_W, kW, kH);
+  const Vec3 p_world = cam.target_world + 0.05 * cam.right_world() - 0.03 * cam.up_world();
+  const Vec3 before = cam.project(p_world, kW, kH);
   const double dx = 37.0;
   const double dy = -21.0;
   cam.pan(dx, dy, kH);
-  const Vec3 after = cam.project(p_W, kW, kH);
+  const Vec3 after = cam.project(p_world, kW, kH);
   EXPECT_NEAR(after.x() - before.x(), dx, 1e-6);
   EXPECT_NEAR(after.y() - before.y(), dy, 1e-6);
 }
@@ -84,9 +84,9 @@ TEST(OrbitCamera, ZoomMultipliesTheDistance) {
   EXPECT_NEAR(cam.distance_m, d0 / std::pow(1.25, 3.0), 1e-12);
   cam.zoom(-3.0, 1.25);
   EXPECT_NEAR(cam.distance_m, d0, 1e-12);
-  const Vec3 target = cam.target_W;
+  const Vec3 target = cam.target_world;
   cam.zoom(1.0);
-  EXPECT_TRUE(cam.target_W.isApprox(target));  // zoom moves the eye, not the target
+  EXPECT_TRUE(cam.target_world.isApprox(target));  // zoom moves the eye, not the target
 }
 
 TEST(OrbitCamera, FrameFitsAllBoxCorners) {
@@ -97,7 +97,7 @@ TEST(OrbitCamera, FrameFitsAllBoxCorners) {
     cam.distance_m = 100.0;  // far off first, so frame() must move in
     const Box3 box(Vec3(1.0, 2.0, -0.5), Vec3(1.3, 2.8, 0.1));
     cam.frame(box, static_cast<double>(w) / h);
-    EXPECT_TRUE(cam.target_W.isApprox(box.center()));
+    EXPECT_TRUE(cam.target_world.isApprox(box.center()));
     double min_x = kInf, max_x = -kInf;
     for (int i = 0; i < 8; ++i) {
       const Vec3 corner = box.corner(static_cast<Box3::CornerType>(i));
@@ -118,23 +118,23 @@ TEST(OrbitCamera, FrameFitsAllBoxCorners) {
 
 TEST(OrbitCamera, UnprojectInvertsProjectAndRaysPassThroughPixels) {
   const OrbitCamera cam = make_camera();
-  const Vec3 p_W(0.15, -0.1, 0.35);
-  const Vec3 pix = cam.project(p_W, kW, kH);
-  EXPECT_TRUE(cam.unproject(pix, kW, kH).isApprox(p_W, 1e-6));
+  const Vec3 p_world(0.15, -0.1, 0.35);
+  const Vec3 pix = cam.project(p_world, kW, kH);
+  EXPECT_TRUE(cam.unproject(pix, kW, kH).isApprox(p_world, 1e-6));
 
   const Ray3 ray = cam.ray_through(pix.x(), pix.y(), kW, kH);
-  EXPECT_TRUE(ray.origin_W.isApprox(cam.eye_W()));
-  EXPECT_NEAR(ray.direction_W.norm(), 1.0, 1e-12);
-  const Vec3 to_p = p_W - ray.origin_W;
-  EXPECT_LT((to_p - to_p.dot(ray.direction_W) * ray.direction_W).norm(), 1e-6);
+  EXPECT_TRUE(ray.origin_world.isApprox(cam.eye_world()));
+  EXPECT_NEAR(ray.direction_world.norm(), 1.0, 1e-12);
+  const Vec3 to_p = p_world - ray.origin_world;
+  EXPECT_LT((to_p - to_p.dot(ray.direction_world) * ray.direction_world).norm(), 1e-6);
 
   const Ray3 centre = cam.ray_through(kW / 2.0, kH / 2.0, kW, kH);
-  EXPECT_TRUE(centre.direction_W.isApprox(cam.forward_W(), 1e-9));
+  EXPECT_TRUE(centre.direction_world.isApprox(cam.forward_world(), 1e-9));
 }
 
 TEST(OrbitCamera, PointsBehindTheEyeDoNotProject) {
   const OrbitCamera cam = make_camera();
-  const Vec3 behind = cam.eye_W() - cam.forward_W();
+  const Vec3 behind = cam.eye_world() - cam.forward_world();
   EXPECT_FALSE(std::isfinite(cam.project(behind, kW, kH).x()));
 }
 

@@ -88,13 +88,13 @@ std::string RendererTest::why_not_;
 
 // Where a camera ray through a pixel centre first meets the sphere |p − c| = r, if it does.
 std::optional<Vec3> hit_sphere(const Ray3& ray, const Vec3& c, double r) {
-  const Vec3 oc = ray.origin_W - c;
-  const double b = oc.dot(ray.direction_W);
+  const Vec3 oc = ray.origin_world - c;
+  const double b = oc.dot(ray.direction_world);
   const double disc = b * b - (oc.squaredNorm() - r * r);
   if (disc < 0.0) {
     return std::nullopt;
   }
-  return ray.origin_W + (-b - std::sqrt(disc)) * ray.direction_W;
+  return ray.origin_world + (-b - std::sqrt(disc)) * ray.direction_world;
 }
 
 TEST_F(RendererTest, FilledSphereCoversItsAnalyticDisc) {
@@ -186,9 +186,9 @@ TEST_F(RendererTest, ShadowMarkLiesOnTheFloorUnderThePoint) {
   scene.floor.visible = true;
   scene.floor.half_extent_m = 3.0;
   scene.floor.colour_a = scene.floor.colour_b = Vec3f::Constant(0.7f);  // one floor colour
-  const Vec3 tool_W(0.3, -0.2, 0.5);
+  const Vec3 tool_world(0.3, -0.2, 0.5);
   ShadowMark mark;
-  mark.point_W = tool_W;
+  mark.point_world = tool_world;
   mark.arm_m = 0.06;
   mark.width_m = 0.015;
   mark.colour = Vec3f(0.9f, 0.1f, 0.1f);
@@ -199,18 +199,18 @@ TEST_F(RendererTest, ShadowMarkLiesOnTheFloorUnderThePoint) {
   cam.distance_m = 2.5;
   const auto rgba = render(scene, cam);
 
-  const Vec3 under = cam.project(Vec3(tool_W.x(), tool_W.y(), 0.0), kW, kH);
+  const Vec3 under = cam.project(Vec3(tool_world.x(), tool_world.y(), 0.0), kW, kH);
   const auto at_mark = pixel_at(rgba, kW, static_cast<int>(under.x()), static_cast<int>(under.y()));
   EXPECT_NEAR(at_mark.r, 0.9 * 255, 3);
   EXPECT_NEAR(at_mark.g, 0.1 * 255, 3);
   // Off the mark (along +X, between its diagonal arms, beyond their reach): plain floor.
-  const Vec3 beside = cam.project(Vec3(tool_W.x() + 0.1, tool_W.y(), 0.0), kW, kH);
+  const Vec3 beside = cam.project(Vec3(tool_world.x() + 0.1, tool_world.y(), 0.0), kW, kH);
   const auto at_floor =
       pixel_at(rgba, kW, static_cast<int>(beside.x()), static_cast<int>(beside.y()));
   EXPECT_NEAR(at_floor.r, 0.7 * 255, 2);
   EXPECT_NEAR(at_floor.g, 0.7 * 255, 2);
   // And not where the point itself projects (0.5 m above the floor).
-  const Vec3 tool_px = cam.project(tool_W, kW, kH);
+  const Vec3 tool_px = cam.project(tool_world, kW, kH);
   EXPECT_GT(std::abs(tool_px.y() - under.y()), 20.0);
   const auto at_tool =
       pixel_at(rgba, kW, static_cast<int>(tool_px.x()), static_cast<int>(tool_px.y()));
@@ -339,8 +339,8 @@ TEST_F(RendererTest, SpheresAndSegmentsAppearWhereTheyProject) {
   const auto on_line = pixel_at(rgba, kW, static_cast<int>(m.x()), static_cast<int>(m.y()));
   EXPECT_GT(on_line.r, 250);
   EXPECT_GT(on_line.b, 250);
-  const Vec3 bounds_centre = scene.bounds_W().center();
-  EXPECT_TRUE(bounds_centre.isApprox(Vec3(0, -0.5, 0.2)));  // segments are not in bounds_W
+  const Vec3 bounds_centre = scene.bounds_world().center();
+  EXPECT_TRUE(bounds_centre.isApprox(Vec3(0, -0.5, 0.2)));  // segments are not in bounds_world
 }
 
 TEST(Palette, FirstColoursAreWellSeparated) {

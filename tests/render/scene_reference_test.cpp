@@ -74,7 +74,7 @@ TEST(SceneReference, KneeInEachDisplayModeMatchesTheReferences) {
   auto device = make_scene_device(scene, world);
   WorldScene view(world);
   const OrbitCamera camera =
-      framed_camera(view.rest_bounds_W(), static_cast<double>(kWidth) / kHeight, 1.95, 0.3);
+      framed_camera(view.rest_bounds_world(), static_cast<double>(kWidth) / kHeight, 1.95, 0.3);
   view.update_from_world(world);
   const std::vector<std::uint8_t> rest = writer->render(view.scene(), camera);
   // 3.5 s into the script the fingertip presses the skin over the patella (~10 mm dent).
@@ -110,7 +110,7 @@ TEST(SceneReference, KneeSegmentAndGroupColoursMatchTheReferences) {
   // The skin hides the rest: show what is under it, as the knee paper's Fig. 3 does.
   view.set_segment_visible(world.flat_segment(0, world.segment_count(0) - 1), false);
   const OrbitCamera camera =
-      framed_camera(view.rest_bounds_W(), static_cast<double>(kWidth) / kHeight, 1.95, 0.3);
+      framed_camera(view.rest_bounds_world(), static_cast<double>(kWidth) / kHeight, 1.95, 0.3);
   view.update_from_world(world);
   const auto segments = check_reference(*writer, view.scene(), camera, "knee_segments");
   o.colouring = SegmentColouring::kGroups;
@@ -137,7 +137,7 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
   TeleopScene view(world);
   view.update_from_world(world);
   const OrbitCamera camera =
-      framed_camera(view.rest_bounds_W(), static_cast<double>(kWidth) / kHeight, -0.9, 0.45);
+      framed_camera(view.rest_bounds_world(), static_cast<double>(kWidth) / kHeight, -0.9, 0.45);
   std::vector<std::vector<std::uint8_t>> pictures;
   for (const DisplayMode mode : {DisplayMode::kFaces, DisplayMode::kLines, DisplayMode::kPoints}) {
     view.scene().style.display_mode = mode;

@@ -98,7 +98,8 @@ TEST_F(TeleopSceneTest, SheetMeshHoldsTheWorldsDentedHeights) {
       ASSERT_EQ(sheet.geometry().vertices[k].x(), rest.vertices[k].x());
       ASSERT_EQ(sheet.geometry().vertices[k].y(), rest.vertices[k].y());
     }
-    EXPECT_TRUE(sheet.X_WM.isApprox(world.description().teleop->environment.X_world_sheet, 0.0));
+    EXPECT_TRUE(
+        sheet.X_world_mesh.isApprox(world.description().teleop->environment.X_world_sheet, 0.0));
   }
   // The dent is under the ball: the node nearest the ball's footprint is the deepest around.
   const Vec3 ball_sheet =
@@ -121,7 +122,7 @@ TEST_F(TeleopSceneTest, BallColourAppearsWhereItsCentreProjects) {
   // Look at the ball from beyond it (the robot behind it), a little from above.
   const Vec3 ball = world.rig()->ball.p_world();
   OrbitCamera cam;
-  cam.target_W = ball;
+  cam.target_world = ball;
   cam.yaw_rad = std::atan2(ball.y(), ball.x());
   cam.pitch_rad = 0.4;
   cam.distance_m = 0.8;
@@ -135,7 +136,7 @@ TEST_F(TeleopSceneTest, BallColourAppearsWhereItsCentreProjects) {
       << pixel_at(with_ball, kW, x, y).g << " " << pixel_at(with_ball, kW, x, y).b;
   // Without the ball the red is gone (it was the ball, not the robot or the background).
   ASSERT_FALSE(scene.scene().spheres.empty());
-  ASSERT_EQ(scene.scene().spheres[0].centre_W, ball);
+  ASSERT_EQ(scene.scene().spheres[0].centre_world, ball);
   scene.scene().spheres.erase(scene.scene().spheres.begin());
   const auto without = render(scene.scene(), cam);
   EXPECT_FALSE(dominant(pixel_at(without, kW, x, y), 0, 60));
@@ -150,17 +151,18 @@ TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
   const Iso3 X_tool = world.rig()->slave->chain().forward(world.rig()->slave->q());
   const ParallelGripperParams& p = world.rig()->gripper.params();
   const double w = world.rig()->result.gripper.width_m;
-  const Vec3 pad_W[2] = {X_tool * Vec3(0.0, 0.5 * w + p.pad_half_m.y(), p.pad_depth_m),
-                         X_tool * Vec3(0.0, -(0.5 * w + p.pad_half_m.y()), p.pad_depth_m)};
+  const Vec3 pad_world[2] = {X_tool * Vec3(0.0, 0.5 * w + p.pad_half_m.y(), p.pad_depth_m),
+                             X_tool * Vec3(0.0, -(0.5 * w + p.pad_half_m.y()), p.pad_depth_m)};
   for (int i = 0; i < 2; ++i) {
     const RenderMesh& pad = scene.scene().mesh(scene.pad_mesh(i));
-    EXPECT_LT((pad.X_WM.translation() - pad_W[i]).norm(), 1e-12) << "pad " << i;
-    EXPECT_TRUE(pad.X_WM.linear().isApprox(X_tool.linear(), 1e-12));
+    EXPECT_LT((pad.X_world_mesh.translation() - pad_world[i]).norm(), 1e-12) << "pad " << i;
+    EXPECT_TRUE(pad.X_world_mesh.linear().isApprox(X_tool.linear(), 1e-12));
   }
   // The shadow mark is under the tool point.
   ASSERT_EQ(scene.scene().shadow_marks.size(), 1u);
-  EXPECT_LT((scene.scene().shadow_marks[0].point_W - X_tool * Vec3(0.0, 0.0, p.pad_depth_m)).norm(),
-            1e-12);
+  EXPECT_LT(
+      (scene.scene().shadow_marks[0].point_world - X_tool * Vec3(0.0, 0.0, p.pad_depth_m)).norm(),
+      1e-12);
 
   // Only the pads, pure green: each pad's centre pixel is green.
   RenderScene& rs = scene.scene();
@@ -173,7 +175,7 @@ TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
   rs.floor.visible = false;
   rs.style.background = Vec3f::Zero();
   OrbitCamera cam;
-  cam.target_W = 0.5 * (pad_W[0] + pad_W[1]);
+  cam.target_world = 0.5 * (pad_world[0] + pad_world[1]);
   // Looking along the pads' face normals' perpendicular: from the tool's x side, a little above.
   const Vec3 side = X_tool.linear().col(0);
   cam.yaw_rad = std::atan2(side.y(), side.x());
@@ -185,7 +187,7 @@ TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
   }
   const auto image = render(rs, cam);
   for (int i = 0; i < 2; ++i) {
-    const Vec3 px = cam.project(pad_W[i], kW, kH);
+    const Vec3 px = cam.project(pad_world[i], kW, kH);
     const auto x = static_cast<int>(px.x());
     const auto y = static_cast<int>(px.y());
     ASSERT_TRUE(x >= 0 && x < kW && y >= 0 && y < kH);
@@ -213,12 +215,12 @@ TEST(TeleopScene, LinkMeshesFollowTheirChainFrames) {
   std::array<Iso3, kMaxChainJoints> frames;
   static_cast<void>(world.rig()->slave->chain().frames(world.rig()->slave->q(), frames));
   const RenderMesh& mesh = scene.scene().mesh(scene.link_meshes()[0]);
-  EXPECT_TRUE(mesh.X_WM.isApprox(frames[2] * g.X_frame_mesh, 1e-12));
+  EXPECT_TRUE(mesh.X_world_mesh.isApprox(frames[2] * g.X_frame_mesh, 1e-12));
   EXPECT_EQ(mesh.geometry().vertices.size(), g.mesh.vertices.size());
   // The bounds frame the whole scene: the ball, the sheet and the master drawn beside.
-  const Box3& b = scene.rest_bounds_W();
+  const Box3& b = scene.rest_bounds_world();
   EXPECT_TRUE(b.contains(world.rig()->ball.p_world()));
-  EXPECT_TRUE(b.contains(scene.master_display_origin_W()));
+  EXPECT_TRUE(b.contains(scene.master_display_origin_world()));
 }
 
 TEST(TeleopScene, BoxLinksJoinTheJointOrigins) {
@@ -248,7 +250,7 @@ TEST(TeleopScene, BoxLinksJoinTheJointOrigins) {
     const RenderMesh& m = scene.scene().mesh(scene.link_meshes()[l]);
     Vec3 c = Vec3::Zero();
     for (const Vec3& v : m.geometry().vertices) {
-      c += m.X_WM * v;
+      c += m.X_world_mesh * v;
     }
     c /= static_cast<double>(m.geometry().vertices.size());
     EXPECT_LT((c - midpoints[l]).norm(), 1e-9) << "link box " << l;
@@ -257,7 +259,7 @@ TEST(TeleopScene, BoxLinksJoinTheJointOrigins) {
   const auto& spheres = scene.scene().spheres;
   ASSERT_GE(spheres.size(), 1u + static_cast<std::size_t>(chain.dof()));
   for (int k = 0; k < chain.dof(); ++k) {
-    EXPECT_LT((spheres[1 + static_cast<std::size_t>(k)].centre_W -
+    EXPECT_LT((spheres[1 + static_cast<std::size_t>(k)].centre_world -
                frames[static_cast<std::size_t>(k)].translation())
                   .norm(),
               1e-12);
@@ -293,13 +295,14 @@ TEST(TeleopScene, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
     }
     ASSERT_LT(l, drawn.link_meshes().size());
     const RenderMesh& m = drawn.scene().mesh(drawn.link_meshes()[l++]);
-    const Iso3 X_WF = g.frame < 0 ? Iso3::Identity() : frames[static_cast<std::size_t>(g.frame)];
-    EXPECT_TRUE(m.X_WM.isApprox(X_WF * g.X_frame_mesh, 1e-12)) << g.link;
+    const Iso3 X_world_frame =
+        g.frame < 0 ? Iso3::Identity() : frames[static_cast<std::size_t>(g.frame)];
+    EXPECT_TRUE(m.X_world_mesh.isApprox(X_world_frame * g.X_frame_mesh, 1e-12)) << g.link;
     EXPECT_EQ(m.geometry().vertices.size(), g.mesh.vertices.size()) << g.link;
   }
   EXPECT_EQ(l, drawn.link_meshes().size());
   // Meshes drawn: no joint spheres, just the ball and the master's joints.
-  EXPECT_TRUE(drawn.rest_bounds_W().contains(frames[0].translation()));
+  EXPECT_TRUE(drawn.rest_bounds_world().contains(frames[0].translation()));
 }
 
 }  // namespace

@@ -13,7 +13,7 @@ namespace {
 
 OrbitCamera test_camera() {
   OrbitCamera c;
-  c.target_W = Vec3(0.0, 0.0, 0.1);
+  c.target_world = Vec3(0.0, 0.0, 0.1);
   c.yaw_rad = 1.95;
   c.pitch_rad = 0.3;
   c.distance_m = 0.6;
@@ -31,8 +31,9 @@ TEST(MouseProbe, DragKeepsTheProbeUnderTheCursor) {
   EXPECT_NEAR(after.x() - before.x(), 37.0, 1e-6);
   EXPECT_NEAR(after.y() - before.y(), -21.0, 1e-6);
   // In the view plane: its distance along the view direction is unchanged.
-  const double depth_before = (Vec3(0.02, 0.08, 0.12) - camera.eye_W()).dot(camera.forward_W());
-  const double depth_after = (probe.p_world() - camera.eye_W()).dot(camera.forward_W());
+  const double depth_before =
+      (Vec3(0.02, 0.08, 0.12) - camera.eye_world()).dot(camera.forward_world());
+  const double depth_after = (probe.p_world() - camera.eye_world()).dot(camera.forward_world());
   EXPECT_NEAR(depth_after, depth_before, 1e-12);
 }
 
@@ -45,12 +46,12 @@ TEST(MouseProbe, WheelMovesAlongTheViewDirection) {
   probe.wheel(5.0, camera);
   const Vec3 moved = probe.p_world() - start;
   EXPECT_NEAR(moved.norm(), 0.010, 1e-12);
-  EXPECT_NEAR(moved.normalized().dot(camera.forward_W()), 1.0, 1e-12);  // into the scene
+  EXPECT_NEAR(moved.normalized().dot(camera.forward_world()), 1.0, 1e-12);  // into the scene
   probe.wheel(-5.0, camera);
   EXPECT_NEAR((probe.p_world() - start).norm(), 0.0, 1e-12);
   // The image does not move (straight away from the eye would; along forward it shifts only
   // off-centre, and the target is on the axis) — check at the target itself.
-  MouseProbe centred(camera.target_W, o);
+  MouseProbe centred(camera.target_world, o);
   const Vec3 px = camera.project(centred.p_world(), 640, 720);
   centred.wheel(3.0, camera);
   const Vec3 px2 = camera.project(centred.p_world(), 640, 720);
@@ -61,11 +62,11 @@ TEST(MouseProbe, WheelMovesAlongTheViewDirection) {
 
 TEST(MouseProbe, StaysInItsWorkspaceAndIgnoresNonFiniteInput) {
   MouseProbeOptions o;
-  o.workspace_W = Box3(Vec3::Constant(-0.1), Vec3::Constant(0.1));
+  o.workspace_world = Box3(Vec3::Constant(-0.1), Vec3::Constant(0.1));
   MouseProbe probe(Vec3::Zero(), o);
   const OrbitCamera camera = test_camera();
   probe.wheel(1e6, camera);
-  EXPECT_TRUE(o.workspace_W.contains(probe.p_world()));
+  EXPECT_TRUE(o.workspace_world.contains(probe.p_world()));
   const Vec3 held = probe.p_world();
   probe.drag(std::numeric_limits<double>::quiet_NaN(), 3.0, camera, 720);
   probe.wheel(std::numeric_limits<double>::infinity(), camera);

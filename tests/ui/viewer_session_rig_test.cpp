@@ -68,7 +68,7 @@ TEST(TeleopViewerSession, ScriptedMasterRunsOnTheLoopAndFillsTheReadout) {
   const std::unique_ptr<ViewerSession> session = make_viewer_session(config_for("sim"), scene);
   EXPECT_EQ(session->mouse_device(), nullptr);
   EXPECT_GT(session->render_scene().mesh_count(), 0u);
-  EXPECT_TRUE(session->bounds_W().volume() > 0.0);
+  EXPECT_TRUE(session->bounds_world().volume() > 0.0);
   run_for(*session, 1.5);
   const SessionReadout& r = session->readout();
   EXPECT_GT(r.time_s, 1.0);
@@ -111,7 +111,7 @@ TEST(TeleopViewerSession, MouseProbeIsTheSlaveToolsTargetAndTheSlaveFollowsIt) {
   InteractiveDevice* mouse = session->mouse_device();
   ASSERT_NE(mouse, nullptr);
   const MasterArm master(setup.description.teleop->master);
-  const Vec3 p0 = session->probe_start_W();
+  const Vec3 p0 = session->probe_start_world();
   const Vec3 hand0 = master.hand_pose(first_arm_rad(setup)).translation();
   // The probe starts on the slave tool's target for the master's first pose.
   const Vec3 start_target =

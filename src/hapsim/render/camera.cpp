@@ -6,33 +6,33 @@
 
 namespace hapsim {
 
-Vec3 OrbitCamera::eye_W() const {
-  return target_W - distance_m * forward_W();
+Vec3 OrbitCamera::eye_world() const {
+  return target_world - distance_m * forward_world();
 }
 
-Vec3 OrbitCamera::forward_W() const {
+Vec3 OrbitCamera::forward_world() const {
   return -Vec3(std::cos(pitch_rad) * std::cos(yaw_rad), std::cos(pitch_rad) * std::sin(yaw_rad),
                std::sin(pitch_rad));
 }
 
 // forward × Z, normalised; horizontal because the eye never looks straight up or down.
-Vec3 OrbitCamera::right_W() const {
+Vec3 OrbitCamera::right_world() const {
   return Vec3(-std::sin(yaw_rad), std::cos(yaw_rad), 0.0);
 }
 
-Vec3 OrbitCamera::up_W() const {
-  return right_W().cross(forward_W());
+Vec3 OrbitCamera::up_world() const {
+  return right_world().cross(forward_world());
 }
 
 Eigen::Matrix4d OrbitCamera::view_matrix() const {
   Eigen::Matrix3d R_CW;
-  R_CW.row(0) = right_W().transpose();
-  R_CW.row(1) = up_W().transpose();
-  R_CW.row(2) = -forward_W().transpose();
-  Eigen::Matrix4d X_CW = Eigen::Matrix4d::Identity();
-  X_CW.topLeftCorner<3, 3>() = R_CW;
-  X_CW.topRightCorner<3, 1>() = -R_CW * eye_W();
-  return X_CW;
+  R_CW.row(0) = right_world().transpose();
+  R_CW.row(1) = up_world().transpose();
+  R_CW.row(2) = -forward_world().transpose();
+  Eigen::Matrix4d X_camera_world = Eigen::Matrix4d::Identity();
+  X_camera_world.topLeftCorner<3, 3>() = R_CW;
+  X_camera_world.topRightCorner<3, 1>() = -R_CW * eye_world();
+  return X_camera_world;
 }
 
 Eigen::Matrix4d OrbitCamera::projection(double aspect) const {
@@ -58,7 +58,7 @@ void OrbitCamera::pan(double dx_px, double dy_px, int viewport_height_px) {
   // Size of one pixel in the plane through the target, facing the camera.
   const double m_per_px =
       2.0 * distance_m * std::tan(0.5 * fov_y_rad) / std::max(viewport_height_px, 1);
-  target_W += m_per_px * (-dx_px * right_W() + dy_px * up_W());
+  target_world += m_per_px * (-dx_px * right_world() + dy_px * up_world());
 }
 
 void OrbitCamera::zoom(double wheel_steps, double factor_per_step) {
@@ -66,12 +66,12 @@ void OrbitCamera::zoom(double wheel_steps, double factor_per_step) {
       std::clamp(distance_m * std::pow(factor_per_step, -wheel_steps), kMinDistance, kMaxDistance);
 }
 
-void OrbitCamera::frame(const Box3& bounds_W, double aspect, double margin) {
-  if (bounds_W.isEmpty()) {
+void OrbitCamera::frame(const Box3& bounds_world, double aspect, double margin) {
+  if (bounds_world.isEmpty()) {
     return;
   }
-  target_W = bounds_W.center();
-  const double radius = 0.5 * bounds_W.diagonal().norm();
+  target_world = bounds_world.center();
+  const double radius = 0.5 * bounds_world.diagonal().norm();
   if (radius <= 0.0) {
     return;
   }
@@ -83,9 +83,9 @@ void OrbitCamera::frame(const Box3& bounds_W, double aspect, double margin) {
       std::clamp(std::max(margin, 1.0) * radius / std::sin(half), kMinDistance, kMaxDistance);
 }
 
-Vec3 OrbitCamera::project(const Vec3& p_W, int width_px, int height_px) const {
+Vec3 OrbitCamera::project(const Vec3& p_world, int width_px, int height_px) const {
   const double aspect = static_cast<double>(width_px) / height_px;
-  const Eigen::Vector4d clip = projection(aspect) * view_matrix() * p_W.homogeneous();
+  const Eigen::Vector4d clip = projection(aspect) * view_matrix() * p_world.homogeneous();
   if (clip.w() <= 0.0) {
     return Vec3::Constant(kInf);
   }
@@ -105,9 +105,9 @@ Vec3 OrbitCamera::unproject(const Vec3& pixel_depth, int width_px, int height_px
 
 Ray3 OrbitCamera::ray_through(double x_px, double y_px, int width_px, int height_px) const {
   Ray3 ray;
-  ray.origin_W = eye_W();
-  ray.direction_W =
-      (unproject(Vec3(x_px, y_px, 0.5), width_px, height_px) - ray.origin_W).normalized();
+  ray.origin_world = eye_world();
+  ray.direction_world =
+      (unproject(Vec3(x_px, y_px, 0.5), width_px, height_px) - ray.origin_world).normalized();
   return ray;
 }
 

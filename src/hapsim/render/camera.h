@@ -8,16 +8,16 @@
 
 namespace hapsim {
 
-/// A ray in the world frame; `direction_W` is unit length.
+/// A ray in the world frame; `direction_world` is unit length.
 struct Ray3 {
-  Vec3 origin_W = Vec3::Zero();
-  Vec3 direction_W = Vec3::UnitX();
+  Vec3 origin_world = Vec3::Zero();
+  Vec3 direction_world = Vec3::UnitX();
 };
 
 class OrbitCamera {
  public:
   /// The point looked at and orbited, world frame, metres.
-  Vec3 target_W = Vec3::Zero();
+  Vec3 target_world = Vec3::Zero();
   /// Azimuth of the eye around the target, from +X towards +Y, radians.
   double yaw_rad = 0.0;
   /// Elevation of the eye above the target's horizontal plane, radians; kept inside ±kMaxPitch.
@@ -32,11 +32,11 @@ class OrbitCamera {
   static constexpr double kMinDistance = 1e-4;
   static constexpr double kMaxDistance = 1e4;
 
-  [[nodiscard]] Vec3 eye_W() const;
+  [[nodiscard]] Vec3 eye_world() const;
   /// Camera frame axes in the world: right, up (screen) and forward (towards the target).
-  [[nodiscard]] Vec3 right_W() const;
-  [[nodiscard]] Vec3 up_W() const;
-  [[nodiscard]] Vec3 forward_W() const;
+  [[nodiscard]] Vec3 right_world() const;
+  [[nodiscard]] Vec3 up_world() const;
+  [[nodiscard]] Vec3 forward_world() const;
 
   /// Near/far clip distances follow the orbit distance (ratio 1e4: enough depth precision at
   /// 24 bits, and the floor stays visible far behind the target).
@@ -56,13 +56,13 @@ class OrbitCamera {
   void pan(double dx_px, double dy_px, int viewport_height_px);
   /// Multiplies the distance by factor_per_step^(−wheel_steps): positive steps zoom in.
   void zoom(double wheel_steps, double factor_per_step = 1.1);
-  /// Looks at the centre of `bounds_W` from the current direction, close enough that the whole
+  /// Looks at the centre of `bounds_world` from the current direction, close enough that the whole
   /// box (its bounding sphere) fits a viewport of `aspect`, with `margin` (≥ 1) to spare.
-  void frame(const Box3& bounds_W, double aspect = 1.0, double margin = 1.1);
+  void frame(const Box3& bounds_world, double aspect = 1.0, double margin = 1.1);
 
   /// World point → (x_px, y_px, depth) with depth the window depth in [0, 1] (0 at the near plane).
   /// Points behind the eye return infinite coordinates.
-  [[nodiscard]] Vec3 project(const Vec3& p_W, int width_px, int height_px) const;
+  [[nodiscard]] Vec3 project(const Vec3& p_world, int width_px, int height_px) const;
   /// Inverse of project(): (x_px, y_px, depth) → world point.
   [[nodiscard]] Vec3 unproject(const Vec3& pixel_depth, int width_px, int height_px) const;
   /// The ray from the eye through a pixel position (use +0.5 for a pixel's centre).

@@ -73,10 +73,11 @@ Vec3f palette_colour(int i) {
   return hsv_to_rgb(hue, odd ? 0.55f : 0.75f, odd ? 0.95f : 0.8f);
 }
 
-MeshId RenderScene::add_mesh(const TriangleMesh& mesh_M, const Vec3f& colour, const Iso3& X_WM) {
+MeshId RenderScene::add_mesh(const TriangleMesh& mesh_M, const Vec3f& colour,
+                             const Iso3& X_world_mesh) {
   RenderMesh& m = meshes_.emplace_back();
   m.colour = colour;
-  m.X_WM = X_WM;
+  m.X_world_mesh = X_world_mesh;
   m.geometry_ = mesh_M;
   if (m.geometry_.vertex_normals.size() != m.geometry_.vertices.size()) {
     m.geometry_.compute_vertex_normals();
@@ -88,7 +89,7 @@ MeshId RenderScene::add_mesh(const TriangleMesh& mesh_M, const Vec3f& colour, co
 
 MeshId RenderScene::add_mesh(std::span<const Vec3> positions_M,
                              std::span<const TriangleIndices> triangles, const Vec3f& colour,
-                             const Iso3& X_WM) {
+                             const Iso3& X_world_mesh) {
   TriangleMesh mesh;
   mesh.vertices.assign(positions_M.begin(), positions_M.end());
   mesh.triangles.assign(triangles.begin(), triangles.end());
@@ -101,7 +102,7 @@ MeshId RenderScene::add_mesh(std::span<const Vec3> positions_M,
       }
     }
   }
-  return add_mesh(mesh, colour, X_WM);
+  return add_mesh(mesh, colour, X_world_mesh);
 }
 
 RenderMesh& RenderScene::checked(MeshId id, const char* where) {
@@ -145,19 +146,19 @@ const RenderMesh& RenderScene::mesh(MeshId id) const {
   return const_cast<RenderScene*>(this)->checked(id, "RenderScene::mesh");
 }
 
-Box3 RenderScene::bounds_W() const {
+Box3 RenderScene::bounds_world() const {
   Box3 box;
   for (const RenderMesh& m : meshes_) {
     if (!m.visible) {
       continue;
     }
     for (const Vec3& v : m.geometry_.vertices) {
-      box.extend(m.X_WM * v);
+      box.extend(m.X_world_mesh * v);
     }
   }
   for (const RenderSphere& s : spheres) {
-    box.extend(s.centre_W - Vec3::Constant(s.radius_m));
-    box.extend(s.centre_W + Vec3::Constant(s.radius_m));
+    box.extend(s.centre_world - Vec3::Constant(s.radius_m));
+    box.extend(s.centre_world + Vec3::Constant(s.radius_m));
   }
   return box;
 }

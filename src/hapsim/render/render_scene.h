@@ -36,7 +36,7 @@ class RenderMesh {
   /// Appearance: change freely, no re-upload needed.
   Vec3f colour = Vec3f(0.8f, 0.8f, 0.8f);
   /// World-from-mesh pose.
-  Iso3 X_WM = Iso3::Identity();
+  Iso3 X_world_mesh = Iso3::Identity();
   bool visible = true;
   std::string name;
 
@@ -58,24 +58,24 @@ class RenderMesh {
 };
 
 struct RenderSphere {
-  Vec3 centre_W = Vec3::Zero();
+  Vec3 centre_world = Vec3::Zero();
   double radius_m = 0.01;
   Vec3f colour = Vec3f(0.9f, 0.3f, 0.2f);
   /// Edges only (e.g. bounding-sphere display) instead of a filled, lit sphere.
   bool wireframe = false;
 };
 
-/// A straight line from `a_W` to `b_W`, unlit, drawn RenderStyle::line_width_px wide.
+/// A straight line from `a_world` to `b_world`, unlit, drawn RenderStyle::line_width_px wide.
 struct RenderSegment {
-  Vec3 a_W = Vec3::Zero();
-  Vec3 b_W = Vec3::Zero();
+  Vec3 a_world = Vec3::Zero();
+  Vec3 b_world = Vec3::Zero();
   Vec3f colour = Vec3f(1.0f, 1.0f, 0.0f);
 };
 
-/// An 'x' on the floor plane directly below (or above) `point_W`: two crossed bars, each
+/// An 'x' on the floor plane directly below (or above) `point_world`: two crossed bars, each
 /// 2·arm_m long and width_m wide, in the floor plane.
 struct ShadowMark {
-  Vec3 point_W = Vec3::Zero();
+  Vec3 point_world = Vec3::Zero();
   double arm_m = 0.01;
   double width_m = 0.002;
   Vec3f colour = Vec3f(0.1f, 0.1f, 0.1f);
@@ -136,9 +136,9 @@ class RenderScene {
   /// Registers a mesh (copied) and returns its id (ids are 0, 1, 2, … in order of adding).
   /// Vertex normals are computed here if `mesh` has none.
   MeshId add_mesh(const TriangleMesh& mesh_M, const Vec3f& colour,
-                  const Iso3& X_WM = Iso3::Identity());
+                  const Iso3& X_world_mesh = Iso3::Identity());
   MeshId add_mesh(std::span<const Vec3> positions_M, std::span<const TriangleIndices> triangles,
-                  const Vec3f& colour, const Iso3& X_WM = Iso3::Identity());
+                  const Vec3f& colour, const Iso3& X_world_mesh = Iso3::Identity());
   /// New positions for a deforming mesh (same vertex count and order); recomputes its vertex
   /// normals. Allocation-free after the first call. Throws hapsim::Error on a size mismatch.
   void update_positions(MeshId id, std::span<const Vec3> positions_M);
@@ -150,7 +150,7 @@ class RenderScene {
   [[nodiscard]] std::size_t mesh_count() const { return meshes_.size(); }
 
   /// World bounds of the visible meshes and spheres (for OrbitCamera::frame); empty if none.
-  [[nodiscard]] Box3 bounds_W() const;
+  [[nodiscard]] Box3 bounds_world() const;
 
   /// Per-frame content: cleared and refilled by the app (vectors keep their capacity).
   std::vector<RenderSphere> spheres;

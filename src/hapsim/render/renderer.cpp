@@ -27,7 +27,7 @@ uniform mat4 u_projection;
 uniform vec3 u_colour;
 uniform bool u_use_vertex_colour;
 uniform int u_light_count;
-uniform vec3 u_light_dir_C[4];
+uniform vec3 u_light_dir_camera[4];
 uniform vec3 u_light_colour[4];
 uniform vec3 u_ambient;
 uniform float u_specular;
@@ -36,14 +36,14 @@ uniform float u_point_size;
 out vec3 v_front_colour;
 out vec3 v_back_colour;
 
-vec3 shade(vec3 n_C, vec3 to_eye_C, vec3 base) {
+vec3 shade(vec3 n_camera, vec3 to_eye_camera, vec3 base) {
   vec3 c = u_ambient * base;
   for (int i = 0; i < u_light_count; ++i) {
-    vec3 l = u_light_dir_C[i];
-    float lambert = max(dot(n_C, l), 0.0);
+    vec3 l = u_light_dir_camera[i];
+    float lambert = max(dot(n_camera, l), 0.0);
     float spec = 0.0;
     if (lambert > 0.0) {
-      spec = pow(max(dot(n_C, normalize(l + to_eye_C)), 0.0), u_shininess);
+      spec = pow(max(dot(n_camera, normalize(l + to_eye_camera)), 0.0), u_shininess);
     }
     c += u_light_colour[i] * (lambert * base + u_specular * spec);
   }
@@ -51,14 +51,14 @@ vec3 shade(vec3 n_C, vec3 to_eye_C, vec3 base) {
 }
 
 void main() {
-  vec4 p_C = u_model_view * vec4(a_position_M, 1.0);
-  vec3 to_eye_C = normalize(-p_C.xyz);
+  vec4 p_camera = u_model_view * vec4(a_position_M, 1.0);
+  vec3 to_eye_camera = normalize(-p_camera.xyz);
   vec3 n = mat3(u_model_view) * a_normal_M;  // rigid pose (+ uniform scale for spheres)
-  vec3 n_C = dot(n, n) > 0.0 ? normalize(n) : to_eye_C;
+  vec3 n_camera = dot(n, n) > 0.0 ? normalize(n) : to_eye_camera;
   vec3 base = u_use_vertex_colour ? a_colour : u_colour;
-  v_front_colour = shade(n_C, to_eye_C, base);
-  v_back_colour = shade(-n_C, to_eye_C, base);
-  gl_Position = u_projection * p_C;
+  v_front_colour = shade(n_camera, to_eye_camera, base);
+  v_back_colour = shade(-n_camera, to_eye_camera, base);
+  gl_Position = u_projection * p_camera;
   gl_PointSize = u_point_size;
 }
 )";
@@ -74,12 +74,12 @@ void main() {
 
 // Unlit, per-vertex coloured lines and triangles given in the world frame (segments, marks).
 constexpr const char* kUnlitVertex = R"(#version 330 core
-layout(location = 0) in vec3 a_position_W;
+layout(location = 0) in vec3 a_position_world;
 layout(location = 1) in vec3 a_colour;
 uniform mat4 u_view_projection;
 out vec3 v_colour;
 void main() {
-  gl_Position = u_view_projection * vec4(a_position_W, 1.0);
+  gl_Position = u_view_projection * vec4(a_position_world, 1.0);
   v_colour = a_colour;
 }
 )";
@@ -92,24 +92,24 @@ void main() { o_colour = vec4(v_colour, 1.0); }
 
 // Floor: a checkerboard computed from the world position, so it needs no texture.
 constexpr const char* kFloorVertex = R"(#version 330 core
-layout(location = 0) in vec3 a_position_W;
+layout(location = 0) in vec3 a_position_world;
 uniform mat4 u_view_projection;
-out vec2 v_xy_W;
+out vec2 v_xy_world;
 void main() {
-  gl_Position = u_view_projection * vec4(a_position_W, 1.0);
-  v_xy_W = a_position_W.xy;
+  gl_Position = u_view_projection * vec4(a_position_world, 1.0);
+  v_xy_world = a_position_world.xy;
 }
 )";
 
 constexpr const char* kFloorFragment = R"(#version 330 core
-in vec2 v_xy_W;
+in vec2 v_xy_world;
 uniform float u_cell_m;
-uniform vec2 u_origin_xy_W;
+uniform vec2 u_origin_xy_world;
 uniform vec3 u_colour_a;
 uniform vec3 u_colour_b;
 out vec4 o_colour;
 void main() {
-  ivec2 cell = ivec2(floor((v_xy_W - u_origin_xy_W) / u_cell_m));
+  ivec2 cell = ivec2(floor((v_xy_world - u_origin_xy_world) / u_cell_m));
   o_colour = vec4(((cell.x + cell.y) & 1) == 0 ? u_colour_a : u_colour_b, 1.0);
 }
 )";
@@ -291,9 +291,9 @@ struct Renderer::Impl {
   }
 
   // Appends one unlit vertex to the stream.
-  void push(const Vec3& p_W, const Vec3f& c) {
-    staging.insert(staging.end(), {static_cast<float>(p_W.x()), static_cast<float>(p_W.y()),
-                                   static_cast<float>(p_W.z()), c.x(), c.y(), c.z()});
+  void push(const Vec3& p_world, const Vec3f& c) {
+    staging.insert(staging.end(), {static_cast<float>(p_world.x()), static_cast<float>(p_world.y()),
+                                   static_cast<float>(p_world.z()), c.x(), c.y(), c.z()});
   }
 
   void set_lit_lighting(const Lighting& lighting, const Eigen::Matrix3d& R_CW) {
@@ -303,12 +303,12 @@ struct Renderer::Impl {
     const int count = std::min(static_cast<int>(lighting.lights.size()), Lighting::kMaxLights);
     for (int i = 0; i < count; ++i) {
       const DirectionalLight& light = lighting.lights[static_cast<std::size_t>(i)];
-      Vec3 d_C = light.frame == LightFrame::kWorld ? Vec3(R_CW * light.direction_to_light)
-                                                   : light.direction_to_light;
-      d_C.normalize();
+      Vec3 d_camera = light.frame == LightFrame::kWorld ? Vec3(R_CW * light.direction_to_light)
+                                                        : light.direction_to_light;
+      d_camera.normalize();
       const auto base = 3 * static_cast<std::size_t>(i);
       for (int k = 0; k < 3; ++k) {
-        dirs[base + static_cast<std::size_t>(k)] = static_cast<float>(d_C[k]);
+        dirs[base + static_cast<std::size_t>(k)] = static_cast<float>(d_camera[k]);
         colours[base + static_cast<std::size_t>(k)] = light.colour[k];
       }
     }
@@ -346,7 +346,7 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   s.lit_u.colour = loc(s.lit, "u_colour");
   s.lit_u.use_vertex_colour = loc(s.lit, "u_use_vertex_colour");
   s.lit_u.light_count = loc(s.lit, "u_light_count");
-  s.lit_u.light_dir = loc(s.lit, "u_light_dir_C");
+  s.lit_u.light_dir = loc(s.lit, "u_light_dir_camera");
   s.lit_u.light_colour = loc(s.lit, "u_light_colour");
   s.lit_u.ambient = loc(s.lit, "u_ambient");
   s.lit_u.specular = loc(s.lit, "u_specular");
@@ -355,7 +355,7 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   s.unlit_view_projection = loc(s.unlit, "u_view_projection");
   s.floor_view_projection = loc(s.floor, "u_view_projection");
   s.floor_cell = loc(s.floor, "u_cell_m");
-  s.floor_origin = loc(s.floor, "u_origin_xy_W");
+  s.floor_origin = loc(s.floor, "u_origin_xy_world");
   s.floor_colour_a = loc(s.floor, "u_colour_a");
   s.floor_colour_b = loc(s.floor, "u_colour_b");
 
@@ -433,9 +433,9 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   glDisable(GL_BLEND);
   glEnable(GL_PROGRAM_POINT_SIZE);
 
-  const Eigen::Matrix4d X_CW = camera.view_matrix();
+  const Eigen::Matrix4d X_camera_world = camera.view_matrix();
   const Eigen::Matrix4d P = camera.projection(static_cast<double>(width_px) / height_px);
-  const Eigen::Matrix4f view_projection = (P * X_CW).cast<float>();
+  const Eigen::Matrix4f view_projection = (P * X_camera_world).cast<float>();
   const Eigen::Matrix4f projection = P.cast<float>();
 
   s.sync_meshes(scene);
@@ -457,7 +457,7 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   }
   const auto marks_first = static_cast<GLint>(s.staging.size() / kUnlitFloats);
   for (const ShadowMark& mark : scene.shadow_marks) {
-    const Vec3 q(mark.point_W.x(), mark.point_W.y(), fl.height_m);
+    const Vec3 q(mark.point_world.x(), mark.point_world.y(), fl.height_m);
     // Two bars along the floor diagonals, each a rectangle of two triangles.
     constexpr double kHalfSqrt2 = 0.5 * std::numbers::sqrt2;
     for (const Vec3& dir :
@@ -473,8 +473,8 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   }
   const auto segments_first = static_cast<GLint>(s.staging.size() / kUnlitFloats);
   for (const RenderSegment& seg : scene.segments) {
-    s.push(seg.a_W, seg.colour);
-    s.push(seg.b_W, seg.colour);
+    s.push(seg.a_world, seg.colour);
+    s.push(seg.b_world, seg.colour);
   }
   const auto stream_end = static_cast<GLint>(s.staging.size() / kUnlitFloats);
   if (stream_end > 0) {
@@ -512,7 +512,7 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   // Meshes and spheres: lit.
   glUseProgram(s.lit);
   set_matrix(s.lit_u.projection, projection);
-  s.set_lit_lighting(scene.lighting, X_CW.topLeftCorner<3, 3>());
+  s.set_lit_lighting(scene.lighting, X_camera_world.topLeftCorner<3, 3>());
   glUniform1f(s.lit_u.point_size, style.point_size_px);
   const float line_width = std::clamp(style.line_width_px, 1.0f, s.max_line_width);
   glLineWidth(line_width);
@@ -522,7 +522,7 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
     if (!m.visible || gpu.vertex_count == 0) {
       continue;
     }
-    set_matrix(s.lit_u.model_view, (X_CW * m.X_WM.matrix()).cast<float>());
+    set_matrix(s.lit_u.model_view, (X_camera_world * m.X_world_mesh.matrix()).cast<float>());
     const bool vertex_colours =
         style.colour_mode == ColourMode::kVertexColours && gpu.has_vertex_colours;
     glUniform1i(s.lit_u.use_vertex_colour, vertex_colours ? 1 : 0);
@@ -549,10 +549,10 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
     glBindVertexArray(s.sphere.vao);
     glUniform1i(s.lit_u.use_vertex_colour, 0);
     for (const RenderSphere& sphere : scene.spheres) {
-      Eigen::Matrix4d X_WS = Eigen::Matrix4d::Identity();
-      X_WS.topLeftCorner<3, 3>() *= sphere.radius_m;
-      X_WS.topRightCorner<3, 1>() = sphere.centre_W;
-      set_matrix(s.lit_u.model_view, (X_CW * X_WS).cast<float>());
+      Eigen::Matrix4d X_world_sphere = Eigen::Matrix4d::Identity();
+      X_world_sphere.topLeftCorner<3, 3>() *= sphere.radius_m;
+      X_world_sphere.topRightCorner<3, 1>() = sphere.centre_world;
+      set_matrix(s.lit_u.model_view, (X_camera_world * X_world_sphere).cast<float>());
       set_vec3(s.lit_u.colour, sphere.colour);
       if (sphere.wireframe) {
         glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);

@@ -49,13 +49,13 @@ std::string SnapshotWriter::renderer_name() const {
   return context_->renderer_name();
 }
 
-OrbitCamera framed_camera(const Box3& bounds_W, double aspect, double yaw_rad, double pitch_rad,
+OrbitCamera framed_camera(const Box3& bounds_world, double aspect, double yaw_rad, double pitch_rad,
                           double margin) {
   OrbitCamera camera;
   camera.yaw_rad = yaw_rad;
   camera.pitch_rad = pitch_rad;
-  if (!bounds_W.isEmpty()) {
-    camera.frame(bounds_W, aspect, margin);
+  if (!bounds_world.isEmpty()) {
+    camera.frame(bounds_world, aspect, margin);
   }
   return camera;
 }

@@ -1,6 +1,6 @@
-// Pictures with no display (architecture.md#viewer "headless rendering to PNG"): an offscreen context and a
-// renderer that draw a RenderScene from a camera and write a PNG, for `hapsim run --snapshot`,
-// reference-image tests, reports and CI.
+// Pictures with no display (architecture.md#viewer "headless rendering to PNG"): an offscreen
+// context and a renderer that draw a RenderScene from a camera and write a PNG, for `hapsim run
+// --snapshot`, reference-image tests, reports and CI.
 #pragma once
 
 #include "hapsim/render/camera.h"
@@ -45,9 +45,9 @@ class SnapshotWriter {
   std::vector<std::uint8_t> rgba_;
 };
 
-/// A camera looking at the centre of `bounds_W` from azimuth `yaw_rad` and elevation
+/// A camera looking at the centre of `bounds_world` from azimuth `yaw_rad` and elevation
 /// `pitch_rad`, close enough to show the whole box in a viewport of `aspect`.
-[[nodiscard]] OrbitCamera framed_camera(const Box3& bounds_W, double aspect, double yaw_rad,
+[[nodiscard]] OrbitCamera framed_camera(const Box3& bounds_world, double aspect, double yaw_rad,
                                         double pitch_rad, double margin = 1.05);
 
 /// "out.png", 42 → "out_000042.png" (a series of snapshots).

@@ -48,8 +48,8 @@ TriangleMesh link_box(const Vec3& d, double half_width_m) {
 }
 
 /// The point `p_master` (master base frame) where the master is drawn.
-Vec3 master_point_W(const Vec3& origin_W, double scale, const Vec3& p_master) {
-  return origin_W + scale * p_master;
+Vec3 master_point_world(const Vec3& origin_world, double scale, const Vec3& p_master) {
+  return origin_world + scale * p_master;
 }
 
 }  // namespace
@@ -72,7 +72,7 @@ TeleopScene::TeleopScene(const World& world, TeleopSceneOptions options)
   options_.show_master = false;  // placed below, beside what the rest occupies
   update(scratch_);
   options_.show_master = show_master;
-  Box3 bounds = scene_.bounds_W();  // slave at its start, gripper, ball, sheet
+  Box3 bounds = scene_.bounds_world();  // slave at its start, gripper, ball, sheet
   const BallEnvironmentOptions& env = world_.description().teleop->environment;
   const double floor_z = env.has_floor ? env.floor_z_m : bounds.min().z();
   bounds.extend(Vec3(bounds.min().x(), bounds.min().y(), floor_z));
@@ -80,15 +80,15 @@ TeleopScene::TeleopScene(const World& world, TeleopSceneOptions options)
   const MasterArmGeometry& g = world_.model().master()->geometry();
   const double master_reach =
       options_.master_display_scale * (g.upper_arm_m + g.forearm_m + g.finger_m);
-  master_origin_W_ = Vec3(bounds.center().x(), bounds.min().y() - 0.6 * master_reach, floor_z);
+  master_origin_world_ = Vec3(bounds.center().x(), bounds.min().y() - 0.6 * master_reach, floor_z);
   if (options_.show_master) {
     pose_from(scratch_);
     for (const RenderSegment& seg : scene_.segments) {
-      bounds.extend(seg.a_W);
-      bounds.extend(seg.b_W);
+      bounds.extend(seg.a_world);
+      bounds.extend(seg.b_world);
     }
   }
-  rest_bounds_W_ = bounds;
+  rest_bounds_world_ = bounds;
   // A floor under everything, a little wider, 5 cm checks.
   scene_.floor.visible = env.has_floor;
   scene_.floor.height_m = floor_z;
@@ -223,19 +223,19 @@ void TeleopScene::pose_from(const TeleopSnapshot& s) {
     chain.frames(s.slave_q, frames_);
   }
   for (const Link& link : links_) {
-    const Iso3 X_WF =
+    const Iso3 X_world_frame =
         link.frame < 0 ? Iso3::Identity() : frames_[static_cast<std::size_t>(link.frame)];
-    scene_.mesh(link.mesh).X_WM = X_WF * link.X_frame_mesh;
+    scene_.mesh(link.mesh).X_world_mesh = X_world_frame * link.X_frame_mesh;
   }
   for (const MeshId id : gripper_body_) {
-    scene_.mesh(id).X_WM = s.X_world_tool;
+    scene_.mesh(id).X_world_mesh = s.X_world_tool;
   }
   const ParallelGripper& gripper = world_.rig()->gripper;
   for (int i = 0; i < 2; ++i) {
     RenderMesh& pad = scene_.mesh(pads_[static_cast<std::size_t>(i)]);
-    pad.X_WM = Iso3::Identity();
-    pad.X_WM.linear() = s.X_world_tool.linear();
-    pad.X_WM.translation() = gripper.pad_center_world(s.X_world_tool, s.gripper_width_m, i);
+    pad.X_world_mesh = Iso3::Identity();
+    pad.X_world_mesh.linear() = s.X_world_tool.linear();
+    pad.X_world_mesh.translation() = gripper.pad_center_world(s.X_world_tool, s.gripper_width_m, i);
     pad.colour = s.held ? options_.colours.pad_holding : options_.colours.pad;
   }
 
@@ -251,8 +251,8 @@ void TeleopScene::pose_from(const TeleopSnapshot& s) {
     }
   }
   // The tool point (between the pads) marked on the floor.
-  const Vec3 tool_point_W = s.X_world_tool * Vec3(0.0, 0.0, gripper.params().pad_depth_m);
-  scene_.shadow_marks.push_back({tool_point_W, 0.03, 0.005, options_.colours.shadow});
+  const Vec3 tool_point_world = s.X_world_tool * Vec3(0.0, 0.0, gripper.params().pad_depth_m);
+  scene_.shadow_marks.push_back({tool_point_world, 0.03, 0.005, options_.colours.shadow});
   if (options_.show_master) {
     add_master_lines(s);
   }
@@ -265,7 +265,9 @@ void TeleopScene::add_master_lines(const TeleopSnapshot& s) {
   const Iso3 hand = master.arm().frames(s.master_joint_rad, f);
   const double scale = options_.master_display_scale;
   const Vec3f c = options_.colours.master;
-  auto at = [&](const Vec3& p_master) { return master_point_W(master_origin_W_, scale, p_master); };
+  auto at = [&](const Vec3& p_master) {
+    return master_point_world(master_origin_world_, scale, p_master);
+  };
   const Vec3 base = at(Vec3::Zero());
   const Vec3 shoulder = at(f[1].translation());
   const Vec3 elbow = at(f[2].translation());

@@ -65,17 +65,18 @@ class TeleopScene {
   [[nodiscard]] RenderScene& scene() { return scene_; }
   [[nodiscard]] const RenderScene& scene() const { return scene_; }
   /// Bounds of the scene as built (slave at its start, ball, sheet, master), for framing.
-  [[nodiscard]] const Box3& rest_bounds_W() const { return rest_bounds_W_; }
+  [[nodiscard]] const Box3& rest_bounds_world() const { return rest_bounds_world_; }
 
   /// The slave's link meshes (URDF link meshes, or boxes base → joint 0 → … → tip, skipping
   /// links of zero length), in chain order.
   [[nodiscard]] const std::vector<MeshId>& link_meshes() const { return link_mesh_ids_; }
   /// Pad i (0: tool +y side, 1: −y side, as ParallelGripper::pad_center_world): a box of the
-  /// gripper's pad half extents whose pose X_WM is the pad centre with the tool's orientation.
+  /// gripper's pad half extents whose pose X_world_mesh is the pad centre with the tool's
+  /// orientation.
   [[nodiscard]] MeshId pad_mesh(int pad) const { return pads_.at(static_cast<std::size_t>(pad)); }
   [[nodiscard]] MeshId sheet_mesh() const { return sheet_; }
-  /// Where the master's base is drawn and at what scale: p_W = origin + scale · p_master.
-  [[nodiscard]] const Vec3& master_display_origin_W() const { return master_origin_W_; }
+  /// Where the master's base is drawn and at what scale: p_world = origin + scale · p_master.
+  [[nodiscard]] const Vec3& master_display_origin_world() const { return master_origin_world_; }
 
  private:
   struct Link {
@@ -101,8 +102,8 @@ class TeleopScene {
   std::vector<double> uploaded_heights_m_;
   std::vector<Iso3> frames_;  // scratch: the slave's joint frames
   TeleopSnapshot scratch_;    // update_from_world fills this
-  Vec3 master_origin_W_ = Vec3::Zero();
-  Box3 rest_bounds_W_;
+  Vec3 master_origin_world_ = Vec3::Zero();
+  Box3 rest_bounds_world_;
 };
 
 }  // namespace hapsim

@@ -73,16 +73,16 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
       seg->mesh = scene_.add_mesh(sd.mesh, seg->tissue_colour, body.X_world_body);
       scene_.mesh(seg->mesh).name = seg->label;
       for (const Vec3& v : sd.mesh.vertices) {
-        rest_bounds_W_.extend(body.X_world_body * v);
+        rest_bounds_world_.extend(body.X_world_body * v);
       }
       segments_[world.flat_segment(b, s)] = std::move(seg);
     }
   }
   // A floor just under the bodies, a little wider than them, with 1 cm checks for scale.
-  if (!rest_bounds_W_.isEmpty()) {
-    const Vec3 c = rest_bounds_W_.center();
-    const double half = 0.75 * rest_bounds_W_.sizes().head<2>().maxCoeff() + 0.05;
-    scene_.floor.height_m = rest_bounds_W_.min().z() - 0.002;
+  if (!rest_bounds_world_.isEmpty()) {
+    const Vec3 c = rest_bounds_world_.center();
+    const double half = 0.75 * rest_bounds_world_.sizes().head<2>().maxCoeff() + 0.05;
+    scene_.floor.height_m = rest_bounds_world_.min().z() - 0.002;
     scene_.floor.centre_x_m = c.x();
     scene_.floor.centre_y_m = c.y();
     scene_.floor.half_extent_m = half;
@@ -194,7 +194,7 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
   scene_.segments.clear();
   scene_.shadow_marks.clear();
   const double scale =
-      std::max(0.05, rest_bounds_W_.isEmpty() ? 0.1 : rest_bounds_W_.sizes().norm());
+      std::max(0.05, rest_bounds_world_.isEmpty() ? 0.1 : rest_bounds_world_.sizes().norm());
   for (std::size_t t = 0; t < tools_.size() && t < d.tools.size(); ++t) {
     const ToolState& tool = tools_[t];
     const double f = t < tool_force_n_.size() ? tool_force_n_[t] : 0.0;

@@ -1,9 +1,9 @@
-// A World as the renderer sees it (architecture.md#viewer): one mesh per segment, coloured by tissue (bone,
-// cartilage, ligament, muscle, skin) or per segment / per vertex group (the knee paper's Fig. 3),
-// the tools as spheres with their god-object proxies and force arrows, an 'x' shadow mark on the
-// floor under each tool, and optionally the sphere tree's spheres at one level. Updated each
-// frame from a WorldSnapshot (the viewer, off the haptic thread) or straight from the World (a
-// headless run, on the thread that steps it).
+// A World as the renderer sees it (architecture.md#viewer): one mesh per segment, coloured by
+// tissue (bone, cartilage, ligament, muscle, skin) or per segment / per vertex group (the knee
+// paper's Fig. 3), the tools as spheres with their god-object proxies and force arrows, an 'x'
+// shadow mark on the floor under each tool, and optionally the sphere tree's spheres at one level.
+// Updated each frame from a WorldSnapshot (the viewer, off the haptic thread) or straight from the
+// World (a headless run, on the thread that steps it).
 #pragma once
 
 #include "hapsim/render/render_scene.h"
@@ -57,7 +57,7 @@ class WorldScene {
   [[nodiscard]] RenderScene& scene() { return scene_; }
   [[nodiscard]] const RenderScene& scene() const { return scene_; }
   /// Bounds of the bodies at rest (for framing the camera).
-  [[nodiscard]] const Box3& rest_bounds_W() const { return rest_bounds_W_; }
+  [[nodiscard]] const Box3& rest_bounds_world() const { return rest_bounds_world_; }
 
   /// The colour of a material by its name (what kTissue uses), for legends.
   [[nodiscard]] static Vec3f tissue_colour(std::string_view material_name, int material_index);
@@ -74,7 +74,7 @@ class WorldScene {
   std::vector<Vec3> scratch_positions_;
   std::vector<ToolState> tools_;
   std::vector<double> tool_force_n_;
-  Box3 rest_bounds_W_;
+  Box3 rest_bounds_world_;
 };
 
 }  // namespace hapsim

@@ -6,16 +6,17 @@
 
 namespace hapsim {
 
-MouseProbe::MouseProbe(const Vec3& start_W, MouseProbeOptions options)
-    : options_(std::move(options)), p_W_(start_W) {
-  place(start_W);
+MouseProbe::MouseProbe(const Vec3& start_world, MouseProbeOptions options)
+    : options_(std::move(options)), p_world_(start_world) {
+  place(start_world);
 }
 
-void MouseProbe::place(const Vec3& p_W) {
-  if (!p_W.allFinite()) {
+void MouseProbe::place(const Vec3& p_world) {
+  if (!p_world.allFinite()) {
     return;
   }
-  p_W_ = p_W.cwiseMax(options_.workspace_W.min()).cwiseMin(options_.workspace_W.max());
+  p_world_ =
+      p_world.cwiseMax(options_.workspace_world.min()).cwiseMin(options_.workspace_world.max());
 }
 
 void MouseProbe::drag(double dx_px, double dy_px, const OrbitCamera& camera, int height_px) {
@@ -23,17 +24,18 @@ void MouseProbe::drag(double dx_px, double dy_px, const OrbitCamera& camera, int
     return;
   }
   // Metres per pixel at the probe's depth: the view's height there is 2·d·tan(fov/2).
-  const double depth_m = std::max((p_W_ - camera.eye_W()).dot(camera.forward_W()), camera.near_m());
+  const double depth_m =
+      std::max((p_world_ - camera.eye_world()).dot(camera.forward_world()), camera.near_m());
   const double m_per_px =
       2.0 * depth_m * std::tan(0.5 * camera.fov_y_rad) / static_cast<double>(height_px);
-  place(p_W_ + m_per_px * (dx_px * camera.right_W() - dy_px * camera.up_W()));
+  place(p_world_ + m_per_px * (dx_px * camera.right_world() - dy_px * camera.up_world()));
 }
 
 void MouseProbe::wheel(double steps, const OrbitCamera& camera) {
   if (!std::isfinite(steps)) {
     return;
   }
-  place(p_W_ + steps * options_.depth_step_m * camera.forward_W());
+  place(p_world_ + steps * options_.depth_step_m * camera.forward_world());
 }
 
 void MouseProbe::update_fingers(const std::array<bool, kMaxFingers>& held, double dt_s) {
@@ -46,7 +48,7 @@ void MouseProbe::update_fingers(const std::array<bool, kMaxFingers>& held, doubl
 
 DeviceInput MouseProbe::input() const {
   DeviceInput in;
-  in.p_world = p_W_;
+  in.p_world = p_world_;
   in.finger_count = kMaxFingers;
   in.finger_rad = finger_rad_;
   // A glove's joints per finger: MCP abduction, MCP flexion, PIP (the hand model couples DIP).

@@ -274,15 +274,15 @@ class Viewer {
     int fb_h = 0;
     glfwGetFramebufferSize(window_, &fb_w, &fb_h);
     const Viewport v = view_rect(fb_w, fb_h);
-    camera_ = framed_camera(session_->bounds_W(), static_cast<double>(v.w) / v.h, 1.95, 0.3);
-    probe_ = MouseProbe(session_->probe_start_W(), probe_options(session_->bounds_W()));
+    camera_ = framed_camera(session_->bounds_world(), static_cast<double>(v.w) / v.h, 1.95, 0.3);
+    probe_ = MouseProbe(session_->probe_start_world(), probe_options(session_->bounds_world()));
     forces_ = ForceGraph{};
   }
 
   static MouseProbeOptions probe_options(const Box3& bounds) {
     MouseProbeOptions o;
     const Vec3 margin = Vec3::Constant(0.5 * bounds.sizes().maxCoeff() + 0.1);
-    o.workspace_W = Box3(bounds.min() - margin, bounds.max() + margin);
+    o.workspace_world = Box3(bounds.min() - margin, bounds.max() + margin);
     return o;
   }
 
@@ -376,7 +376,7 @@ class Viewer {
     int fb_h = 0;
     glfwGetFramebufferSize(window_, &fb_w, &fb_h);
     const Viewport v = view_rect(fb_w, fb_h);
-    camera_.frame(session_->bounds_W(), static_cast<double>(v.w) / v.h, 1.05);
+    camera_.frame(session_->bounds_world(), static_cast<double>(v.w) / v.h, 1.05);
   }
 
   void draw_panels(int fb_w, int fb_h) {

@@ -1,13 +1,13 @@
-// What the viewer runs and shows (architecture.md#viewer): one scene on the real-time haptic loop with its
-// device, a render scene kept up to date from the loop's snapshots, and the figures of the data
-// area. A knee-type World and a teleoperation world each have one; the viewer rebuilds the
+// What the viewer runs and shows (architecture.md#viewer): one scene on the real-time haptic loop
+// with its device, a render scene kept up to date from the loop's snapshots, and the figures of the
+// data area. A knee-type World and a teleoperation world each have one; the viewer rebuilds the
 // session when the user picks another scene, device, contact method or deformation method.
 #pragma once
 
+#include "hapsim/core/device_io.h"
 #include "hapsim/force/contact_material.h"
 #include "hapsim/render/render_scene.h"
 #include "hapsim/runtime/haptic_loop.h"
-#include "hapsim/core/device_io.h"
 
 #include <filesystem>
 #include <optional>
@@ -65,13 +65,13 @@ class ViewerSession {
   /// Takes the newest snapshot from the haptic thread and updates the render scene.
   virtual void update() = 0;
   [[nodiscard]] virtual RenderScene& render_scene() = 0;
-  [[nodiscard]] virtual Box3 bounds_W() const = 0;
+  [[nodiscard]] virtual Box3 bounds_world() const = 0;
   [[nodiscard]] virtual const SessionReadout& readout() const = 0;
   [[nodiscard]] virtual HapticLoopStatus loop_status() const = 0;
   /// The probe's device when the config asked for the mouse (null otherwise).
   [[nodiscard]] virtual InteractiveDevice* mouse_device() = 0;
   /// Where the probe starts (in front of the scene, as seen from the default camera).
-  [[nodiscard]] virtual Vec3 probe_start_W() const = 0;
+  [[nodiscard]] virtual Vec3 probe_start_world() const = 0;
   [[nodiscard]] virtual const std::string& device_name() const = 0;
   [[nodiscard]] virtual const std::string& title() const = 0;
 

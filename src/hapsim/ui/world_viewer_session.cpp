@@ -41,9 +41,10 @@ std::string format_mm(const Vec3& p_m) {
 // glove the probe is the tracker: placed so that the fingertip nearest the scene (straight
 // fingers, the device's orientation) lands on that spot and the others are farther out: the hand
 // starts clear of the body.
-Vec3 probe_start_for(const WorldDescription& world, const Box3& bounds_W) {
+Vec3 probe_start_for(const WorldDescription& world, const Box3& bounds_world) {
   const Vec3 towards_viewer = Vec3(-0.2, 1.0, 0.0).normalized();
-  Vec3 p = bounds_W.center() + towards_viewer * (0.5 * bounds_W.sizes().head<2>().norm() + 0.03);
+  Vec3 p =
+      bounds_world.center() + towards_viewer * (0.5 * bounds_world.sizes().head<2>().norm() + 0.03);
   if (world.has_hand) {
     const HandModel hand(world.hand);
     const auto tips = hand.fingertips_world(GloveReading{});
@@ -103,15 +104,15 @@ class WorldViewerSession final : public ViewerSession {
                                             first.joint_rad[2]};
       hand_mapping.emplace(*world_->model().master(), first_arm);
       hand_mapping->set_probe_in_slave_frame(world_->description().teleop->mapping);
-      probe_start_W_ = hand_mapping->probe_for(first_arm);
+      probe_start_world_ = hand_mapping->probe_for(first_arm);
     } else {
       view_ = std::make_unique<WorldScene>(*world_);
-      probe_start_W_ = probe_start_for(scene_.world, view_->rest_bounds_W());
+      probe_start_world_ = probe_start_for(scene_.world, view_->rest_bounds_world());
     }
     const std::string target = hand_mapping ? " as the slave tool's target" : "";
     if (config.device == "mouse") {
       DeviceInput start;
-      start.p_world = probe_start_W_;
+      start.p_world = probe_start_world_;
       auto mouse = std::make_unique<InteractiveDevice>(
           profile, start, InteractiveDeviceOptions{.position_smoothing_s = 0.01});
       mouse_ = mouse.get();
@@ -124,7 +125,7 @@ class WorldViewerSession final : public ViewerSession {
     } else if (config.device == "spacemouse") {
 #if defined(HAPSIM_WITH_SPNAV)
       SpacenavOptions so;
-      so.start_p_world = probe_start_W_;
+      so.start_p_world = probe_start_world_;
       probe_ = std::make_unique<SpacenavDevice>(profile, so);
       device_name_ = "3D mouse (spacenavd)" + target;
 #else
@@ -228,8 +229,8 @@ class WorldViewerSession final : public ViewerSession {
   RenderScene& render_scene() override {
     return rig_view_ ? rig_view_->scene() : view_->scene();
   }
-  Box3 bounds_W() const override {
-    return rig_view_ ? rig_view_->rest_bounds_W() : view_->rest_bounds_W();
+  Box3 bounds_world() const override {
+    return rig_view_ ? rig_view_->rest_bounds_world() : view_->rest_bounds_world();
   }
   const SessionReadout& readout() const override {
     return readout_;
@@ -240,8 +241,8 @@ class WorldViewerSession final : public ViewerSession {
   InteractiveDevice* mouse_device() override {
     return mouse_;
   }
-  Vec3 probe_start_W() const override {
-    return probe_start_W_;
+  Vec3 probe_start_world() const override {
+    return probe_start_world_;
   }
   const std::string& device_name() const override {
     return device_name_;
@@ -475,7 +476,7 @@ class WorldViewerSession final : public ViewerSession {
   std::size_t recorded_dropped_ = 0;
   std::vector<ContactMaterial> materials_;  // the UI's copy (the world's is the haptic thread's)
   SessionReadout readout_;
-  Vec3 probe_start_W_ = Vec3::Zero();
+  Vec3 probe_start_world_ = Vec3::Zero();
   std::string device_name_;
   std::string title_;
   bool paused_ = false;
