@@ -6,6 +6,7 @@
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/geometry/procedural_knee.h"
+#include "hapsim/scene/csg_reader.h"
 #include "hapsim/scene/json_reader.h"
 #include "hapsim/world/device_io.h"
 
@@ -298,7 +299,7 @@ void Parser::parse_body(const Json& j, const std::string& ptr, WorldDescription&
 void Parser::parse_geometry(const Json& j, const std::string& ptr, BodyDescription& body,
                             std::vector<std::optional<TissueKind>>& tissues) {
   object(j, ptr, "a geometry");
-  const char* kinds[] = {"procedural", "box", "sphere", "sheet", "mesh", "mesh_folder"};
+  const char* kinds[] = {"procedural", "box", "sphere", "sheet", "mesh", "mesh_folder", "csg"};
   std::string kind;
   for (const char* k : kinds) {
     if (j.contains(k)) {
@@ -309,7 +310,8 @@ void Parser::parse_geometry(const Json& j, const std::string& ptr, BodyDescripti
     }
   }
   if (kind.empty()) {
-    fail(ptr, "expected one geometry kind: procedural, box, sphere, sheet, mesh or mesh_folder");
+    fail(ptr,
+         "expected one geometry kind: procedural, box, sphere, sheet, mesh, mesh_folder or csg");
   }
   const std::string kp = at(ptr, kind);
   auto add = [&](std::string name, TriangleMesh mesh, std::optional<TissueKind> tissue,
@@ -336,6 +338,13 @@ void Parser::parse_geometry(const Json& j, const std::string& ptr, BodyDescripti
     for (KneePart& part : make_procedural_knee(o)) {
       add(part.name, std::move(part.mesh), part.tissue);
     }
+    return;
+  }
+  if (kind == "csg") {
+    report_progress(options_.progress, "scene: polygonising the CSG solid of " + body.name, 0.0);
+    CsgGeometry g = read_csg_geometry(*this, j, ptr, options_.progress);
+    add(body.name, std::move(g.mesh), std::nullopt);
+    body.segments.back().csg = std::move(g.solid);
     return;
   }
   allow_keys(j, ptr, {kind.c_str()});

@@ -1,5 +1,6 @@
 #include "hapsim/world/world.h"
 
+#include "hapsim/collision/csg_query.h"
 #include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/collision/sphere_tree.h"
@@ -85,7 +86,15 @@ struct World::Tool {
 
 namespace {
 
-std::unique_ptr<ProximityQuery> make_query(ContactMethod method, const TriangleMesh& mesh) {
+// A CSG segment always answers from its solid's signed distance (exact, and cheaper than any
+// mesh structure), whatever the body's method: the method names how a *mesh* is searched, and
+// the polygonised mesh only approximates the solid (edges bevelled by about a cell).
+std::unique_ptr<ProximityQuery> make_query(ContactMethod method,
+                                           const SegmentDescription& segment) {
+  if (segment.csg) {
+    return std::make_unique<CsgQuery>(*segment.csg, segment.mesh);
+  }
+  const TriangleMesh& mesh = segment.mesh;
   switch (method) {
     case ContactMethod::kSphereTree:
       return std::make_unique<SphereTree>(mesh);
@@ -161,12 +170,12 @@ World::World(WorldDescription description, WorldOptions options)
       seg->X_world_body = body.X_world_body;
       seg->X_body_world = body.X_world_body.inverse();
       seg->rest_bounds_body = sd.mesh.bounds();
-      seg->rest_query = make_query(body.method, sd.mesh);
+      seg->rest_query = make_query(body.method, sd);
       if (body.kind == BodyKind::kDeformable) {
         VertexDeflectionOptions dopt;
         dopt.segments = {description_.materials[sd.material].deflection};
         dopt.typical_contact_radius_m = max_tool_radius_m;
-        if (body.method == ContactMethod::kKnee) {
+        if (body.method == ContactMethod::kKnee && !sd.csg) {
           // The knee paper moves vertices along their group's radial direction.
           const auto& knee = static_cast<const KneeIndex&>(*seg->rest_query);
           dopt.directions.resize(sd.mesh.vertex_count());
@@ -530,6 +539,11 @@ std::string content_hash(const WorldDescription& description_) {
       h.text(s.name);
       h.number(s.material);
       h.number(s.two_sided ? 1.0 : 0.0);
+      if (s.csg) {
+        // Contact comes from the solid, not the mesh; the mesh (hashed below) polygonises it.
+        h.text("csg");
+        h.number(static_cast<double>(s.csg->node_count()));
+      }
       for (const Vec3& v : s.mesh.vertices) {
         h.bytes(v.data(), sizeof(double) * 3);
       }
