@@ -223,8 +223,8 @@ Json small_scene() {
 
 TEST(SceneSchema, ShippedScenesAndASmallSceneSatisfyIt) {
   const SchemaValidator v = schema();
-  for (const char* name :
-       {"knee.json", "knee_vhf.json", "knee_hand.json", "teleop.json", "teleop_gp7.json"}) {
+  for (const char* name : {"knee.json", "knee_vhf.json", "knee_hand.json", "teleop.json",
+                           "teleop_gp7.json", "csg_block.json"}) {
     EXPECT_EQ(v.validate(read_json(kScenes / name)), "") << name;
   }
   EXPECT_EQ(v.validate(small_scene()), "");
@@ -232,6 +232,66 @@ TEST(SceneSchema, ShippedScenesAndASmallSceneSatisfyIt) {
   const fs::path file = fs::temp_directory_path() / "hapsim_schema_small_scene.json";
   std::ofstream(file) << small_scene().dump();
   EXPECT_NO_THROW((void)load_scene(file));
+  fs::remove(file);
+}
+
+// The small scene with its block as a CSG solid using every kind of node.
+Json small_csg_scene() {
+  Json j = small_scene();
+  j["bodies"][0]["geometry"] = Json::parse(R"({ "resolution_m": 0.002, "csg": { "difference": [
+      { "union": [ { "box": { "half_extents_m": [0.02, 0.02, 0.02] } },
+                   { "cone": { "radius_m": 0.01, "height_m": 0.01 },
+                     "pose": { "position_m": [0, 0, 0.02] } } ] },
+      { "intersection": [ { "cylinder": { "radius_m": 0.005, "half_height_m": 0.03 } },
+                          { "sphere": { "radius_m": 0.025 } } ] },
+      { "torus": { "major_radius_m": 0.02, "minor_radius_m": 0.003 },
+        "pose": { "rotation_deg": [90, 0, 0] } } ] } })");
+  return j;
+}
+
+TEST(SceneSchema, ACsgSceneSatisfiesIt) {
+  EXPECT_EQ(schema().validate(small_csg_scene()), "");
+  const fs::path file = fs::temp_directory_path() / "hapsim_schema_csg_scene.json";
+  std::ofstream(file) << small_csg_scene().dump();
+  EXPECT_NO_THROW((void)load_scene(file));
+  fs::remove(file);
+}
+
+TEST(SceneSchema, BadCsgScenesAreRefusedByTheSchemaAndTheLoader) {
+  struct Case {
+    const char* name;
+    std::function<void(Json&)> change;
+  };
+  Json& (*csg)(Json&) = [](Json& j) -> Json& { return j["bodies"][0]["geometry"]["csg"]; };
+  const Case cases[] = {
+      {"unknown solid kind",
+       [&](Json& j) {
+         csg(j) = {{"pyramid", {{"radius_m", 0.01}}}};
+       }},
+      {"two kinds in a node",
+       [&](Json& j) {
+         csg(j)["difference"][2]["sphere"] = {{"radius_m", 0.01}};
+       }},
+      {"one-child list", [&](Json& j) { csg(j)["difference"][0]["union"].erase(1); }},
+      {"empty list", [&](Json& j) { csg(j)["difference"][1]["intersection"] = Json::array(); }},
+      {"zero radius",
+       [&](Json& j) { csg(j)["difference"][1]["intersection"][1]["sphere"]["radius_m"] = 0; }},
+      {"negative half extent",
+       [&](Json& j) { csg(j)["difference"][0]["union"][0]["box"]["half_extents_m"][1] = -0.02; }},
+      {"misspelt key", [&](Json& j) { csg(j)["difference"][2]["torus"]["minor_radius"] = 0.003; }},
+      {"bad node pose", [&](Json& j) { csg(j)["difference"][2]["pose"]["scale"] = 2; }},
+      {"zero resolution", [](Json& j) { j["bodies"][0]["geometry"]["resolution_m"] = 0; }},
+  };
+  const SchemaValidator v = schema();
+  const fs::path file = fs::temp_directory_path() / "hapsim_schema_bad_csg_scene.json";
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    Json scene = small_csg_scene();
+    c.change(scene);
+    EXPECT_NE(v.validate(scene), "") << "the schema accepts it";
+    std::ofstream(file) << scene.dump();
+    EXPECT_THROW((void)load_scene(file), Error) << "the loader accepts it";
+  }
   fs::remove(file);
 }
 

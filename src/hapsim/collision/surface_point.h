@@ -6,6 +6,9 @@
 
 namespace hapsim {
 
+/// SurfacePoint::triangle of an answer from a signed distance field rather than a mesh triangle.
+inline constexpr std::uint32_t kSdfSurface = kNoTriangle - 1;
+
 struct SurfacePoint {
   /// Closest point on the surface, in the mesh's frame (metres).
   Vec3 point = Vec3::Zero();
@@ -14,7 +17,8 @@ struct SurfacePoint {
   Vec3 normal = Vec3::Zero();
   /// Distance to the surface, negative inside the body (metres).
   double signed_distance = kInf;
-  /// Index of the triangle that holds `point`; kNoTriangle if the query found nothing.
+  /// Index of the triangle that holds `point`; kNoTriangle if the query found nothing;
+  /// kSdfSurface when a signed distance field answered (CsgQuery): found, but no triangle.
   std::uint32_t triangle = kNoTriangle;
 
   [[nodiscard]] bool found() const { return triangle != kNoTriangle; }

@@ -366,6 +366,10 @@ double CsgSolid::distance(const Vec3& p_S) const {
   return evaluate(p_S).distance_m;
 }
 
+std::size_t CsgSolid::memory_bytes() const {
+  return node_count() * sizeof(Node);
+}
+
 Box3 CsgSolid::bounds() const {
   return node_ ? node_->bounds : Box3();
 }

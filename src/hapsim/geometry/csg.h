@@ -82,6 +82,8 @@ class CsgSolid {
   [[nodiscard]] bool is_empty() const { return node_ == nullptr; }
   /// Number of nodes in the tree (primitives, booleans and transforms); 0 when empty.
   [[nodiscard]] std::size_t node_count() const;
+  /// Bytes of the tree's nodes (shared subtrees counted once per use: an upper bound).
+  [[nodiscard]] std::size_t memory_bytes() const;
 
   friend CsgSolid csg_union(const CsgSolid& a, const CsgSolid& b);
   friend CsgSolid csg_intersection(const CsgSolid& a, const CsgSolid& b);
@@ -99,8 +101,14 @@ CsgSolid csg_intersection(const CsgSolid& a, const CsgSolid& b);
 /// a − b = a ∩ complement(b) (distance max(a, −b)).
 CsgSolid csg_difference(const CsgSolid& a, const CsgSolid& b);
 
-inline CsgSolid operator|(const CsgSolid& a, const CsgSolid& b) { return csg_union(a, b); }
-inline CsgSolid operator&(const CsgSolid& a, const CsgSolid& b) { return csg_intersection(a, b); }
-inline CsgSolid operator-(const CsgSolid& a, const CsgSolid& b) { return csg_difference(a, b); }
+inline CsgSolid operator|(const CsgSolid& a, const CsgSolid& b) {
+  return csg_union(a, b);
+}
+inline CsgSolid operator&(const CsgSolid& a, const CsgSolid& b) {
+  return csg_intersection(a, b);
+}
+inline CsgSolid operator-(const CsgSolid& a, const CsgSolid& b) {
+  return csg_difference(a, b);
+}
 
 }  // namespace hapsim

@@ -7,6 +7,8 @@
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/geometry/procedural_knee.h"
 #include "hapsim/core/device_io.h"
+#include "hapsim/scene/csg_reader.h"
+#include "hapsim/scene/json_reader.h"
 
 #include <nlohmann/json.hpp>
 
@@ -24,198 +26,22 @@ namespace {
 
 using Json = nlohmann::json;
 
-std::string type_name(const Json& j) {
-  switch (j.type()) {
-    case Json::value_t::null:
-      return "null";
-    case Json::value_t::object:
-      return "an object";
-    case Json::value_t::array:
-      return "an array";
-    case Json::value_t::string:
-      return "a string";
-    case Json::value_t::boolean:
-      return "a boolean";
-    case Json::value_t::number_integer:
-    case Json::value_t::number_unsigned:
-    case Json::value_t::number_float:
-      return "a number";
-    default:
-      return "something else";
-  }
-}
-
-std::string shown(const Json& j) {
-  std::string s = j.dump();
-  if (s.size() > 40) {
-    s = s.substr(0, 37) + "...";
-  }
-  return s;
-}
-
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
 }
 
-// JSON pointer escaping (RFC 6901) for keys that contain '/' or '~'.
-std::string escape_key(const std::string& key) {
-  std::string out;
-  for (char c : key) {
-    if (c == '~') {
-      out += "~0";
-    } else if (c == '/') {
-      out += "~1";
-    } else {
-      out += c;
-    }
-  }
-  return out;
-}
-
 // The parser: carries the file name for messages, the folders paths resolve against, and the
 // materials and bodies read so far for cross-references.
-class Parser {
+class Parser : public JsonReader {
  public:
   Parser(std::filesystem::path file, const SceneLoadOptions& options)
-      : file_(std::move(file)), options_(options) {}
+      : JsonReader(std::move(file)), options_(options) {}
 
   SceneDescription parse(const Json& root);
 
  private:
-  [[noreturn]] void fail(const std::string& ptr, const std::string& what) const {
-    throw Error(file_.string() + ":" + (ptr.empty() ? "/" : ptr), what);
-  }
-
-  static std::string at(const std::string& ptr, const std::string& key) {
-    return ptr + "/" + escape_key(key);
-  }
-  static std::string at(const std::string& ptr, std::size_t index) {
-    return ptr + "/" + std::to_string(index);
-  }
-
-  const Json& object(const Json& j, const std::string& ptr, const std::string& what) const {
-    if (!j.is_object()) {
-      fail(ptr, "expected " + what + " (a JSON object), got " + type_name(j));
-    }
-    return j;
-  }
-  const Json& array(const Json& j, const std::string& ptr, const std::string& what) const {
-    if (!j.is_array()) {
-      fail(ptr, "expected " + what + " (a JSON array), got " + type_name(j));
-    }
-    return j;
-  }
-
-  void allow_keys(const Json& obj, const std::string& ptr,
-                  std::initializer_list<const char*> allowed) const {
-    for (const auto& item : obj.items()) {
-      const std::string& key = item.key();
-      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
-        std::string list;
-        for (const char* a : allowed) {
-          list += list.empty() ? "" : ", ";
-          list += a;
-        }
-        std::string what = "unknown key '";
-        what += key;
-        what += "'; allowed here: ";
-        what += list;
-        fail(at(ptr, key), what);
-      }
-    }
-  }
-
-  const Json& required(const Json& obj, const std::string& ptr, const char* key) const {
-    if (!obj.contains(key)) {
-      fail(ptr, std::string("missing required key '") + key + "'");
-    }
-    return obj.at(key);
-  }
-
-  double number(const Json& j, const std::string& ptr, const std::string& unit) const {
-    if (!j.is_number()) {
-      fail(ptr, "expected a number" + (unit.empty() ? "" : " in " + unit) + ", got " +
-                    type_name(j) + " " + shown(j));
-    }
-    const double v = j.get<double>();
-    if (!std::isfinite(v)) {
-      fail(ptr, "expected a finite number" + (unit.empty() ? "" : " in " + unit));
-    }
-    return v;
-  }
-
-  // A number in [lo, hi] (open at lo when lo_open), or the default when the key is absent.
-  double number_in(const Json& obj, const std::string& ptr, const char* key, double fallback,
-                   double lo, double hi, const std::string& unit, bool lo_open = false,
-                   bool inf_allowed = false) const {
-    if (!obj.contains(key)) {
-      return fallback;
-    }
-    const std::string p = at(ptr, key);
-    const Json& j = obj.at(key);
-    if (inf_allowed && j.is_string() && j.get<std::string>() == "inf") {
-      return kInf;
-    }
-    const double v = number(j, p, unit);
-    if (v < lo || (lo_open && v == lo) || v > hi) {
-      std::ostringstream range;
-      range << (lo_open ? "> " : ">= ") << lo;
-      if (std::isfinite(hi)) {
-        range << " and <= " << hi;
-      }
-      fail(p, "expected a number " + range.str() + (unit.empty() ? "" : " in " + unit) + ", got " +
-                  shown(j));
-    }
-    return v;
-  }
-
-  std::string string(const Json& j, const std::string& ptr, const std::string& what) const {
-    if (!j.is_string()) {
-      fail(ptr, "expected " + what + " (a string), got " + type_name(j));
-    }
-    return j.get<std::string>();
-  }
-
-  std::string nonempty_string(const Json& j, const std::string& ptr,
-                              const std::string& what) const {
-    std::string s = string(j, ptr, what);
-    if (s.empty()) {
-      fail(ptr, "expected " + what + ", got an empty string");
-    }
-    return s;
-  }
-
-  std::string one_of(const Json& j, const std::string& ptr,
-                     std::initializer_list<const char*> choices) const {
-    std::string list;
-    for (const char* c : choices) {
-      list += (list.empty() ? "'" : ", '") + std::string(c) + "'";
-    }
-    if (j.is_string()) {
-      std::string s = j.get<std::string>();
-      for (const char* c : choices) {
-        if (s == c) {
-          return s;
-        }
-      }
-    }
-    fail(ptr, "expected one of " + list + ", got " + shown(j));
-  }
-
-  Vec3 vec3(const Json& j, const std::string& ptr, const std::string& unit) const {
-    if (!j.is_array() || j.size() != 3) {
-      fail(ptr, "expected [x, y, z] (3 numbers" + (unit.empty() ? "" : " in " + unit) + "), got " +
-                    shown(j));
-    }
-    Vec3 v;
-    for (std::size_t i = 0; i < 3; ++i) {
-      v[static_cast<Eigen::Index>(i)] = number(j[i], at(ptr, i), unit);
-    }
-    return v;
-  }
-
   std::filesystem::path path(const Json& j, const std::string& ptr, const std::string& what) {
     const std::string s = nonempty_string(j, ptr, what);
     if (s.rfind("data:", 0) == 0) {
@@ -255,7 +81,6 @@ class Parser {
                       std::vector<std::optional<TissueKind>>& tissues);
   void parse_body_materials(const Json& j, const std::string& ptr, BodyDescription& body,
                             const std::vector<std::optional<TissueKind>>& tissues);
-  Iso3 parse_pose(const Json& j, const std::string& ptr) const;
   ToolDescription parse_tool(const Json& j, const std::string& ptr) const;
   void parse_device(const Json& j, const std::string& ptr, SceneDescription& scene);
   void parse_teleop(const Json& j, const std::string& ptr, TeleopSceneDescription& t);
@@ -264,7 +89,6 @@ class Parser {
   void parse_glove_palpation(const Json& j, const std::string& ptr, SceneDescription& scene) const;
   std::uint32_t material_ref(const Json& j, const std::string& ptr) const;
 
-  std::filesystem::path file_;
   SceneLoadOptions options_;
   std::string data_default_;
   std::map<std::string, std::uint32_t> material_index_;
@@ -445,41 +269,6 @@ std::uint32_t Parser::material_ref(const Json& j, const std::string& ptr) const 
   return it->second;
 }
 
-Iso3 Parser::parse_pose(const Json& j, const std::string& ptr) const {
-  object(j, ptr, "a pose");
-  allow_keys(j, ptr, {"position_m", "rotation_deg", "quaternion_wxyz"});
-  Iso3 X = Iso3::Identity();
-  if (j.contains("position_m")) {
-    X.translation() = vec3(j["position_m"], at(ptr, "position_m"), "m");
-  }
-  if (j.contains("rotation_deg") && j.contains("quaternion_wxyz")) {
-    fail(ptr, "expected one of 'rotation_deg' or 'quaternion_wxyz', not both");
-  }
-  if (j.contains("rotation_deg")) {
-    const Vec3 deg = vec3(j["rotation_deg"], at(ptr, "rotation_deg"), "degrees");
-    const Vec3 rad = deg * (3.14159265358979323846 / 180.0);
-    // Fixed-axis x, then y, then z: R = Rz * Ry * Rx.
-    X.linear() =
-        (Eigen::AngleAxisd(rad.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rad.y(), Vec3::UnitY()) *
-         Eigen::AngleAxisd(rad.x(), Vec3::UnitX()))
-            .toRotationMatrix();
-  }
-  if (j.contains("quaternion_wxyz")) {
-    const std::string qp = at(ptr, "quaternion_wxyz");
-    const Json& q = j["quaternion_wxyz"];
-    if (!q.is_array() || q.size() != 4) {
-      fail(qp, "expected [w, x, y, z], got " + shown(q));
-    }
-    Quat quat(number(q[0], at(qp, std::size_t{0}), ""), number(q[1], at(qp, 1), ""),
-              number(q[2], at(qp, 2), ""), number(q[3], at(qp, 3), ""));
-    if (std::abs(quat.norm() - 1.0) > 1e-6) {
-      fail(qp, "expected a unit quaternion, got norm " + std::to_string(quat.norm()));
-    }
-    X.linear() = quat.normalized().toRotationMatrix();
-  }
-  return X;
-}
-
 void Parser::parse_body(const Json& j, const std::string& ptr, WorldDescription& world) {
   object(j, ptr, "a body");
   allow_keys(j, ptr, {"name", "type", "pose", "contact_method", "geometry", "materials"});
@@ -510,7 +299,7 @@ void Parser::parse_body(const Json& j, const std::string& ptr, WorldDescription&
 void Parser::parse_geometry(const Json& j, const std::string& ptr, BodyDescription& body,
                             std::vector<std::optional<TissueKind>>& tissues) {
   object(j, ptr, "a geometry");
-  const char* kinds[] = {"procedural", "box", "sphere", "sheet", "mesh", "mesh_folder"};
+  const char* kinds[] = {"procedural", "box", "sphere", "sheet", "mesh", "mesh_folder", "csg"};
   std::string kind;
   for (const char* k : kinds) {
     if (j.contains(k)) {
@@ -521,7 +310,8 @@ void Parser::parse_geometry(const Json& j, const std::string& ptr, BodyDescripti
     }
   }
   if (kind.empty()) {
-    fail(ptr, "expected one geometry kind: procedural, box, sphere, sheet, mesh or mesh_folder");
+    fail(ptr,
+         "expected one geometry kind: procedural, box, sphere, sheet, mesh, mesh_folder or csg");
   }
   const std::string kp = at(ptr, kind);
   auto add = [&](std::string name, TriangleMesh mesh, std::optional<TissueKind> tissue,
@@ -548,6 +338,13 @@ void Parser::parse_geometry(const Json& j, const std::string& ptr, BodyDescripti
     for (KneePart& part : make_procedural_knee(o)) {
       add(part.name, std::move(part.mesh), part.tissue);
     }
+    return;
+  }
+  if (kind == "csg") {
+    report_progress(options_.progress, "scene: polygonising the CSG solid of " + body.name, 0.0);
+    CsgGeometry g = read_csg_geometry(*this, j, ptr, options_.progress);
+    add(body.name, std::move(g.mesh), std::nullopt);
+    body.segments.back().csg = std::move(g.solid);
     return;
   }
   allow_keys(j, ptr, {kind.c_str()});

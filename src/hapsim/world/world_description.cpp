@@ -96,6 +96,11 @@ std::string content_hash(const WorldDescription& description) {
       h.text(s.name);
       h.number(s.material);
       h.number(s.two_sided ? 1.0 : 0.0);
+      if (s.csg) {
+        // Contact comes from the solid, not the mesh; the mesh (hashed below) polygonises it.
+        h.text("csg");
+        h.number(static_cast<double>(s.csg->node_count()));
+      }
       for (const Vec3& v : s.mesh.vertices) {
         h.bytes(v.data(), sizeof(double) * 3);
       }

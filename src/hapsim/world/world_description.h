@@ -11,6 +11,7 @@
 #include "hapsim/dynamics/parallel_gripper.h"
 #include "hapsim/dynamics/rigid_ball.h"
 #include "hapsim/force/contact_material.h"
+#include "hapsim/geometry/csg.h"
 #include "hapsim/geometry/triangle_mesh.h"
 #include "hapsim/kinematics/hand_model.h"
 #include "hapsim/kinematics/master_arm.h"
@@ -41,6 +42,7 @@ enum class ContactMethod : std::uint8_t {
   kExact,       ///< MeshBvh: exact closest point (the reference).
   kSphereTree,  ///< SphereTree: sphere hierarchy, refined exactly.
   kKnee,        ///< KneeIndex: the knee paper's groups and plane test (approximate).
+  // CSG segments ignore the method: they always use CsgQuery (SegmentDescription::csg).
 };
 
 enum class BodyKind : std::uint8_t {
@@ -67,10 +69,14 @@ struct SegmentDescription {
   std::string name;
   /// Index into WorldDescription::materials.
   std::uint32_t material = 0;
-  /// In the body frame, metres. Closed and outward-oriented unless two_sided.
+  /// In the body frame, metres. Closed and outward-oriented unless two_sided. For a CSG segment,
+  /// the solid polygonised: display, sphere trees, deflection and the content hash use it.
   TriangleMesh mesh;
   /// Open surface (a sheet): both sides are outside.
   bool two_sided = false;
+  /// A CSG solid (body frame) that `mesh` polygonises: contact then comes from its signed
+  /// distance (CsgQuery), whatever the body's contact method.
+  std::optional<CsgSolid> csg;
 };
 
 struct BodyDescription {

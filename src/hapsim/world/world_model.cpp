@@ -1,5 +1,6 @@
 #include "hapsim/world/world_model.h"
 
+#include "hapsim/collision/csg_query.h"
 #include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/collision/sphere_tree.h"
@@ -15,7 +16,15 @@ namespace hapsim {
 
 namespace {
 
-std::unique_ptr<ProximityQuery> make_query(ContactMethod method, const TriangleMesh& mesh) {
+// A CSG segment always answers from its solid's signed distance (exact, and cheaper than any
+// mesh structure), whatever the body's method: the method names how a *mesh* is searched, and
+// the polygonised mesh only approximates the solid (edges bevelled by about a cell).
+std::unique_ptr<ProximityQuery> make_query(ContactMethod method,
+                                           const SegmentDescription& segment) {
+  if (segment.csg) {
+    return std::make_unique<CsgQuery>(*segment.csg, segment.mesh);
+  }
+  const TriangleMesh& mesh = segment.mesh;
   switch (method) {
     case ContactMethod::kSphereTree:
       return std::make_unique<SphereTree>(mesh);
@@ -94,7 +103,7 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
       seg.X_world_body = body.X_world_body;
       seg.X_body_world = body.X_world_body.inverse();
       seg.rest_bounds_body = sd.mesh.bounds();
-      seg.rest_query = make_query(body.method, sd.mesh);
+      seg.rest_query = make_query(body.method, sd);
       (seg.response == ContactResponse::kProxy ? proxy_segments_ : penalty_segments_) += 1;
       segments_.push_back(std::move(seg));
     }
