@@ -1,11 +1,15 @@
-// `hapsim query MESH --points FILE.csv --method exact|spheretree`: signed distance, closest
-// point, normal and triangle for each point, in the input's order and units.
+// `hapsim query MESH --points FILE.csv --method exact|spheretree|knee`: signed distance, closest
+// point, normal and triangle for each point, in the input's order and units. An approximate
+// method (the knee paper's) also reports its error against the exact query on the same points.
 #include "commands.h"
 #include "mesh_argument.h"
 #include "points_csv.h"
 
+#include "hapsim/collision/knee_error.h"
+#include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/collision/sphere_tree.h"
+#include "hapsim/core/statistics.h"
 #include "hapsim/core/stopwatch.h"
 
 #include <nlohmann/json.hpp>
@@ -15,6 +19,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <optional>
 
 namespace hapsim::app {
 namespace {
@@ -48,8 +53,8 @@ void write_row(std::FILE* f, const Vec3& p, const SurfacePoint& s, double to_uni
 }
 
 void run_query(const QueryOptions& opt) {
-  if (opt.method != "exact" && opt.method != "spheretree") {
-    throw CommandError("--method: expected exact or spheretree, got '" + opt.method + "'");
+  if (opt.method != "exact" && opt.method != "spheretree" && opt.method != "knee") {
+    throw CommandError("--method: expected exact, spheretree or knee, got '" + opt.method + "'");
   }
   // Read the points before the (possibly slow) mesh load so a bad file fails fast.
   const std::vector<Vec3> points_units =
@@ -61,8 +66,10 @@ void run_query(const QueryOptions& opt) {
   std::unique_ptr<ProximityQuery> query;
   if (opt.method == "exact") {
     query = std::make_unique<MeshBvh>(arg.mesh);
-  } else {
+  } else if (opt.method == "spheretree") {
     query = std::make_unique<SphereTree>(arg.mesh);
+  } else {
+    query = std::make_unique<KneeIndex>(arg.mesh);
   }
 
   std::FILE* out = stdout;
@@ -93,9 +100,9 @@ void run_query(const QueryOptions& opt) {
   if (out != stdout) {
     std::fclose(out);
   }
-  std::sort(query_ns.begin(), query_ns.end());
-  const double median_ns = query_ns[query_ns.size() / 2];
-  const double p99_ns = query_ns[std::min(query_ns.size() - 1, query_ns.size() * 99 / 100)];
+  const SampleSummary cost = summarize_samples(query_ns);
+  const double median_ns = cost.p50;
+  const double p99_ns = cost.p99;
   // The summary goes to stderr when the CSV is on stdout, so pipes stay clean.
   std::FILE* info = out == stdout ? stderr : stdout;
   std::fprintf(info,
@@ -103,6 +110,26 @@ void run_query(const QueryOptions& opt) {
                "distance %.4g .. %.4g mm; %.0f ns median, %.0f ns p99 per query\n",
                points_units.size(), arg.name.c_str(), arg.mesh.triangle_count(), opt.method.c_str(),
                inside, min_distance * 1e3, max_distance * 1e3, median_ns, p99_ns);
+  // An approximate method's error against the exact query, on the points near the surface (the
+  // knee method answers only near the body: farther than kErrorBand_m outside is not compared).
+  constexpr double kErrorBand_m = 0.01;
+  std::optional<ApproximationError> error;
+  if (opt.method == "knee") {
+    std::vector<Vec3> points_m;
+    points_m.reserve(points_units.size());
+    for (const Vec3& p : points_units) {
+      points_m.push_back(p * opt.scale);
+    }
+    const MeshBvh exact(arg.mesh);
+    error = measure_approximation_error(*query, exact, points_m, kErrorBand_m);
+    std::fprintf(info,
+                 "error vs exact on the %zu points within %.0f mm of the surface: |distance "
+                 "error| mean %.3f mm, p95 %.3f mm, max %.3f mm; %zu answered; %zu missed "
+                 "contact(s) of %zu, %zu false contact(s)\n",
+                 error->points, kErrorBand_m * 1e3, error->mean_abs_error_m * 1e3,
+                 error->p95_abs_error_m * 1e3, error->max_abs_error_m * 1e3, error->answered,
+                 error->misses, error->reference_contacts, error->false_contacts);
+  }
   if (!opt.json_path.empty()) {
     const nlohmann::json j = {{"mesh", arg.name},
                               {"triangles", arg.mesh.triangle_count()},
@@ -113,11 +140,23 @@ void run_query(const QueryOptions& opt) {
                               {"max_signed_distance_m", max_distance},
                               {"median_ns", median_ns},
                               {"p99_ns", p99_ns}};
+    nlohmann::json full = j;
+    if (error) {
+      full["error_vs_exact"] = {{"band_m", kErrorBand_m},
+                                {"points", error->points},
+                                {"answered", error->answered},
+                                {"mean_abs_error_m", error->mean_abs_error_m},
+                                {"p95_abs_error_m", error->p95_abs_error_m},
+                                {"max_abs_error_m", error->max_abs_error_m},
+                                {"reference_contacts", error->reference_contacts},
+                                {"misses", error->misses},
+                                {"false_contacts", error->false_contacts}};
+    }
     std::ofstream js(opt.json_path);
     if (!js) {
       throw CommandError(opt.json_path + ": cannot write the JSON file");
     }
-    js << j.dump(2) << "\n";
+    js << full.dump(2) << "\n";
   }
 }
 
@@ -132,7 +171,11 @@ void add_query_command(CLI::App& app) {
   cmd->add_option("--points", opt->points,
                   "CSV of x,y,z rows in mesh units (header optional), or builtin:probe-path")
       ->required();
-  cmd->add_option("--method", opt->method, "exact (BVH) or spheretree")->capture_default_str();
+  cmd->add_option(
+         "--method", opt->method,
+         "exact (BVH), spheretree or knee (the knee paper's groups; also reports its error "
+         "against exact)")
+      ->capture_default_str();
   cmd->add_option("--scale", opt->scale, "Mesh units to metres (e.g. 0.001 for millimetres)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--out", opt->out_path, "Write the CSV here instead of standard output");

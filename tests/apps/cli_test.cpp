@@ -3,6 +3,7 @@
 #include "hapsim_process.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -98,6 +99,48 @@ TEST(Cli, QueryAnswersMatchTheBoxAnalytically) {
     EXPECT_NEAR(rows[3][3], -0.001, 1e-12) << method;                  // 1 mm under the top face
     EXPECT_NEAR(rows[3][9], 1.0, 1e-12) << method;                     // normal +z
   }
+}
+
+// The knee method is a method like the others: it answers the query, and reports its error
+// against the exact query — checked here against the difference of the two methods' own answers.
+TEST(Cli, QueryKneeMethodReportsItsErrorAgainstExact) {
+  const auto knee_csv = hapsim::test::temp_path("knee_out.csv");
+  const auto exact_csv = hapsim::test::temp_path("exact_out.csv");
+  const auto json = hapsim::test::temp_path("knee_query.json");
+  const RunResult r = run_hapsim(
+      "query builtin:bumpy-sphere --method knee --points "
+      "builtin:probe-path --out " +
+      knee_csv.string() + " --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("error vs exact"), std::string::npos) << r.output;
+  ASSERT_EQ(run_hapsim("query builtin:bumpy-sphere --method exact --points builtin:probe-path "
+                       "--out " +
+                       exact_csv.string())
+                .exit_code,
+            0);
+  const auto knee = read_csv_numbers(knee_csv);
+  const auto exact = read_csv_numbers(exact_csv);
+  ASSERT_EQ(knee.size(), exact.size());
+  double max_error = 0.0;
+  double sum_error = 0.0;
+  std::size_t compared = 0;
+  for (std::size_t i = 0; i < knee.size(); ++i) {
+    const bool knee_answered = knee[i][10] != 4294967295.0;
+    if (exact[i][3] > 0.01 || !knee_answered) {
+      continue;  // beyond the 10 mm band, or not answered: not part of the distance error
+    }
+    ++compared;
+    max_error = std::max(max_error, std::abs(knee[i][3] - exact[i][3]));
+    sum_error += std::abs(knee[i][3] - exact[i][3]);
+  }
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  const nlohmann::json& e = j.at("error_vs_exact");
+  EXPECT_EQ(e.at("answered").get<std::size_t>(), compared);
+  EXPECT_NEAR(e.at("max_abs_error_m").get<double>(), max_error, 1e-12);
+  EXPECT_NEAR(e.at("mean_abs_error_m").get<double>(), sum_error / static_cast<double>(compared),
+              1e-12);
+  EXPECT_GT(max_error, 0.0);  // approximate (deep inside the body it is far off: see the summary)
 }
 
 TEST(Cli, ScaleConvertsUnitsBothWays) {

@@ -1,5 +1,7 @@
 #include "hapsim/collision/knee_error.h"
 
+#include "hapsim/core/statistics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -36,11 +38,8 @@ ApproximationError measure_approximation_error(const ProximityQuery& method,
       sum += e;
     }
     err.mean_abs_error_m = sum / static_cast<double>(abs_errors.size());
-    const auto k95 =
-        static_cast<std::ptrdiff_t>(std::ceil(0.95 * static_cast<double>(abs_errors.size())) - 1);
-    std::nth_element(abs_errors.begin(), abs_errors.begin() + k95, abs_errors.end());
-    err.p95_abs_error_m = abs_errors[static_cast<std::size_t>(k95)];
     err.max_abs_error_m = *std::max_element(abs_errors.begin(), abs_errors.end());
+    err.p95_abs_error_m = nearest_rank_percentile(abs_errors, 0.95);
   }
   if (err.reference_contacts > 0) {
     err.miss_rate = static_cast<double>(err.misses) / static_cast<double>(err.reference_contacts);
