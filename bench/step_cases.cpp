@@ -1,5 +1,7 @@
 #include "bench/step_cases.h"
 
+#include "hapsim/collision/knee_error.h"
+#include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/core/error.h"
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/run_setup.h"
@@ -88,6 +90,30 @@ std::vector<StepRow> run_step_bench(const StepBenchOptions& options) {
         row.peak_force_n = std::max(row.peak_force_n, t.peak_force_n);
       }
       row.pop_throughs = s.pop_throughs;
+      if (method != "exact") {
+        // The method's error against the exact query on each segment's rest surface, the one
+        // the step uses (outside the timed run).
+        std::size_t contacts = 0;
+        std::size_t misses = 0;
+        row.error_p95_m = 0.0;
+        row.error_max_m = 0.0;
+        for (std::size_t b = 0; b < world.body_count(); ++b) {
+          for (std::size_t seg = 0; seg < world.segment_count(b); ++seg) {
+            const TriangleMesh& mesh = world.description().bodies[b].segments[seg].mesh;
+            const MeshBvh exact(mesh);
+            const std::vector<Vec3> points =
+                sample_surface_band(mesh, kErrorPointsPerSegment, 0.005);
+            const ApproximationError e =
+                measure_approximation_error(world.rest_query(b, seg), exact, points, 0.005);
+            row.error_p95_m = std::max(row.error_p95_m, e.p95_abs_error_m);
+            row.error_max_m = std::max(row.error_max_m, e.max_abs_error_m);
+            contacts += e.reference_contacts;
+            misses += e.misses;
+          }
+        }
+        row.error_miss_rate =
+            contacts > 0 ? static_cast<double>(misses) / static_cast<double>(contacts) : 0.0;
+      }
       rows.push_back(row);
       ++done;
     }
@@ -123,6 +149,24 @@ std::string format_step_table(const std::vector<StepRow>& rows) {
         r.p50_ratio_to_exact, r.p99_ratio_to_exact, r.contact_steps, r.pop_throughs);
     out << line;
   }
+  bool any_error = false;
+  for (const StepRow& r : rows) {
+    if (r.error_p95_m < 0.0) {
+      continue;
+    }
+    if (!any_error) {
+      std::snprintf(line, sizeof line,
+                    "error vs exact (%zu points per segment within 5 mm of its surface):\n",
+                    kErrorPointsPerSegment);
+      out << line;
+      any_error = true;
+    }
+    std::snprintf(line, sizeof line,
+                  "  %-15s %-11s worst segment p95 %.3f mm, max %.3f mm, missed contacts %.2f %%\n",
+                  r.case_name.c_str(), r.method.c_str(), r.error_p95_m * 1e3, r.error_max_m * 1e3,
+                  100.0 * r.error_miss_rate);
+    out << line;
+  }
   return out.str();
 }
 
@@ -144,6 +188,11 @@ nlohmann::json step_rows_to_json(const std::vector<StepRow>& rows) {
                  {"contact_steps", r.contact_steps},
                  {"pop_throughs", r.pop_throughs},
                  {"peak_force_n", r.peak_force_n}});
+    if (r.error_p95_m >= 0.0) {
+      j.back()["error_vs_exact"] = {{"worst_segment_p95_m", r.error_p95_m},
+                                    {"max_m", r.error_max_m},
+                                    {"miss_rate", r.error_miss_rate}};
+    }
   }
   return j;
 }

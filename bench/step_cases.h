@@ -64,7 +64,16 @@ struct StepRow {
   /// p50 / p99 of this row over the exact row of the same case (< 1: faster than exact).
   double p50_ratio_to_exact = 0.0;
   double p99_ratio_to_exact = 0.0;
+  /// An approximate method's (knee) signed-distance error against the exact query, over
+  /// kErrorPointsPerSegment points in a ±5 mm band about each segment's surface: the worst
+  /// segment's p95 and the largest, metres, and the share of contacts it missed. Negative: not
+  /// measured (the exact method).
+  double error_p95_m = -1.0;
+  double error_max_m = -1.0;
+  double error_miss_rate = -1.0;
 };
+
+inline constexpr std::size_t kErrorPointsPerSegment = 2000;
 
 [[nodiscard]] std::vector<StepRow> run_step_bench(const StepBenchOptions& options);
 [[nodiscard]] std::string format_step_table(const std::vector<StepRow>& rows);

@@ -41,5 +41,27 @@ TEST(StepBench, MethodsRunTheSamePalpationBesideTheExactBaseline) {
   EXPECT_NE(format_step_table(rows).find("knee"), std::string::npos);
 }
 
+// The knee method's rows carry its error against the exact query (the sphere tree refines
+// exactly: its error is rounding only); the exact row has none.
+TEST(StepBench, ApproximateMethodsReportTheirErrorAgainstExact) {
+  StepBenchOptions options;
+  options.cases.push_back({"knee", std::string(HAPSIM_SCENES_DIR) + "/knee.json", std::nullopt});
+  options.methods = {"exact", "spheretree", "knee"};
+  options.duration_s = 0.2;
+  const std::vector<StepRow> rows = run_step_bench(options);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_LT(rows[0].error_p95_m, 0.0);  // exact: not measured
+  EXPECT_GE(rows[1].error_max_m, 0.0);
+  EXPECT_LT(rows[1].error_max_m, 1e-9);
+  EXPECT_GT(rows[2].error_max_m, 0.0);
+  EXPECT_GE(rows[2].error_max_m, rows[2].error_p95_m);
+  EXPECT_GE(rows[2].error_miss_rate, 0.0);
+  EXPECT_LE(rows[2].error_miss_rate, 1.0);
+  const auto j = step_rows_to_json(rows);
+  EXPECT_FALSE(j[0].contains("error_vs_exact"));
+  EXPECT_DOUBLE_EQ(j[2]["error_vs_exact"]["max_m"].get<double>(), rows[2].error_max_m);
+  EXPECT_NE(format_step_table(rows).find("error vs exact"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace hapsim::bench
