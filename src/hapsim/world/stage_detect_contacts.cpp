@@ -105,7 +105,8 @@ void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) no
         continue;
       }
       const ContactMaterial& material = state.materials[seg.material];
-      const Vec3 p_body = seg.X_body_world * p_world;
+      const Vec3 p_body = state.X_body_world(seg) * p_world;
+      const ProximityQuery& query = state.contact_query(seg, i);
       const bool was_pressing = tool.pressing[i] != 0;
       tool.pressing[i] = 0;  // set again below when the tool presses the segment this step
       const double reach = radius + std::max(material.max_penetration_m, 0.0);
@@ -119,7 +120,7 @@ void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) no
       }
       SurfacePoint sp;
       std::uint8_t& near = tool.near_last_step[i];
-      if (!seg.rest_query->contact_within(p_body, reach, &sp, &tool.hints[i])) {
+      if (!query.contact_within(p_body, reach, &sp, &tool.hints[i])) {
         // Either clear of the surface or deeper inside than the reach (saturated spring). Deeper
         // is only possible inside the bounds, and only for a tool that was near or inside last
         // step or has moved more than a reach since (a first cycle, a jump).
@@ -128,7 +129,7 @@ void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) no
           end_contact(state, side);
           continue;
         }
-        sp = seg.rest_query->closest_point(p_body, &tool.hints[i]);
+        sp = query.closest_point(p_body, &tool.hints[i]);
         if (!(sp.signed_distance < 0.0)) {
           near = 0;
           end_contact(state, side);
@@ -141,8 +142,9 @@ void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) no
         end_contact(state, side);
         continue;
       }
-      Vec3 n_world = seg.X_world_body.linear() * sp.normal;
-      Vec3 point_world = seg.X_world_body * sp.point;
+      const Iso3& X_world_body = state.X_world_body(seg);
+      Vec3 n_world = X_world_body.linear() * sp.normal;
+      Vec3 point_world = X_world_body * sp.point;
       Vec3 rest_point_body = sp.point;
       // Past the middle (or back): the nearest surface faces away from the entry side's normal.
       side.crossed = side.in_contact && n_world.dot(side.n_world) < 0.0;
@@ -154,7 +156,7 @@ void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) no
         depth = radius - (p_world - side.point_world).dot(side.n_world);
         n_world = side.n_world;
         point_world = p_world - (radius - depth) * n_world;
-        rest_point_body = seg.X_body_world * point_world;
+        rest_point_body = state.X_body_world(seg) * point_world;
       }
       const double rest_depth = depth;
       const SegmentState& seg_state = state.segments[i];

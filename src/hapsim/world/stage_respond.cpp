@@ -1,5 +1,6 @@
 // Stage 3: forces. Proxy segments through each tool's god-object, penalty segments as springs on
 // the contacts the detection stage found; every contact reported and handed to deformation.
+#include "hapsim/force/contact_friction.h"
 #include "hapsim/force/penalty_force.h"
 #include "hapsim/world/world_model.h"
 #include "hapsim/world/world_stages.h"
@@ -26,6 +27,18 @@ void add_pending(SegmentState& seg, const DeflectionContact& contact) noexcept {
 }
 
 }  // namespace
+
+// haptic path
+void add_sheet_push(SegmentState& sheet, const Iso3& X_sheet_world, const Vec3& p_world,
+                    const Vec3& force_on_presser_world_n) noexcept {
+  if (sheet.sheet_push_count >= sheet.sheet_pushes.size()) {
+    return;
+  }
+  // The sheet is pushed down (along its −z) by what pushes the presser up.
+  const double push_n = (X_sheet_world.linear() * force_on_presser_world_n).z();
+  sheet.sheet_pushes[sheet.sheet_push_count++] =
+      SheetContact{X_sheet_world * p_world, std::max(push_n, 0.0)};
+}
 
 // haptic path
 void respond(const WorldModel& model, WorldState& state, double dt_s) noexcept {
@@ -69,16 +82,47 @@ void respond(const WorldModel& model, WorldState& state, double dt_s) noexcept {
       ++out.contact_count;
       if (depth > 0.0) {
         add_pending(state.segments[flat],
-                    DeflectionContact{seg.X_body_world * c.point_world, depth, radius, 0});
+                    DeflectionContact{state.X_body_world(seg) * c.point_world, depth, radius, 0});
       }
     }
 
-    // Penalty segments, at the tool's own position: F = k·x along the entry side's normal.
+    // Penalty segments, at the tool's own position: F = k·x along the entry side's normal, plus
+    // friction where the material has it; the body gets the opposite.
+    std::size_t next = 0;  // penalty candidates come in segment order
+    for (std::size_t i = 0; i < segs.size(); ++i) {
+      while (next < tool.penalty_count && tool.penalty[next].segment < i) {
+        ++next;
+      }
+      if (next < tool.penalty_count && tool.penalty[next].segment == i) {
+        continue;
+      }
+      tool.stick_body[i].active = false;  // not pressing this segment: nothing sticks
+    }
     for (std::size_t k = 0; k < tool.penalty_count; ++k) {
       const PenaltyCandidate& c = tool.penalty[k];
       const SegmentModel& seg = segs[c.segment];
       const ContactMaterial& material = state.materials[seg.material];
-      const Vec3 f = penalty_force(material, c.depth_m, c.n_world, -tool.v_world.dot(c.n_world));
+      BodyState& body = state.bodies[seg.body];
+      const BodyModel& body_model = model.bodies()[seg.body];
+      const Vec3 v_rel =
+          seg.dynamic ? Vec3(tool.v_world - body.velocity_at(c.point_world, body_model.com_body))
+                      : tool.v_world;
+      const Vec3 f_normal = penalty_force(material, c.depth_m, c.n_world, -v_rel.dot(c.n_world));
+      // Friction follows the tool's own contact point (its sphere's surface towards the segment)
+      // against the material point of the segment where it stuck: what slips is the one over
+      // the other (the closest point on the segment slides over it as the geometry changes).
+      StickPoint stick{tool.stick_body[c.segment].active,
+                       body.X_world_body * tool.stick_body[c.segment].p};
+      const Vec3 f = f_normal + contact_friction_force(material, f_normal.norm(), c.n_world, v_rel,
+                                                       tool.p_world - radius * c.n_world, stick);
+      tool.stick_body[c.segment] = {stick.active, body.X_body_world * stick.p};
+      if (seg.dynamic) {
+        body.force_world_n -= f;
+        body.torque_world_nm -= (c.point_world - body.com_world(body_model.com_body)).cross(f);
+      }
+      if (seg.sheet) {
+        add_sheet_push(state.segments[c.segment], body.X_body_world, c.point_world, f);
+      }
       total += f;
       add_contact(state, WorldContact{tool_index, static_cast<std::int32_t>(seg.body),
                                       static_cast<std::int32_t>(seg.index_in_body), c.point_world,

@@ -45,7 +45,15 @@ const ProximityQuery& World::rest_query(std::size_t body, std::size_t segment) c
 const TriangleMesh& World::surface(std::size_t body, std::size_t segment) const {
   const std::size_t flat = flat_segment(body, segment);
   const SegmentState& seg = state_.segments.at(flat);
+  if (seg.sheet) {
+    return seg.sheet->mesh();
+  }
   return seg.deflection ? seg.deflection->mesh() : model_.segments()[flat].description->mesh;
+}
+
+const VirtualSheet* World::sheet(std::size_t body) const {
+  const std::size_t flat = flat_segment(body, 0);
+  return state_.segments.at(flat).sheet.get();
 }
 
 const ProximityQuery& World::deformed_query(std::size_t body, std::size_t segment) {

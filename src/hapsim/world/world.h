@@ -1,8 +1,9 @@
-// The simulated world (architecture.md#force-and-safety, architecture.md#deformation, architecture.md#real-time): device input in, per-tool forces, contacts and
-// deformation out. A World holds the read-only model (world_model.h, built once from a
-// WorldDescription) and the per-step state (world_state.h, sized at construction), and steps them
-// with the deterministic, allocation-free step() of world_step.h: the same inputs replay to the
-// same bits. The stages of a step are listed in world_stages.h:
+// The simulated world (architecture.md#force-and-safety, architecture.md#deformation,
+// architecture.md#real-time): device input in, per-tool forces, contacts and deformation out. A
+// World holds the read-only model (world_model.h, built once from a WorldDescription) and the
+// per-step state (world_state.h, sized at construction), and steps them with the deterministic,
+// allocation-free step() of world_step.h: the same inputs replay to the same bits. The stages of a
+// step are listed in world_stages.h:
 //  1. place tools: a sphere at the device pose times its offset, or the glove hand's fingertips;
 //  2. detect contacts with penalty segments (skin, muscle), remembering the side a tool entered
 //     from so a thin segment never pulls it through;
@@ -31,6 +32,7 @@
 namespace hapsim {
 
 class VertexDeflection;
+class VirtualSheet;
 
 class World {
  public:
@@ -71,6 +73,13 @@ class World {
   /// world has none. Only the thread that steps may read it while the world runs.
   [[nodiscard]] const RigState* rig() const { return state_.rig.get(); }
   [[nodiscard]] std::size_t segment_count(std::size_t body) const;
+  /// Where a body is now (a dynamic body moves; the others stay at their description's pose).
+  /// Only the thread that steps may read it while the world runs.
+  [[nodiscard]] const Iso3& body_pose(std::size_t body) const {
+    return state_.bodies.at(body).X_world_body;
+  }
+  /// The virtual sheet of a sheet body (BodyDeformation::kGaussianSheet), or null.
+  [[nodiscard]] const VirtualSheet* sheet(std::size_t body) const;
   /// Flat index of (body, segment) over all bodies, for per-segment statistics.
   [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const;
   [[nodiscard]] std::size_t flat_segment_count() const { return model_.segments().size(); }

@@ -1,5 +1,6 @@
 #include "hapsim/world/world_description.h"
 
+#include <algorithm>
 #include <cstdio>
 
 namespace hapsim {
@@ -40,6 +41,10 @@ std::string_view to_string(BodyKind kind) {
       return "deformable";
   }
   return "unknown";
+}
+
+std::string_view to_string(BodyDeformation deformation) {
+  return deformation == BodyDeformation::kGaussianSheet ? "sheet" : "deflection";
 }
 
 WorldDescription rig_world(TeleopRigDescription rig, std::string name) {
@@ -92,6 +97,22 @@ std::string content_hash(const WorldDescription& description) {
     h.number(static_cast<double>(b.kind));
     h.number(static_cast<double>(b.method));
     h.bytes(b.X_world_body.matrix().data(), sizeof(double) * 16);
+    // Only what steps differently is hashed, and only where it is used, so that worlds without
+    // dynamic bodies or sheets keep the hashes their recordings carry.
+    if (b.kind == BodyKind::kDynamic) {
+      const RigidBodyDescription& r = b.rigid;
+      h.number(r.mass_kg);
+      h.bytes(r.com_body.data(), sizeof(double) * 3);
+      h.bytes(r.inertia_kg_m2.data(), sizeof(double) * 9);
+      h.bytes(r.v_world.data(), sizeof(double) * 3);
+      h.bytes(r.w_world.data(), sizeof(double) * 3);
+    }
+    if (b.kind == BodyKind::kDeformable && b.deformation == BodyDeformation::kGaussianSheet) {
+      h.text("sheet");
+      h.number(b.sheet.nodes_per_side);
+      h.number(b.sheet.side_m);
+      h.number(b.sheet.max_depth_m);
+    }
     for (const SegmentDescription& s : b.segments) {
       h.text(s.name);
       h.number(s.material);
@@ -100,6 +121,11 @@ std::string content_hash(const WorldDescription& description) {
         // Contact comes from the solid, not the mesh; the mesh (hashed below) polygonises it.
         h.text("csg");
         h.number(static_cast<double>(s.csg->node_count()));
+      }
+      if (s.sphere) {
+        h.text("sphere");
+        h.bytes(s.sphere->center_body.data(), sizeof(double) * 3);
+        h.number(s.sphere->radius_m);
       }
       for (const Vec3& v : s.mesh.vertices) {
         h.bytes(v.data(), sizeof(double) * 3);
@@ -117,6 +143,10 @@ std::string content_hash(const WorldDescription& description) {
   }
   h.number(description.passivity_damping_factor);
   h.number(description.has_hand ? description.hand.dip_per_pip : -1.0);
+  if (std::any_of(description.bodies.begin(), description.bodies.end(),
+                  [](const BodyDescription& b) { return b.kind == BodyKind::kDynamic; })) {
+    h.bytes(description.gravity_m_per_s2.data(), sizeof(double) * 3);
+  }
   if (const auto& rig = description.teleop) {
     // What makes two rigs step differently: the slave, its start, the mapping, the ball, the sheet.
     h.number(rig->slave ? rig->slave->dof() : -1);

@@ -47,13 +47,22 @@ enum class ContactMethod : std::uint8_t {
 
 enum class BodyKind : std::uint8_t {
   kStatic,      ///< never moves, never deforms
-  kDynamic,     ///< rigid with mass (later issue: grasping)
-  kDeformable,  ///< vertices deflect under contact and recover (architecture.md#deformation)
+  kDynamic,     ///< rigid with mass: moves under gravity and its contacts (integrate stage)
+  kDeformable,  ///< deforms under contact and recovers (architecture.md#deformation)
+};
+
+/// How a deformable body deforms.
+enum class BodyDeformation : std::uint8_t {
+  kVertexDeflection,  ///< knee paper eq. 1 about each contact, recovering when released
+  /// The virtual sheet (paper 000 §3.2.2): an N×N height grid displaced by the Gaussian profile of
+  /// every force pressing it this step; a sphere resting on it transcribes its lower cap.
+  kGaussianSheet,
 };
 
 [[nodiscard]] std::string_view to_string(ContactResponse response);
 [[nodiscard]] std::string_view to_string(ContactMethod method);
 [[nodiscard]] std::string_view to_string(BodyKind kind);
+[[nodiscard]] std::string_view to_string(BodyDeformation deformation);
 /// "exact" | "spheretree" | "knee" (to_string's names); nullopt for anything else.
 [[nodiscard]] std::optional<ContactMethod> parse_contact_method(std::string_view name);
 
@@ -63,6 +72,13 @@ struct MaterialDescription {
   ContactResponse response = ContactResponse::kProxy;
   /// Used when the body is deformable.
   DeflectionParams deflection;
+};
+
+/// A segment that is exactly a sphere (its mesh only approximates it): bodies meet it through its
+/// centre and radius, exactly, instead of through its mesh's vertices.
+struct ExactSphere {
+  Vec3 center_body = Vec3::Zero();
+  double radius_m = 0.0;
 };
 
 struct SegmentDescription {
@@ -77,6 +93,20 @@ struct SegmentDescription {
   /// A CSG solid (body frame) that `mesh` polygonises: contact then comes from its signed
   /// distance (CsgQuery), whatever the body's contact method.
   std::optional<CsgSolid> csg;
+  /// Set when the segment is exactly this sphere (the mesh tessellates it).
+  std::optional<ExactSphere> sphere;
+};
+
+/// Mass properties of a dynamic body (BodyKind::kDynamic), in its body frame.
+struct RigidBodyDescription {
+  double mass_kg = 0.1;
+  /// Centre of mass, body frame, metres.
+  Vec3 com_body = Vec3::Zero();
+  /// Inertia about the centre of mass, body axes, kg·m² (symmetric positive definite).
+  Mat3 inertia_kg_m2 = Mat3::Identity() * 1e-4;
+  /// Velocity of the centre of mass and angular velocity at the start, world frame.
+  Vec3 v_world = Vec3::Zero();
+  Vec3 w_world = Vec3::Zero();
 };
 
 struct BodyDescription {
@@ -85,6 +115,12 @@ struct BodyDescription {
   Iso3 X_world_body = Iso3::Identity();
   ContactMethod method = ContactMethod::kExact;
   std::vector<SegmentDescription> segments;
+  /// kDynamic: mass, centre of mass, inertia and start velocity.
+  RigidBodyDescription rigid;
+  /// kDeformable: how. kGaussianSheet needs one segment whose mesh is the sheet's grid
+  /// (make_sheet(sheet.nodes_per_side, sheet.side_m), body frame = sheet frame, z up).
+  BodyDeformation deformation = BodyDeformation::kVertexDeflection;
+  VirtualSheetOptions sheet;
 };
 
 /// A contact sphere driven by the device: a stylus tip or a fingertip.
@@ -134,6 +170,8 @@ struct WorldDescription {
   /// Floor on the normal damping of every contact: b ≥ factor · k · dt. Sampling a spring at
   /// period T makes it active (Colgate & Schenkel); b > k·T/2 restores passivity, 1 gives margin.
   double passivity_damping_factor = 1.0;
+  /// Gravity on dynamic bodies, world frame.
+  Vec3 gravity_m_per_s2 = Vec3(0.0, 0.0, -9.81);
   /// A teleoperation rig driven by the device (the master arm), when the scene has one.
   std::optional<TeleopRigDescription> teleop;
 };

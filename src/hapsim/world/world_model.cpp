@@ -9,6 +9,8 @@
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/force/god_object.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 
@@ -16,13 +18,19 @@ namespace hapsim {
 
 namespace {
 
-// A CSG segment always answers from its solid's signed distance (exact, and cheaper than any
-// mesh structure), whatever the body's method: the method names how a *mesh* is searched, and
-// the polygonised mesh only approximates the solid (edges bevelled by about a cell).
+// A CSG segment (and an exact sphere) always answers from its solid's signed distance (exact, and
+// cheaper than any mesh structure), whatever the body's method: the method names how a *mesh* is
+// searched, and the polygonised mesh only approximates the solid (edges bevelled by about a cell).
 std::unique_ptr<ProximityQuery> make_query(ContactMethod method,
                                            const SegmentDescription& segment) {
   if (segment.csg) {
     return std::make_unique<CsgQuery>(*segment.csg, segment.mesh);
+  }
+  if (segment.sphere) {
+    // Exactly a sphere: its signed distance answers exactly (the mesh only tessellates it).
+    const Iso3 X_body_sphere(Eigen::Translation3d(segment.sphere->center_body));
+    return std::make_unique<CsgQuery>(
+        CsgSolid::sphere(segment.sphere->radius_m).transformed(X_body_sphere), segment.mesh);
   }
   const TriangleMesh& mesh = segment.mesh;
   switch (method) {
@@ -47,6 +55,49 @@ void check_rig(const TeleopRigDescription& d) {
   }
   if (!d.ball_start_world.allFinite() || !std::isfinite(d.force_scale) || d.force_scale < 0.0) {
     throw Error("teleop", "ball start must be finite and the force scale >= 0");
+  }
+}
+
+// A dynamic body needs a usable mass and inertia; its segments answer by penalty (a god-object's
+// proxy assumes a surface that stays put within the cycle).
+void check_dynamic(const WorldDescription& d, const BodyDescription& body) {
+  const std::string where = "body '" + body.name + "'";
+  const RigidBodyDescription& r = body.rigid;
+  if (!(r.mass_kg > 0.0) || !std::isfinite(r.mass_kg) || !r.com_body.allFinite() ||
+      !r.v_world.allFinite() || !r.w_world.allFinite()) {
+    throw Error(where, "a dynamic body needs a finite mass > 0 kg and finite start velocities");
+  }
+  const Mat3& I = r.inertia_kg_m2;
+  const Eigen::SelfAdjointEigenSolver<Mat3> eig(0.5 * (I + I.transpose()));
+  if (!I.allFinite() || !(eig.eigenvalues().minCoeff() > 0.0) ||
+      (I - I.transpose()).norm() > 1e-9 * I.norm()) {
+    throw Error(where, "a dynamic body's inertia must be symmetric positive definite");
+  }
+  for (const SegmentDescription& s : body.segments) {
+    if (d.materials.at(s.material).response != ContactResponse::kPenalty) {
+      throw Error(where + " segment '" + s.name + "'",
+                  "a dynamic body's materials must answer by \"penalty\" (a proxy needs a "
+                  "surface that stays put within a cycle)");
+    }
+  }
+}
+
+// A sheet is one segment of the sheet's grid, answered by penalty (it moves under its contacts).
+void check_sheet(const WorldDescription& d, const BodyDescription& body) {
+  const std::string where = "body '" + body.name + "'";
+  if (body.segments.size() != 1) {
+    throw Error(where, "a sheet has exactly one segment");
+  }
+  const SegmentDescription& s = body.segments.front();
+  const auto n = static_cast<std::size_t>(std::max(body.sheet.nodes_per_side, 0));
+  if (s.mesh.vertex_count() != n * n) {
+    throw Error(where, "a sheet's mesh must be its " + std::to_string(n) + "x" + std::to_string(n) +
+                           " grid (make_sheet)");
+  }
+  if (d.materials.at(s.material).response != ContactResponse::kPenalty) {
+    throw Error(where,
+                "a sheet's material must answer by \"penalty\" (the sheet moves under "
+                "its contacts)");
   }
 }
 
@@ -93,19 +144,67 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
         throw Error(where, "refers to material " + std::to_string(sd.material) + " of " +
                                std::to_string(description_.materials.size()));
       }
+      if (s == 0 && body.kind == BodyKind::kDynamic) {
+        check_dynamic(description_, body);
+      }
+      const bool sheet =
+          body.kind == BodyKind::kDeformable && body.deformation == BodyDeformation::kGaussianSheet;
+      if (s == 0 && sheet) {
+        check_sheet(description_, body);
+      }
       SegmentModel seg;
+      seg.sheet = sheet;
+      seg.dynamic = body.kind == BodyKind::kDynamic;
       seg.body = b;
       seg.index_in_body = s;
       seg.description = &sd;
       seg.material = sd.material;
       seg.response = description_.materials[sd.material].response;
-      seg.deformable = body.kind == BodyKind::kDeformable;
+      seg.deformable = body.kind == BodyKind::kDeformable && !sheet;
       seg.X_world_body = body.X_world_body;
       seg.X_body_world = body.X_world_body.inverse();
       seg.rest_bounds_body = sd.mesh.bounds();
+      if (sheet) {
+        // The sheet sinks under its contacts: as deep as its cap, or (uncapped) its side.
+        const double deepest =
+            std::isfinite(body.sheet.max_depth_m) ? body.sheet.max_depth_m : body.sheet.side_m;
+        seg.rest_bounds_body.extend(seg.rest_bounds_body.min() - Vec3(0.0, 0.0, deepest));
+      }
       seg.rest_query = make_query(body.method, sd);
       (seg.response == ContactResponse::kProxy ? proxy_segments_ : penalty_segments_) += 1;
       segments_.push_back(std::move(seg));
+    }
+  }
+  for (std::size_t b = 0; b < description_.bodies.size(); ++b) {
+    const BodyDescription& body = description_.bodies[b];
+    BodyModel bm;
+    bm.kind = body.kind;
+    bm.first_segment = body_first_segment_[b];
+    bm.segment_count = body.segments.size();
+    bm.sheet = segments_[bm.first_segment].sheet;
+    if (body.kind == BodyKind::kDynamic) {
+      bm.mass_kg = body.rigid.mass_kg;
+      bm.com_body = body.rigid.com_body;
+      bm.inertia_body_kg_m2 = body.rigid.inertia_kg_m2;
+      bm.inverse_inertia_body = body.rigid.inertia_kg_m2.inverse();
+      if (body.segments.size() != 1 || !body.segments.front().sphere) {
+        // Mesh-against-mesh contact of a moving body (both trees' leaves, vertices refined
+        // against the other's exact surface) is not written yet; say so instead of letting the
+        // body fall through everything.
+        throw Error("body '" + body.name + "'",
+                    "a dynamic body must be one sphere (geometry \"sphere\"): dynamic bodies of "
+                    "other shapes do not collide with other bodies yet");
+      }
+      bm.sphere = body.segments.front().sphere;
+      dynamic_bodies_.push_back(b);
+    }
+    bodies_.push_back(bm);
+  }
+  if (!dynamic_bodies_.empty()) {
+    for (SegmentModel& seg : segments_) {
+      if (!seg.sheet) {
+        seg.body_tree = std::make_unique<SphereTree>(seg.description->mesh);
+      }
     }
   }
   if (proxy_segments_ > static_cast<std::size_t>(GodObject::kMaxSurfaces)) {
@@ -139,6 +238,9 @@ std::size_t WorldModel::query_memory_bytes() const {
   std::size_t bytes = 0;
   for (const SegmentModel& seg : segments_) {
     bytes += seg.rest_query->memory_bytes();
+    if (seg.body_tree) {
+      bytes += seg.body_tree->memory_bytes();
+    }
   }
   return bytes;
 }

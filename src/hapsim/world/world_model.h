@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,25 @@ struct WorldOptions {
   int proxy_max_iterations = 16;
 };
 
+class SphereTree;
+
+/// One body as a step sees it: where its segments are in the flat list and, for a dynamic body,
+/// its mass properties.
+struct BodyModel {
+  BodyKind kind = BodyKind::kStatic;
+  std::size_t first_segment = 0;
+  std::size_t segment_count = 0;
+  bool sheet = false;  ///< a Gaussian sheet (one segment)
+  // Dynamic bodies only.
+  double mass_kg = 0.0;
+  Vec3 com_body = Vec3::Zero();
+  Mat3 inertia_body_kg_m2 = Mat3::Identity();
+  Mat3 inverse_inertia_body = Mat3::Identity();
+  /// A dynamic body of one exactly spherical segment meets other bodies through its centre and
+  /// radius (exact); otherwise through its mesh vertices.
+  std::optional<ExactSphere> sphere;
+};
+
 /// One segment of one body, flattened over all bodies (flat index = the body's first segment +
 /// the segment's index in its body).
 struct SegmentModel {
@@ -33,11 +53,19 @@ struct SegmentModel {
   std::uint32_t material = 0;
   ContactResponse response = ContactResponse::kProxy;
   bool deformable = false;
+  bool sheet = false;  ///< a Gaussian sheet: contact with its live field (WorldState), not rest
+  bool dynamic = false;
+  /// The body's pose at the start (a dynamic body's current pose is in WorldState::bodies).
   Iso3 X_world_body = Iso3::Identity();
   Iso3 X_body_world = Iso3::Identity();
+  /// Where the surface can be, body frame (a sheet's bounds include how deep it can sink).
   Box3 rest_bounds_body;
   /// The rest surface's query in the body frame (the body's contact method): what a step uses.
   std::unique_ptr<ProximityQuery> rest_query;
+  /// Sphere tree of the rest surface for body-against-body contact (paper 000 §3.1: both bodies'
+  /// trees descended where parent spheres overlap, then refined exactly); built only when the
+  /// world has dynamic bodies, and not for sheets (their field answers directly).
+  std::unique_ptr<SphereTree> body_tree;
 };
 
 class WorldModel {
@@ -56,6 +84,9 @@ class WorldModel {
   /// The teleoperation rig's master arm (the device), or null when the scene has no rig.
   [[nodiscard]] const MasterArm* master() const { return master_.get(); }
   [[nodiscard]] const std::vector<SegmentModel>& segments() const { return segments_; }
+  [[nodiscard]] const std::vector<BodyModel>& bodies() const { return bodies_; }
+  /// Indices of the dynamic bodies, in body order.
+  [[nodiscard]] const std::vector<std::size_t>& dynamic_bodies() const { return dynamic_bodies_; }
   [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const {
     return body_first_segment_.at(body) + segment;
   }
@@ -76,6 +107,8 @@ class WorldModel {
   std::unique_ptr<HandModel> hand_;
   std::unique_ptr<MasterArm> master_;
   std::vector<SegmentModel> segments_;
+  std::vector<BodyModel> bodies_;
+  std::vector<std::size_t> dynamic_bodies_;
   std::vector<std::size_t> body_first_segment_;
   std::size_t proxy_segments_ = 0;
   std::size_t penalty_segments_ = 0;

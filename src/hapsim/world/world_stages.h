@@ -22,21 +22,31 @@
 #pragma once
 
 #include "hapsim/core/device_io.h"
+#include "hapsim/core/types.h"
 
 namespace hapsim {
 
 class WorldModel;
 struct WorldState;
+struct SegmentState;
 
 namespace stage {
 
 void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& input,
                  double dt_s) noexcept;
 void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) noexcept;
+/// Dynamic bodies against every other body's segments (detection and response in one: a body's
+/// contacts are found and answered where they are found; stage_body_contacts.cpp).
+void body_contacts(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void respond(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void integrate(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void deform(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void safety(const WorldModel& model, WorldState& state) noexcept;
+
+/// A push on a sheet segment this step: the force that pushes the presser out, at `p_world`;
+/// the deform stage displaces the sheet by it.
+void add_sheet_push(SegmentState& sheet, const Iso3& X_sheet_world, const Vec3& p_world,
+                    const Vec3& force_on_presser_world_n) noexcept;
 
 }  // namespace stage
 }  // namespace hapsim

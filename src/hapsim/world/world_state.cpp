@@ -3,6 +3,7 @@
 #include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/core/error.h"
+#include "hapsim/deform/sheet_query.h"
 #include "hapsim/world/world_model.h"
 
 #include <algorithm>
@@ -39,13 +40,46 @@ void RigState::reset() {
 
 RigState::~RigState() = default;
 
+namespace {
+
+// Every body at its start pose and velocity.
+void place_bodies(const WorldModel& model, std::vector<BodyState>& bodies) {
+  const WorldDescription& d = model.description();
+  bodies.assign(d.bodies.size(), BodyState{});
+  for (std::size_t b = 0; b < d.bodies.size(); ++b) {
+    BodyState& body = bodies[b];
+    body.X_world_body = d.bodies[b].X_world_body;
+    body.X_body_world = body.X_world_body.inverse();
+    if (d.bodies[b].kind == BodyKind::kDynamic) {
+      body.v_world = d.bodies[b].rigid.v_world;
+      body.w_world = d.bodies[b].rigid.w_world;
+    }
+  }
+}
+
+}  // namespace
+
 WorldState::WorldState(const WorldModel& model) {
   const WorldDescription& d = model.description();
   const std::size_t tool_count = model.tool_count();
   const std::vector<SegmentModel>& segs = model.segments();
   segments.resize(segs.size());
+  place_bodies(model, bodies);
+  body_pairs.resize(model.dynamic_bodies().size() * segs.size());
+  body_contacts.resize(std::max<std::size_t>(body_pairs.size(), 1));
   for (std::size_t i = 0; i < segs.size(); ++i) {
     const SegmentModel& seg = segs[i];
+    if (seg.sheet) {
+      const BodyDescription& body = d.bodies[seg.body];
+      try {
+        segments[i].sheet = std::make_unique<VirtualSheet>(body.sheet);
+      } catch (const Error& e) {
+        throw Error("body '" + body.name + "'", e.what());
+      }
+      segments[i].sheet_query = std::make_unique<SheetQuery>(*segments[i].sheet);
+      segments[i].sheet_pushes.resize(tool_count + model.dynamic_bodies().size() + 1);
+      continue;
+    }
     if (!seg.deformable) {
       continue;
     }
@@ -81,6 +115,7 @@ WorldState::WorldState(const WorldModel& model) {
     tool.own_dent.assign(segs.size(), OwnDent{});
     tool.felt_dent_m.assign(segs.size(), 0.0);
     tool.pressing.assign(segs.size(), 0);
+    tool.stick_body.assign(segs.size(), StickPoint{});
     tool.penalty.resize(std::max<std::size_t>(model.penalty_segment_count(), 1));
     tools.push_back(std::move(tool));
   }
@@ -114,7 +149,9 @@ WorldState::WorldState(const WorldModel& model) {
   }
   result.tools = tool_states;
   result.contacts = {contacts.data(), 0};
+  result.body_contacts = {body_contacts.data(), 0};
   result.teleop = rig ? &rig->result : nullptr;
+  model_ = &model;
 }
 
 WorldState::~WorldState() = default;
@@ -135,13 +172,22 @@ void WorldState::reset() {
     std::fill(tool.own_dent.begin(), tool.own_dent.end(), OwnDent{});
     std::fill(tool.felt_dent_m.begin(), tool.felt_dent_m.end(), 0.0);
     std::fill(tool.pressing.begin(), tool.pressing.end(), std::uint8_t{0});
+    std::fill(tool.stick_body.begin(), tool.stick_body.end(), StickPoint{});
   }
   for (SegmentState& seg : segments) {
     if (seg.deflection) {
       seg.deflection->reset();
       seg.deformed_dirty = true;
     }
+    if (seg.sheet) {
+      seg.sheet->reset();
+      seg.sheet_push_count = 0;
+      seg.sheet_dirty = true;
+    }
   }
+  place_bodies(*model_, bodies);
+  std::fill(body_pairs.begin(), body_pairs.end(), BodyPairState{});
+  body_contact_count = 0;
   for (ToolState& state : tool_states) {
     state = ToolState{};
   }
@@ -152,6 +198,7 @@ void WorldState::reset() {
   result = StepResult{};
   result.tools = tool_states;
   result.contacts = {contacts.data(), 0};
+  result.body_contacts = {body_contacts.data(), 0};
   result.teleop = rig ? &rig->result : nullptr;
 }
 

@@ -10,10 +10,12 @@
 #include "hapsim/dynamics/ball_environment.h"
 #include "hapsim/dynamics/parallel_gripper.h"
 #include "hapsim/dynamics/rigid_ball.h"
+#include "hapsim/force/contact_friction.h"
 #include "hapsim/force/contact_material.h"
 #include "hapsim/force/god_object.h"
 #include "hapsim/kinematics/slave_follower.h"
 #include "hapsim/world/world_description.h"
+#include "hapsim/world/world_model.h"
 
 #include <array>
 #include <cstdint>
@@ -24,7 +26,6 @@
 namespace hapsim {
 
 class MeshBvh;
-class WorldModel;
 
 /// One contact of one tool with one segment this step.
 struct WorldContact {
@@ -36,6 +37,44 @@ struct WorldContact {
   double depth_m = 0.0;              ///< tool depth below the rest surface (≥ 0)
   double force_n = 0.0;              ///< magnitude of this contact's force on the tool
   bool proxy = false;                ///< answered by the god-object (else penalty)
+};
+
+/// One contact of a dynamic body with another body's segment this step (body contacts stage):
+/// the force on the dynamic body; the other body gets the opposite.
+struct BodyContact {
+  std::int32_t body = -1;        ///< the dynamic body
+  std::int32_t other_body = -1;  ///< the body it touches
+  std::int32_t other_segment = -1;
+  Vec3 point_world = Vec3::Zero();   ///< on the other body's surface
+  Vec3 normal_world = Vec3::Zero();  ///< unit, out of the other body towards the dynamic one
+  double depth_m = 0.0;
+  Vec3 force_world_n = Vec3::Zero();  ///< on the dynamic body (normal and friction)
+};
+
+/// Where a body is and how it moves (every body; only dynamic ones change, integrate stage).
+struct BodyState {
+  Iso3 X_world_body = Iso3::Identity();
+  Iso3 X_body_world = Iso3::Identity();
+  /// Dynamic bodies: the centre of mass's velocity and the angular velocity, world frame.
+  Vec3 v_world = Vec3::Zero();
+  Vec3 w_world = Vec3::Zero();
+  /// Sums of this step's contact forces on the body and their torques about its centre of mass
+  /// (respond and body-contact stages), world frame.
+  Vec3 force_world_n = Vec3::Zero();
+  Vec3 torque_world_nm = Vec3::Zero();
+  /// The centre of mass, world frame.
+  [[nodiscard]] Vec3 com_world(const Vec3& com_body) const { return X_world_body * com_body; }
+  /// Velocity of the body's material point at `p_world`.
+  [[nodiscard]] Vec3 velocity_at(const Vec3& p_world, const Vec3& com_body) const {
+    return v_world + w_world.cross(p_world - com_world(com_body));
+  }
+};
+
+/// Per (dynamic body, flat segment) pair: what the body-contact stage remembers between steps.
+struct BodyPairState {
+  QueryHint hint;
+  StickPoint stick_body;  ///< friction stick point, in the other segment's body frame
+  bool touching = false;
 };
 
 struct ToolState {
@@ -75,6 +114,10 @@ struct StepResult {
   /// Tools that left a penalty segment through its far side this step (pulled through a thin
   /// segment: must stay 0).
   std::int32_t penalty_pop_throughs = 0;
+  /// Contacts of dynamic bodies with other bodies this step.
+  std::span<const BodyContact> body_contacts;
+  /// Body contacts found but not reported because the per-step buffer was full.
+  std::int32_t dropped_body_contacts = 0;
   /// The teleoperation rig's step, or null when the world has no rig.
   const TeleopStepResult* teleop = nullptr;
 };
@@ -124,6 +167,15 @@ struct SegmentState {
   /// This step's contacts on the segment (respond stage), capacity fixed at construction.
   std::vector<DeflectionContact> pending;
   std::size_t pending_count = 0;
+  /// A Gaussian sheet (BodyDeformation::kGaussianSheet): its grid, the query over its elastic
+  /// field that contacts use, and this step's pushes on it (respond and body-contact stages;
+  /// the deform stage applies them).
+  std::unique_ptr<VirtualSheet> sheet;
+  std::unique_ptr<ProximityQuery> sheet_query;
+  std::vector<SheetContact> sheet_pushes;
+  std::size_t sheet_push_count = 0;
+  /// The sheet's mesh changed this step (deform stage).
+  bool sheet_dirty = false;
 };
 
 /// Per-step state of one tool.
@@ -144,6 +196,9 @@ struct ToolRuntime {
   /// at the tissue's rate, never jumping; the tool's own press is its spring and does not count.
   std::vector<double> felt_dent_m;
   std::vector<std::uint8_t> pressing;  ///< per flat segment: in contact last step
+  /// Per flat segment: where a penalty contact with friction sticks, in the segment's body frame
+  /// (respond stage).
+  std::vector<StickPoint> stick_body;
   /// Penalty contacts of this step, in segment order (detect stage); capacity = penalty segments.
   std::vector<PenaltyCandidate> penalty;
   std::size_t penalty_count = 0;
@@ -197,6 +252,12 @@ struct WorldState {
 
   std::vector<SegmentState> segments;  ///< per flat segment
   std::vector<ToolRuntime> tools;
+  std::vector<BodyState> bodies;  ///< per body
+  /// Per (dynamic body i of model.dynamic_bodies(), flat segment s): [i · segments + s].
+  std::vector<BodyPairState> body_pairs;
+  /// Body contacts stage: this step's contacts of dynamic bodies, capacity fixed at construction.
+  std::vector<BodyContact> body_contacts;
+  std::size_t body_contact_count = 0;
   std::unique_ptr<RigState> rig;  ///< when the world has a teleoperation rig
   double time_s = 0.0;
   /// Steps taken since construction or reset (the first step is 1).
@@ -211,9 +272,26 @@ struct WorldState {
   std::vector<WorldContact> contacts;  ///< capacity fixed at construction
   std::size_t contact_count = 0;
   std::int32_t dropped_contacts = 0;
+  std::int32_t dropped_body_contacts = 0;
   std::int32_t pop_throughs = 0;
   DeviceCommand command;
   StepResult result;
+
+  /// Where segment `seg` (flat) is now: its body's current pose.
+  [[nodiscard]] const Iso3& X_world_body(const SegmentModel& seg) const {
+    return bodies[seg.body].X_world_body;
+  }
+  [[nodiscard]] const Iso3& X_body_world(const SegmentModel& seg) const {
+    return bodies[seg.body].X_body_world;
+  }
+  /// The query a step uses for a segment: a sheet's live field, else the rest surface's.
+  [[nodiscard]] const ProximityQuery& contact_query(const SegmentModel& seg,
+                                                    std::size_t flat) const {
+    return segments[flat].sheet_query ? *segments[flat].sheet_query : *seg.rest_query;
+  }
+
+ private:
+  const WorldModel* model_ = nullptr;  // the model this state was sized for (reset)
 };
 
 }  // namespace hapsim

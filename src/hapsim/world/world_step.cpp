@@ -44,10 +44,16 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   state.pop_throughs = 0;
   for (SegmentState& seg : state.segments) {
     seg.pending_count = 0;
+    seg.sheet_push_count = 0;
+  }
+  for (BodyState& body : state.bodies) {
+    body.force_world_n.setZero();
+    body.torque_world_nm.setZero();
   }
 
   stage::place_tools(model, state, input, dt);
   stage::detect_contacts(model, state, dt);
+  stage::body_contacts(model, state, dt);
   stage::respond(model, state, dt);
   stage::integrate(model, state, dt);
   stage::deform(model, state, dt);
@@ -59,6 +65,8 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   r.contacts = {state.contacts.data(), state.contact_count};
   r.command = state.command;
   r.dropped_contacts = state.dropped_contacts;
+  r.body_contacts = {state.body_contacts.data(), state.body_contact_count};
+  r.dropped_body_contacts = state.dropped_body_contacts;
   r.penalty_pop_throughs = state.pop_throughs;
   if (state.rig) {
     state.rig->result.time_s = state.time_s;
