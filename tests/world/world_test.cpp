@@ -7,6 +7,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/geometry/procedural.h"
+#include "hapsim/kinematics/hand_model.h"
 
 #include "support/allocation_counter.h"
 
@@ -160,6 +161,45 @@ TEST(World, PenaltyPlateNeverPullsTheToolThroughAndCountsThePopThrough) {
   }
   EXPECT_GT(deepest_force_z, 0.9);
   EXPECT_EQ(pop_throughs, 1);
+}
+
+// After a pause (World::forget_tool_motion) the tool may come back anywhere: a side crossed before
+// the pause is forgotten. Half way through a 2 mm plate from above, paused, back 0.2 mm inside the
+// bottom face: the plate pushes it out of the bottom (k·0.2 mm down), not up along the old side.
+TEST(World, APauseForgetsWhichSideOfAPenaltyPlateTheToolCameFrom) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.001, BodyKind::kStatic, 0.0);
+  w.materials[0].contact.max_penetration_m = 0.05;
+  w.materials[0].contact.max_force_n = 100.0;
+  World world(std::move(w));
+  for (int i = 0; i <= 15; ++i) {
+    world.step(at(Vec3(0.003, -0.002, 0.001 - 0.0001 * i)), 1e-3);  // down to 0.5 mm past middle
+  }
+  EXPECT_GT(world.last_result().tools[0].force_world_n.z(), 0.0) << "pushed back up: crossed";
+  world.forget_tool_motion();
+  const StepResult& r = world.step(at(Vec3(0.003, -0.002, -0.0018)), 1e-3);
+  EXPECT_NEAR(r.tools[0].force_world_n.z(), -500.0 * 0.0002, 1e-9);
+  EXPECT_EQ(r.penalty_pop_throughs, 0);
+}
+
+// A glove reading with a non-finite finger angle is unusable: the fingertips are held where they
+// were and nothing is pushed (never a NaN position or force).
+TEST(World, AGloveAngleThatIsNotFiniteHoldsTheHand) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.008);
+  w.has_hand = true;
+  w.tools[0].finger = 1;
+  World world(std::move(w));
+  DeviceInput in = at(Vec3(-0.05, 0.0, 0.02));
+  in.joint_count = kHandFingers * kGloveAnglesPerFinger;
+  in.joint_rad[4] = 0.8;
+  const Vec3 before = world.step(in, 1e-3).tools[0].p_world;
+  ASSERT_TRUE(before.allFinite());
+  in.joint_rad[4] = std::numeric_limits<double>::quiet_NaN();
+  in.p_world.z() -= 0.01;
+  const StepResult& r = world.step(in, 1e-3);
+  EXPECT_EQ(r.tools[0].p_world, before);
+  EXPECT_EQ(r.tools[0].force_world_n, Vec3::Zero());
+  EXPECT_EQ(r.command.finger_force_n[1], 0.0);
+  EXPECT_EQ(r.command.force_world_n, Vec3::Zero());
 }
 
 // Sliding over a curved penalty body turns the normal gradually: no crossing, no pop-through, the

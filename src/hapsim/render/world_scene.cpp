@@ -77,6 +77,7 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
       }
       segments_[world.flat_segment(b, s)] = std::move(seg);
     }
+    body_poses_.push_back(body.X_world_body);
   }
   // A floor just under the bodies, a little wider than them, with 1 cm checks for scale.
   if (!rest_bounds_world_.isEmpty()) {
@@ -150,8 +151,12 @@ void WorldScene::apply_colouring() {
 }
 
 void WorldScene::update(const WorldSnapshot& snapshot) {
+  if (snapshot.body_poses_world.size() == body_poses_.size()) {
+    body_poses_ = snapshot.body_poses_world;
+  }
   for (std::size_t i = 0; i < segments_.size(); ++i) {
     Segment& seg = *segments_[i];
+    scene_.mesh(seg.mesh).X_world_mesh = body_poses_[seg.body];
     if (!seg.deformable || i >= snapshot.positions_body.size() ||
         snapshot.positions_version[i] == seg.version) {
       continue;
@@ -168,7 +173,11 @@ void WorldScene::update(const WorldSnapshot& snapshot) {
 }
 
 void WorldScene::update_from_world(const World& world) {
+  for (std::size_t b = 0; b < body_poses_.size(); ++b) {
+    body_poses_[b] = world.body_pose(b);
+  }
   for (const auto& seg : segments_) {
+    scene_.mesh(seg->mesh).X_world_mesh = body_poses_[seg->body];
     if (seg->deformable) {
       scene_.update_positions(seg->mesh, world.surface(seg->body, seg->index_in_body).vertices);
     }
@@ -224,7 +233,7 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
         seg->tree =
             std::make_unique<SphereTree>(d.bodies[seg->body].segments[seg->index_in_body].mesh);
       }
-      const Iso3& X = d.bodies[seg->body].X_world_body;
+      const Iso3& X = body_poses_[seg->body];
       const auto level = static_cast<std::size_t>(options_.sphere_tree_level);
       for (std::size_t n = 0; n < seg->tree->node_count(); ++n) {
         const std::size_t node_level = seg->tree->node_level(n);

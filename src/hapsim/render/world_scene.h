@@ -41,7 +41,8 @@ class WorldScene {
   WorldScene(WorldScene&&) = delete;
   WorldScene& operator=(WorldScene&&) = delete;
 
-  /// From a snapshot: deformed segments re-uploaded only when their version changed.
+  /// From a snapshot: deformed segments (and sheets) re-uploaded only when their version
+  /// changed; every segment drawn where its body is now.
   void update(const WorldSnapshot& snapshot);
   /// From the world itself (only on the thread that steps it, while it is not stepping).
   void update_from_world(const World& world);
@@ -74,6 +75,7 @@ class WorldScene {
   std::vector<Vec3> scratch_positions_;
   std::vector<ToolState> tools_;
   std::vector<double> tool_force_n_;
+  std::vector<Iso3> body_poses_;  // where each body is drawn (dynamic bodies move)
   Box3 rest_bounds_world_;
 };
 

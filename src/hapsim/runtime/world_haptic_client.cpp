@@ -1,6 +1,7 @@
 #include "hapsim/runtime/world_haptic_client.h"
 
 #include "hapsim/deform/vertex_deflection.h"
+#include "hapsim/deform/virtual_sheet.h"
 
 #include <algorithm>
 
@@ -11,6 +12,9 @@ WorldHapticClient::WorldHapticClient(World& world, WorldHapticClientOptions opti
   const WorldDescription& d = world_.description();
   max_deflection_m_.assign(world_.flat_segment_count(), 0.0);
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
+    if (world_.sheet(b) != nullptr) {
+      sheets_.emplace_back(world_.flat_segment(b, 0), b);
+    }
     for (std::size_t s = 0; s < d.bodies[b].segments.size(); ++s) {
       const VertexDeflection* deflection = world_.deflection(b, s);
       if (deflection == nullptr) {
@@ -167,6 +171,21 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
     }
     pending.clear();
     s.positions_version[seg.flat] = seg.changes;
+  }
+  // Moving bodies and sheets: a pose per body and a few hundred grid nodes per sheet.
+  for (std::size_t b = 0; b < s.body_poses_world.size(); ++b) {
+    s.body_poses_world[b] = world_.body_pose(b);
+  }
+  ++sheet_version_;
+  for (const auto& [flat, body] : sheets_) {
+    const std::vector<Vec3>& vertices = world_.sheet(body)->mesh().vertices;
+    float* xyz = s.positions_body[flat].data();
+    for (std::size_t v = 0; v < vertices.size(); ++v) {
+      xyz[3 * v + 0] = static_cast<float>(vertices[v].x());
+      xyz[3 * v + 1] = static_cast<float>(vertices[v].y());
+      xyz[3 * v + 2] = static_cast<float>(vertices[v].z());
+    }
+    s.positions_version[flat] = sheet_version_;
   }
   snapshots_->publish();
 }

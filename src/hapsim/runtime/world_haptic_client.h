@@ -1,4 +1,5 @@
-// The haptic loop's client for a World (architecture.md#real-time): each cycle steps the world, then publishes
+// The haptic loop's client for a World (architecture.md#real-time): each cycle steps the world,
+// then publishes
 // - the newest snapshot for the viewer through a triple buffer (deformed vertices copied by
 //   delta: only the ones that moved since that slot was last written, so the copy costs about
 //   what the step's own deformation update did), and
@@ -92,6 +93,9 @@ class WorldHapticClient final : public HapticClient {
   std::unique_ptr<SpscRing<CycleRecord>> records_;
   CycleRecord scratch_record_;
   std::vector<DeformableSegment> deformable_;
+  /// Sheets: (flat segment, body); their small grids are published whole every cycle.
+  std::vector<std::pair<std::size_t, std::size_t>> sheets_;
+  std::uint64_t sheet_version_ = 0;
   std::vector<double> max_deflection_m_;
   std::atomic<std::uint64_t> dropped_records_{0};
   struct MaterialChange {

@@ -1,6 +1,7 @@
 #include "hapsim/runtime/world_snapshot.h"
 
 #include "hapsim/deform/vertex_deflection.h"
+#include "hapsim/deform/virtual_sheet.h"
 
 namespace hapsim {
 
@@ -16,7 +17,20 @@ WorldSnapshot make_world_snapshot(const World& world) {
   s.positions_body.resize(world.flat_segment_count());
   s.deflection_m.assign(world.flat_segment_count(), 0.0);
   s.positions_version.assign(world.flat_segment_count(), 0);
+  s.body_poses_world.resize(d.bodies.size());
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
+    s.body_poses_world[b] = world.body_pose(b);
+    if (const VirtualSheet* sheet = world.sheet(b)) {
+      const std::vector<Vec3>& vertices = sheet->mesh().vertices;
+      std::vector<float>& xyz = s.positions_body[world.flat_segment(b, 0)];
+      xyz.resize(3 * vertices.size());
+      for (std::size_t v = 0; v < vertices.size(); ++v) {
+        for (int k = 0; k < 3; ++k) {
+          xyz[3 * v + static_cast<std::size_t>(k)] = static_cast<float>(vertices[v][k]);
+        }
+      }
+      continue;
+    }
     for (std::size_t seg = 0; seg < d.bodies[b].segments.size(); ++seg) {
       const VertexDeflection* deflection = world.deflection(b, seg);
       if (deflection == nullptr) {

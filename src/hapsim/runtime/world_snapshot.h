@@ -31,7 +31,10 @@ struct WorldSnapshot {
   /// Per flat segment: largest deflection right now, metres.
   std::vector<double> deflection_m;
   /// Per flat segment: bumped whenever positions_body changed, so a reader re-uploads only then.
+  /// A sheet's grid (its surface, imprints included) is published there too, every cycle.
   std::vector<std::uint64_t> positions_version;
+  /// Per body: where it is now (dynamic bodies move).
+  std::vector<Iso3> body_poses_world;
   /// The teleoperation rig (slave, gripper, ball, sheet, master), when the world has one.
   std::optional<TeleopSnapshot> teleop;
 };

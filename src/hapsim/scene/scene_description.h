@@ -56,6 +56,27 @@ struct GlovePalpationDescription {
   double release_s = 0.6;
 };
 
+/// A scripted glove pick-and-place (the one-world scene hand_ball_sheet): the hand comes over the
+/// ball with thumb and index open, goes down around it, pinches it at its equator, lifts it,
+/// carries it over the sheet, presses it `press_depth_m` into the sheet, lets go and backs off.
+struct GlovePickAndPlaceDescription {
+  std::string ball;   ///< a dynamic body that is one sphere
+  std::string sheet;  ///< a sheet body (deformation "sheet")
+  /// Where on the sheet to put the ball, in the sheet's frame (x, y; metres from its centre).
+  Vec3 place_sheet = Vec3::Zero();
+  /// How far each fingertip presses into the ball, and how far the ball's bottom is pushed below
+  /// the sheet's rest surface.
+  double squeeze_m = 0.002;
+  double press_depth_m = 0.01;
+  /// Height of the carry above the sheet's rest surface (the ball's bottom), and how far apart
+  /// beyond the ball the open fingertips pass.
+  double lift_m = 0.06;
+  double open_clearance_m = 0.02;
+  /// Phase durations, seconds (> 0).
+  double approach_s = 1.0, close_s = 0.6, lift_s = 0.8, carry_s = 1.5, lower_s = 1.0, press_s = 0.8,
+         open_s = 0.5, retreat_s = 0.8, settle_s = 1.0;
+};
+
 /// The teleoperation scene's scripted master (device/pick_and_place_trajectory.h): picks the ball
 /// where it starts and places it at `place_m` (the ball's resting centre).
 struct PickAndPlaceDescription {
@@ -81,6 +102,9 @@ struct DeviceDescription {
   /// type "glove": the world's tools are the virtual hand's fingertips.
   bool has_glove_palpation = false;
   GlovePalpationDescription glove_palpation;
+  /// type "glove": a scripted pick-and-place by the hand (a dynamic ball onto a sheet).
+  bool has_glove_pick_and_place = false;
+  GlovePickAndPlaceDescription glove_pick_and_place;
 };
 
 /// A teleoperation scene (000): master arm → slave arm with a parallel gripper → ball → sheet.

@@ -1,10 +1,11 @@
 // The device a scene asks for: a simulated device playing the scene's trajectory file, or a
-// scripted palpation aimed at named segments of the world (architecture.md#scenes: the knee runs unattended).
+// scripted palpation aimed at named segments of the world (architecture.md#scenes: the knee runs
+// unattended).
 #pragma once
 
-#include "hapsim/script/palpation_trajectory.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/scene/scene_description.h"
+#include "hapsim/script/palpation_trajectory.h"
 #include "hapsim/world/world.h"
 
 #include <filesystem>
@@ -36,6 +37,13 @@ struct PalpationAim {
 /// hapsim::Error ("glove palpation") when a finger cannot reach its target from that hand pose.
 [[nodiscard]] Trajectory make_scene_glove_palpation(const World& world,
                                                     const GlovePalpationDescription& script);
+
+/// The scripted glove pick-and-place of a scene (GlovePickAndPlaceDescription): thumb and index
+/// pinch the named ball at its equator, from a hand pose (palm down) solved so both fingertips
+/// reach their goals; the open pose puts them `open_clearance_m` further out on the same line.
+/// Throws hapsim::Error ("glove pick-and-place") naming what is missing or out of reach.
+[[nodiscard]] Trajectory make_scene_glove_pick_and_place(
+    const World& world, const GlovePickAndPlaceDescription& script);
 
 /// The device of the scene: `trajectory_override` (a CSV file) if given, else the scene's
 /// trajectory file, else its palpation script. Throws hapsim::Error if the scene has none.

@@ -83,7 +83,7 @@ void body_contacts(const WorldModel& model, WorldState& state, double /*dt_s*/) 
         v_rel -= other.velocity_at(point_world, other_model.com_body);
       }
       const ContactMaterial material =
-          combine_materials(state.materials[own.material], state.materials[seg.material]);
+          combine_materials(state.body_materials[own.material], state.body_materials[seg.material]);
       const Vec3 f_normal = penalty_force(material, depth, n_world, -v_rel.dot(n_world));
       StickPoint stick{pair.stick_body.active, other.X_world_body * pair.stick_body.p};
       const Vec3 f = f_normal + contact_friction_force(material, f_normal.norm(), n_world, v_rel,

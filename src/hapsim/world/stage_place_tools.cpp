@@ -21,7 +21,8 @@ void place_rig(const WorldModel& model, RigState& rig, const DeviceInput& input,
   TeleopStepResult& r = rig.result;
   const std::array<double, 3> arm{input.joint_rad[0], input.joint_rad[1], input.joint_rad[2]};
   const std::array<double, 2> fingers{input.finger_rad[0], input.finger_rad[1]};
-  rig.input_usable = input.healthy;
+  // A master gives three arm joints and two fingers: fewer is not a master's reading.
+  rig.input_usable = input.healthy && input.joint_count >= 3 && input.finger_count >= 2;
   for (const double v : {arm[0], arm[1], arm[2], fingers[0], fingers[1]}) {
     rig.input_usable = rig.input_usable && std::isfinite(v);
   }
@@ -50,6 +51,13 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
   }
   state.input_usable = input.healthy && input.p_world.allFinite() &&
                        input.q_world.coeffs().allFinite() && input.q_world.squaredNorm() > 0.5;
+  if (model.hand() != nullptr) {
+    // A glove's finger angles place the tools: a non-finite one makes the input unusable.
+    const int n = std::clamp(input.joint_count, 0, kMaxDeviceJoints);
+    for (int j = 0; j < n && state.input_usable; ++j) {
+      state.input_usable = std::isfinite(input.joint_rad[static_cast<std::size_t>(j)]);
+    }
+  }
   if (!state.input_usable) {
     for (ToolRuntime& tool : state.tools) {
       tool.has_previous = false;  // no velocity spike when the input comes back

@@ -1,4 +1,4 @@
-// Stage 5: what leaves the world is finite. A tool whose force is not finite renders nothing; the
+// Stage 6: what leaves the world is finite. A tool whose force is not finite renders nothing; the
 // device command is assembled from the tools (a finger tool drives its finger's actuator, the
 // largest force among its tools; the others add up at the tip). The device's own limits (its
 // rated force, the stall ramp) are applied after the world, by the runtime's safety layer
@@ -8,6 +8,7 @@
 #include "hapsim/world/world_state.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace hapsim::stage {
 
@@ -37,9 +38,13 @@ void rig_command(const WorldModel& model, RigState& rig) noexcept {
   r.command.joint_torque_nm[3] = t.fingers_n_m[0];
   r.command.joint_torque_nm[4] = t.fingers_n_m[1];
   r.command.joint_count = 5;
-  r.command.finger_force_n[0] = r.gripper.grasp_force_n();
-  r.command.finger_force_n[1] = r.gripper.grasp_force_n();
+  const double grasp = r.gripper.grasp_force_n();
+  r.command.finger_force_n[0] = std::isfinite(grasp) ? grasp : 0.0;
+  r.command.finger_force_n[1] = r.command.finger_force_n[0];
   r.command.finger_count = 2;
+  for (double& torque : r.command.joint_torque_nm) {
+    torque = std::isfinite(torque) ? torque : 0.0;
+  }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/world/world_step.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace hapsim {
@@ -16,7 +17,7 @@ World::World(WorldDescription description, WorldOptions options)
   for (std::size_t m = 0; m < state_.materials.size(); ++m) {
     state_.materials[m] = hapsim::effective_material(model_, state_.material_contact[m], 1e-3);
   }
-  state_.materials_dt_s = 1e-3;
+  state_.materials_dt_s = -1.0;  // the first step fills every material table for its own dt
   build_ms_ = build_watch_.elapsed_ms();
 }
 
@@ -87,6 +88,12 @@ ContactMaterial World::effective_material(std::uint32_t material, double dt_s) c
 void World::forget_tool_motion() noexcept {
   for (ToolRuntime& tool : state_.tools) {
     tool.has_previous = false;
+    // The tool may come back anywhere (as after an unusable input): no side or dent is kept.
+    for (PenaltySide& side : tool.penalty_side) {
+      side = PenaltySide{};
+    }
+    std::fill(tool.pressing.begin(), tool.pressing.end(), std::uint8_t{0});
+    std::fill(tool.stick_body.begin(), tool.stick_body.end(), StickPoint{});
   }
 }
 

@@ -112,6 +112,9 @@ std::string content_hash(const WorldDescription& description) {
       h.number(b.sheet.nodes_per_side);
       h.number(b.sheet.side_m);
       h.number(b.sheet.max_depth_m);
+      h.number(b.sheet_profile.cutoff_radius_m);
+      h.number(b.sheet_profile.width_m);
+      h.number(b.sheet_profile.sensitivity_n_per_m);
     }
     for (const SegmentDescription& s : b.segments) {
       h.text(s.name);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "hapsim/core/types.h"
+#include "hapsim/deform/sheet_profile.h"
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/deform/virtual_sheet.h"
 #include "hapsim/dynamics/ball_environment.h"
@@ -121,6 +122,8 @@ struct BodyDescription {
   /// (make_sheet(sheet.nodes_per_side, sheet.side_m), body frame = sheet frame, z up).
   BodyDeformation deformation = BodyDeformation::kVertexDeflection;
   VirtualSheetOptions sheet;
+  /// The sheet's Gaussian profile (d0, ξ, F0; the paper's by default).
+  GaussianSheetParams sheet_profile;
 };
 
 /// A contact sphere driven by the device: a stylus tip or a fingertip.

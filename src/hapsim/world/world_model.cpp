@@ -7,6 +7,7 @@
 #include "hapsim/core/device_io.h"
 #include "hapsim/core/error.h"
 #include "hapsim/core/stopwatch.h"
+#include "hapsim/deform/sheet_profile.h"
 #include "hapsim/force/god_object.h"
 
 #include <Eigen/Eigenvalues>
@@ -200,6 +201,7 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
     }
     bodies_.push_back(bm);
   }
+  check_sheet_contacts();
   if (!dynamic_bodies_.empty()) {
     for (SegmentModel& seg : segments_) {
       if (!seg.sheet) {
@@ -223,6 +225,38 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
 }
 
 WorldModel::~WorldModel() = default;
+
+// A sheet answers contacts from its elastic field, which takes this step's push one step later:
+// the push and the field's give settle only while the contact spring is softer than the sheet
+// under a contact, k · compliance < 1 (else the press grows from step to step).
+void WorldModel::check_sheet_contacts() const {
+  const WorldDescription& d = description_;
+  for (const BodyModel& sheet : bodies_) {
+    if (!sheet.sheet) {
+      continue;
+    }
+    const BodyDescription& body = d.bodies[static_cast<std::size_t>(&sheet - bodies_.data())];
+    const double compliance_m_per_n = GaussianSheetProfile(body.sheet_profile).depth_m(0.0, 1.0);
+    const ContactMaterial& own = d.materials[body.segments.front().material].contact;
+    const auto check = [&](double k, const std::string& what) {
+      if (!(k * compliance_m_per_n < 1.0)) {
+        throw Error("body '" + body.name + "'",
+                    what + " presses the sheet with " + std::to_string(k) +
+                        " N/m, not softer than the sheet under a contact (" +
+                        std::to_string(1.0 / compliance_m_per_n) +
+                        " N/m): the press would not settle; soften the material or stiffen the "
+                        "sheet (sensitivity_n_per_mm)");
+      }
+    };
+    if (!d.tools.empty()) {
+      check(std::min(own.stiffness_n_per_m, options_.max_stiffness_n_per_m), "a tool");
+    }
+    for (const std::size_t b : dynamic_bodies_) {
+      const ContactMaterial& ball = d.materials[d.bodies[b].segments.front().material].contact;
+      check(combine_materials(ball, own).stiffness_n_per_m, "body '" + d.bodies[b].name + "'");
+    }
+  }
+}
 
 double WorldModel::slave_width_for(double master_opening_m) const noexcept {
   if (!master_) {

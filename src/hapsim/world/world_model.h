@@ -102,6 +102,8 @@ class WorldModel {
   [[nodiscard]] double build_ms() const { return build_ms_; }
 
  private:
+  void check_sheet_contacts() const;
+
   WorldDescription description_;
   WorldOptions options_;
   std::unique_ptr<HandModel> hand_;

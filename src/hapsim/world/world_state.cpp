@@ -72,7 +72,8 @@ WorldState::WorldState(const WorldModel& model) {
     if (seg.sheet) {
       const BodyDescription& body = d.bodies[seg.body];
       try {
-        segments[i].sheet = std::make_unique<VirtualSheet>(body.sheet);
+        segments[i].sheet = std::make_unique<VirtualSheet>(
+            body.sheet, std::make_unique<GaussianSheetProfile>(body.sheet_profile));
       } catch (const Error& e) {
         throw Error("body '" + body.name + "'", e.what());
       }
@@ -126,6 +127,7 @@ WorldState::WorldState(const WorldModel& model) {
     material_contact.push_back(m.contact);
   }
   materials.resize(d.materials.size());
+  body_materials.resize(d.materials.size());
   for (ToolRuntime& tool : tools) {
     for (std::size_t i = 0; i < segs.size(); ++i) {
       const SegmentModel& seg = segs[i];

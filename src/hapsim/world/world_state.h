@@ -248,6 +248,9 @@ struct WorldState {
   std::vector<ContactMaterial> material_contact;
   /// Effective materials (stiffness clamped, passivity damping floor) for `materials_dt_s`.
   std::vector<ContactMaterial> materials;
+  /// The same for contacts between bodies (body-contact stage): the passivity floor without the
+  /// device's stiffness clamp (no device renders them).
+  std::vector<ContactMaterial> body_materials;
   double materials_dt_s = -1.0;
 
   std::vector<SegmentState> segments;  ///< per flat segment

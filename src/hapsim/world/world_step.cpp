@@ -27,6 +27,12 @@ void refresh_materials(const WorldModel& model, WorldState& state, double dt_s) 
   state.materials_dt_s = dt_s;
   for (std::size_t m = 0; m < state.materials.size(); ++m) {
     state.materials[m] = effective_material(model, state.material_contact[m], dt_s);
+    // Between bodies no device renders the force: no device clamp, the passivity floor only.
+    ContactMaterial& body = state.body_materials[m];
+    body = state.material_contact[m];
+    body.damping_n_s_per_m =
+        std::max(body.damping_n_s_per_m, model.description().passivity_damping_factor *
+                                             body.stiffness_n_per_m * (dt_s > 0.0 ? dt_s : 0.0));
   }
 }
 
