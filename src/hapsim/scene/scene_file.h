@@ -1,7 +1,12 @@
 // Reading scene files ("format": "hapsim-scene/1", docs/scene-format.md, scenes/scene.schema.json)
 // into a SceneDescription: materials, bodies and their geometry (procedural knee, box, sphere,
-// sheet, a mesh file, or a folder of mesh files, one segment each), tools, the device and the
-// run. Every error is a hapsim::Error whose where() is "<file>:<JSON pointer>" and whose message
+// sheet, a mesh file, a folder of mesh files (one segment each), or a CSG solid), tools, the
+// device and the run; or, for a teleoperation scene, the rig and its master device. This file
+// reads the top level, materials, bodies, tools and run; the parts have their own readers on the
+// same SceneReader (scene_reader.h: JSON pointers in errors, paths): geometry_reader.h (a body's
+// geometry into segments; CSG solids in csg_reader.h), device_reader.h (the device, palpation and
+// glove palpation scripts) and teleop_reader.h (the teleoperation branch).
+// Every error is a hapsim::Error whose where() is "<file>:<JSON pointer>" and whose message
 // says what was expected; unknown keys are errors; a load either returns a complete description
 // or throws (nothing half-loads).
 #pragma once

@@ -1,0 +1,177 @@
+#include "hapsim/scene/geometry_reader.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/geometry/mesh_io.h"
+#include "hapsim/geometry/procedural.h"
+#include "hapsim/scene/csg_reader.h"
+
+#include <algorithm>
+#include <set>
+
+namespace hapsim {
+
+using Json = JsonReader::Json;
+
+BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
+                                  const std::string& body_name) {
+  r_.object(j, ptr, "a geometry");
+  const char* kinds[] = {"procedural", "box", "sphere", "sheet", "mesh", "mesh_folder", "csg"};
+  std::string kind;
+  for (const char* k : kinds) {
+    if (j.contains(k)) {
+      if (!kind.empty()) {
+        r_.fail(ptr, "expected exactly one geometry kind, got both '" + kind + "' and '" + k + "'");
+      }
+      kind = k;
+    }
+  }
+  if (kind.empty()) {
+    r_.fail(ptr,
+            "expected one geometry kind: procedural, box, sphere, sheet, mesh, mesh_folder or csg");
+  }
+  const std::string kp = JsonReader::at(ptr, kind);
+  BodyGeometry body;
+  auto add = [&](std::string name, TriangleMesh mesh, std::optional<TissueKind> tissue,
+                 bool two_sided = false) {
+    SegmentDescription s;
+    s.name = std::move(name);
+    s.mesh = std::move(mesh);
+    s.two_sided = two_sided;
+    body.segments.push_back(std::move(s));
+    body.tissues.push_back(tissue);
+  };
+  const ProgressFn& progress = r_.options().progress;
+  if (kind == "procedural") {
+    r_.allow_keys(j, ptr, {"procedural", "resolution_scale", "include_skin"});
+    r_.one_of(j["procedural"], kp, {"knee"});
+    ProceduralKneeOptions o;
+    o.resolution_scale = r_.number_in(j, ptr, "resolution_scale", 1.0, 0.25, 4.0, "", true);
+    if (j.contains("include_skin")) {
+      if (!j["include_skin"].is_boolean()) {
+        r_.fail(JsonReader::at(ptr, "include_skin"),
+                "expected true or false, got " + JsonReader::shown(j["include_skin"]));
+      }
+      o.include_skin = j["include_skin"].get<bool>();
+    }
+    report_progress(progress, "scene: generating the procedural knee", 0.0);
+    for (KneePart& part : make_procedural_knee(o)) {
+      add(part.name, std::move(part.mesh), part.tissue);
+    }
+    return body;
+  }
+  if (kind == "csg") {
+    report_progress(progress, "scene: polygonising the CSG solid of " + body_name, 0.0);
+    CsgGeometry g = read_csg_geometry(r_, j, ptr, progress);
+    add(body_name, std::move(g.mesh), std::nullopt);
+    body.segments.back().csg = std::move(g.solid);
+    return body;
+  }
+  r_.allow_keys(j, ptr, {kind.c_str()});
+  if (kind == "box") {
+    const Json& b = r_.object(j[kind], kp, "box settings");
+    r_.allow_keys(b, kp, {"half_extents_m"});
+    const Vec3 h =
+        r_.vec3(r_.required(b, kp, "half_extents_m"), JsonReader::at(kp, "half_extents_m"), "m");
+    if (!(h.minCoeff() > 0.0)) {
+      r_.fail(JsonReader::at(kp, "half_extents_m"), "expected half extents > 0 m");
+    }
+    add(body_name, make_box(h), std::nullopt);
+  } else if (kind == "sphere") {
+    const Json& s = r_.object(j[kind], kp, "sphere settings");
+    r_.allow_keys(s, kp, {"radius_m", "segments"});
+    if (!s.contains("radius_m")) {
+      r_.fail(kp, "missing required key 'radius_m'");
+    }
+    const double r = r_.number_in(s, kp, "radius_m", 0.0, 0.0, 100.0, "m", true);
+    const auto n = static_cast<int>(r_.number_in(s, kp, "segments", 64, 8, 1024, ""));
+    add(body_name, make_uv_sphere(r, n, n / 2), std::nullopt);
+  } else if (kind == "sheet") {
+    const Json& s = r_.object(j[kind], kp, "sheet settings");
+    r_.allow_keys(s, kp, {"size_m", "nodes_per_side"});
+    if (!s.contains("size_m")) {
+      r_.fail(kp, "missing required key 'size_m'");
+    }
+    const double size = r_.number_in(s, kp, "size_m", 0.0, 0.0, 100.0, "m", true);
+    const auto n = static_cast<int>(r_.number_in(s, kp, "nodes_per_side", 32, 2, 2048, ""));
+    add(body_name, make_sheet(n, size), std::nullopt, true);
+  } else if (kind == "mesh" || kind == "mesh_folder") {
+    const Json& m = r_.object(j[kind], kp, kind + " settings");
+    if (kind == "mesh") {
+      r_.allow_keys(m, kp, {"file", "scale"});
+    } else {
+      r_.allow_keys(m, kp, {"folder", "pattern", "scale", "strip_prefix", "strip_suffix"});
+    }
+    MeshLoadOptions lo;
+    lo.scale = r_.number_in(m, kp, "scale", 1.0, 0.0, 1e6, "metres per file unit", true);
+    auto load = [&](const std::filesystem::path& file, const std::string& p) {
+      try {
+        return load_mesh(file, lo);
+      } catch (const Error& e) {
+        r_.fail(p, "cannot load mesh " + e.where() + ": " + e.detail());
+      }
+    };
+    if (kind == "mesh") {
+      const std::string fp = JsonReader::at(kp, "file");
+      const std::filesystem::path file =
+          r_.path(r_.required(m, kp, "file"), fp, "a mesh file path");
+      add(body_name, load(file, fp), std::nullopt);
+    } else {
+      const std::string fp = JsonReader::at(kp, "folder");
+      const std::filesystem::path folder =
+          r_.path(r_.required(m, kp, "folder"), fp, "a folder path");
+      if (!std::filesystem::is_directory(folder)) {
+        r_.fail(fp, "expected a folder of mesh files; " + folder.string() + " is not a folder");
+      }
+      std::string pattern = "*.stl";
+      if (m.contains("pattern")) {
+        pattern = r_.nonempty_string(m["pattern"], JsonReader::at(kp, "pattern"),
+                                     "a file pattern like *.stl");
+        if (pattern.rfind('*', 0) != 0 || pattern.find('*', 1) != std::string::npos) {
+          r_.fail(JsonReader::at(kp, "pattern"),
+                  "expected '*' followed by a file-name ending, e.g. '*.stl'");
+        }
+      }
+      const std::string ending = ascii_lower(pattern.substr(1));
+      const std::string prefix =
+          m.contains("strip_prefix")
+              ? r_.string(m["strip_prefix"], JsonReader::at(kp, "strip_prefix"), "text")
+              : "";
+      const std::string suffix =
+          m.contains("strip_suffix")
+              ? r_.string(m["strip_suffix"], JsonReader::at(kp, "strip_suffix"), "text")
+              : "";
+      std::vector<std::filesystem::path> files;
+      for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+        const std::string name = ascii_lower(entry.path().filename().string());
+        if (entry.is_regular_file() && name.size() >= ending.size() &&
+            name.compare(name.size() - ending.size(), ending.size(), ending) == 0) {
+          files.push_back(entry.path());
+        }
+      }
+      std::sort(files.begin(), files.end());
+      if (files.empty()) {
+        r_.fail(fp, "no file matching '" + pattern + "' in " + folder.string());
+      }
+      std::set<std::string> names;
+      for (std::size_t i = 0; i < files.size(); ++i) {
+        report_progress(progress, "scene: loading " + files[i].filename().string(),
+                        static_cast<double>(i) / static_cast<double>(files.size()));
+        std::string name = files[i].stem().string();
+        if (!prefix.empty() && name.rfind(prefix, 0) == 0) {
+          name = name.substr(prefix.size());
+        }
+        if (!suffix.empty() && name.size() > suffix.size() &&
+            name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+          name = name.substr(0, name.size() - suffix.size());
+        }
+        if (!names.insert(name).second) {
+          r_.fail(fp, "two files give the segment name '" + name + "'");
+        }
+        add(name, load(files[i], fp), std::nullopt);
+      }
+    }
+  }
+  return body;
+}
+
+}  // namespace hapsim

@@ -1,0 +1,105 @@
+#include "hapsim/scene/teleop_reader.h"
+
+namespace hapsim {
+
+using Json = JsonReader::Json;
+
+void read_teleop(const SceneReader& r, const Json& j, const std::string& ptr,
+                 TeleopSceneDescription& t) {
+  r.object(j, ptr, "teleoperation settings");
+  r.allow_keys(j, ptr, {"slave", "mapping", "gripper", "ball", "sheet", "floor_z_m"});
+  if (j.contains("slave")) {
+    const std::string sp = JsonReader::at(ptr, "slave");
+    const Json& s = r.object(j["slave"], sp, "the slave arm");
+    r.allow_keys(s, sp, {"model", "urdf", "tip"});
+    if (s.contains("model") == s.contains("urdf")) {
+      r.fail(sp, "expected one of 'model' (\"procedural\") or 'urdf' (a URDF file)");
+    }
+    if (s.contains("model")) {
+      r.one_of(s["model"], JsonReader::at(sp, "model"), {"procedural"});
+    } else {
+      t.slave_urdf = r.path(s["urdf"], JsonReader::at(sp, "urdf"), "a URDF file path");
+      if (!std::filesystem::is_regular_file(t.slave_urdf)) {
+        r.fail(JsonReader::at(sp, "urdf"), "no such file: " + t.slave_urdf.string());
+      }
+    }
+    if (s.contains("tip")) {
+      t.slave_tip = r.nonempty_string(s["tip"], JsonReader::at(sp, "tip"), "a link name");
+    }
+  }
+  if (j.contains("mapping")) {
+    const std::string mp = JsonReader::at(ptr, "mapping");
+    const Json& m = r.object(j["mapping"], mp, "the master-to-slave mapping");
+    r.allow_keys(m, mp, {"scale", "offset_m"});
+    t.scale = r.number_in(m, mp, "scale", t.scale, 0.0, 100.0, "", true);
+    if (m.contains("offset_m")) {
+      t.offset_m = r.vec3(m["offset_m"], JsonReader::at(mp, "offset_m"), "m");
+    }
+  }
+  if (j.contains("gripper")) {
+    const std::string gp = JsonReader::at(ptr, "gripper");
+    const Json& g = r.object(j["gripper"], gp, "gripper settings");
+    r.allow_keys(g, gp, {"max_force_n", "max_width_m", "speed_m_per_s"});
+    t.gripper_max_force_n =
+        r.number_in(g, gp, "max_force_n", t.gripper_max_force_n, 0.0, 1000.0, "N", true);
+    t.gripper_max_width_m =
+        r.number_in(g, gp, "max_width_m", t.gripper_max_width_m, 0.0, 1.0, "m", true);
+    t.gripper_speed_m_per_s =
+        r.number_in(g, gp, "speed_m_per_s", t.gripper_speed_m_per_s, 0.0, 10.0, "m/s", true);
+  }
+  if (j.contains("ball")) {
+    const std::string bp = JsonReader::at(ptr, "ball");
+    const Json& b = r.object(j["ball"], bp, "ball settings");
+    r.allow_keys(b, bp, {"mass_kg", "radius_m", "start_m"});
+    t.ball_mass_kg = r.number_in(b, bp, "mass_kg", t.ball_mass_kg, 0.0, 100.0, "kg", true);
+    t.ball_radius_m = r.number_in(b, bp, "radius_m", t.ball_radius_m, 0.0, 1.0, "m", true);
+    if (b.contains("start_m")) {
+      t.ball_start_m = r.vec3(b["start_m"], JsonReader::at(bp, "start_m"), "m");
+    }
+  }
+  if (j.contains("sheet")) {
+    const std::string shp = JsonReader::at(ptr, "sheet");
+    const Json& sh = r.object(j["sheet"], shp, "sheet settings");
+    r.allow_keys(sh, shp, {"nodes_per_side", "size_m", "position_m"});
+    t.sheet_nodes_per_side =
+        static_cast<int>(r.number_in(sh, shp, "nodes_per_side", 16, 2, 512, ""));
+    t.sheet_size_m = r.number_in(sh, shp, "size_m", t.sheet_size_m, 0.0, 100.0, "m", true);
+    if (sh.contains("position_m")) {
+      t.sheet_position_m = r.vec3(sh["position_m"], JsonReader::at(shp, "position_m"), "m");
+    }
+  }
+  t.floor_z_m = r.number_in(j, ptr, "floor_z_m", t.floor_z_m, -100.0, 100.0, "m");
+}
+
+void read_teleop_device(const SceneReader& r, const Json& j, const std::string& ptr,
+                        DeviceDescription& d) {
+  r.object(j, ptr, "the master device");
+  r.allow_keys(j, ptr, {"type", "trajectory", "pick_and_place"});
+  d.profile = "simulated";
+  if (j.contains("type")) {
+    d.type = r.one_of(j["type"], JsonReader::at(ptr, "type"), {"simulated"});
+  }
+  if (j.contains("trajectory") == j.contains("pick_and_place")) {
+    r.fail(ptr,
+           "expected exactly one of 'trajectory' (a CSV of master joints j0..j2 and fingers "
+           "f0, f1) or 'pick_and_place' (a script)");
+  }
+  if (j.contains("trajectory")) {
+    d.trajectory_file =
+        r.path(j["trajectory"], JsonReader::at(ptr, "trajectory"), "a trajectory CSV path");
+    if (!std::filesystem::is_regular_file(d.trajectory_file)) {
+      r.fail(JsonReader::at(ptr, "trajectory"), "no such file: " + d.trajectory_file.string());
+    }
+    return;
+  }
+  const std::string pp = JsonReader::at(ptr, "pick_and_place");
+  const Json& p = r.object(j["pick_and_place"], pp, "a pick-and-place script");
+  r.allow_keys(p, pp, {"place_m", "clearance_m", "carry_s"});
+  d.has_pick_and_place = true;
+  PickAndPlaceDescription& s = d.pick_and_place;
+  s.place_m = r.vec3(r.required(p, pp, "place_m"), JsonReader::at(pp, "place_m"), "m");
+  s.clearance_m = r.number_in(p, pp, "clearance_m", s.clearance_m, 0.0, 1.0, "m", true);
+  s.carry_s = r.number_in(p, pp, "carry_s", s.carry_s, 0.0, 60.0, "seconds", true);
+}
+
+}  // namespace hapsim
