@@ -190,6 +190,27 @@ nlohmann::json summary_json(const SceneDescription& scene, const World& world,
                              {"peak_force_n", g.peak_force_n},
                              {"max_deflection_m", g.max_deflection_m}});
   }
+  if (!s.bodies.empty()) {
+    j["bodies"] = nlohmann::json::array();
+    for (const BodySummary& b : s.bodies) {
+      const auto xyz = [](const Vec3& v) { return std::vector<double>{v.x(), v.y(), v.z()}; };
+      j["bodies"].push_back({{"name", b.name},
+                             {"start_m", xyz(b.start_world)},
+                             {"final_m", xyz(b.final_world)},
+                             {"max_rise_m", b.max_rise_m},
+                             {"final_speed_m_per_s", b.final_speed_m_per_s},
+                             {"touching_at_end", b.touching_at_end},
+                             {"nonfinite_steps", b.nonfinite_steps}});
+    }
+  }
+  if (!s.sheets.empty()) {
+    j["sheets"] = nlohmann::json::array();
+    for (const SheetSummary& sh : s.sheets) {
+      j["sheets"].push_back({{"name", sh.name},
+                             {"max_depth_m", sh.max_depth_m},
+                             {"final_depth_m", sh.final_depth_m}});
+    }
+  }
   std::vector<std::string> methods;
   for (const BodyDescription& b : world.description().bodies) {
     methods.emplace_back(to_string(b.method));

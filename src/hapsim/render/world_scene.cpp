@@ -52,6 +52,12 @@ Vec3f WorldScene::tissue_colour(std::string_view material_name, int material_ind
   if (contains(n, "sheet")) {
     return {0.55f, 0.75f, 0.95f};
   }
+  if (contains(n, "table") || contains(n, "wood")) {
+    return {0.62f, 0.46f, 0.30f};
+  }
+  if (contains(n, "ball") || contains(n, "rubber")) {
+    return {0.95f, 0.55f, 0.15f};
+  }
   return palette_colour(material_index);
 }
 

@@ -21,6 +21,25 @@ void fill_cycle_record(CycleRecord& record, std::uint64_t cycle, const DeviceInp
   record.dropped_contacts = std::max(0, result.dropped_contacts) +
                             static_cast<std::int32_t>(result.contacts.size() - contacts);
   record.penalty_pop_throughs = result.penalty_pop_throughs;
+  record.dynamic_count = 0;
+  for (std::size_t b = 0; b < result.bodies.size(); ++b) {
+    if (result.bodies[b].dynamic && record.dynamic_count < kMaxCycleDynamicBodies) {
+      const auto i = static_cast<std::size_t>(record.dynamic_count++);
+      record.dynamic_p_world[i] = result.bodies[b].X_world_body.translation();
+      record.dynamic_touching[i] = 0;
+      for (const BodyContact& c : result.body_contacts) {
+        if (c.body == static_cast<std::int32_t>(b) && c.other_body < 64) {
+          record.dynamic_touching[i] |= std::uint64_t{1} << c.other_body;
+        }
+      }
+    }
+  }
+  record.sheet_count = 0;
+  for (const double depth : result.sheet_depth_m) {
+    if (record.sheet_count < kMaxCycleSheets) {
+      record.sheet_depth_m[static_cast<std::size_t>(record.sheet_count++)] = depth;
+    }
+  }
   record.has_teleop = result.teleop != nullptr;
   if (record.has_teleop) {
     record.teleop = *result.teleop;

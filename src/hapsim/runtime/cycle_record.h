@@ -13,6 +13,9 @@ namespace hapsim {
 
 inline constexpr int kMaxCycleTools = 8;
 inline constexpr int kMaxCycleContacts = 64;
+/// Dynamic bodies and sheets a cycle record follows (the first ones of the world).
+inline constexpr int kMaxCycleDynamicBodies = 8;
+inline constexpr int kMaxCycleSheets = 4;
 
 struct CycleRecord {
   std::uint64_t cycle = 0;
@@ -30,6 +33,14 @@ struct CycleRecord {
   std::int32_t dropped_contacts = 0;
   /// Tools pulled through a penalty segment this cycle (StepResult::penalty_pop_throughs).
   std::int32_t penalty_pop_throughs = 0;
+  /// The first dynamic bodies (in body order): where their body frames are
+  /// and, as a bit per body index (< 64), which bodies each touches this cycle.
+  std::array<Vec3, kMaxCycleDynamicBodies> dynamic_p_world{};
+  std::array<std::uint64_t, kMaxCycleDynamicBodies> dynamic_touching{};
+  std::int32_t dynamic_count = 0;
+  /// The first sheets (in flat segment order): their deepest dent, metres.
+  std::array<double, kMaxCycleSheets> sheet_depth_m{};
+  std::int32_t sheet_count = 0;
   /// The teleoperation rig's step (when the world has a rig: has_teleop).
   bool has_teleop = false;
   TeleopStepResult teleop;

@@ -104,6 +104,20 @@ class SessionAccountant {
     if (options.check_pop_through) {
       checks_ = make_proxy_checks(world);
     }
+    for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
+      if (desc.bodies[b].kind == BodyKind::kDynamic &&
+          summary_.bodies.size() < static_cast<std::size_t>(kMaxCycleDynamicBodies)) {
+        BodySummary body;
+        body.name = desc.bodies[b].name;
+        body.start_world = world.body_pose(b).translation();
+        summary_.bodies.push_back(body);
+        dynamic_bodies_.push_back(b);
+      }
+      if (world.sheet(b) != nullptr &&
+          summary_.sheets.size() < static_cast<std::size_t>(kMaxCycleSheets)) {
+        summary_.sheets.push_back(SheetSummary{desc.bodies[b].name, 0.0, 0.0});
+      }
+    }
     if (world.rig() != nullptr) {
       summary_.teleop.emplace();
       ball_start_z_ = world.rig()->ball.p_world().z();
@@ -169,6 +183,22 @@ class SessionAccountant {
     if (r.has_teleop) {
       account_teleop(r.teleop);
     }
+    for (std::size_t i = 0; i < std::min<std::size_t>(static_cast<std::size_t>(r.dynamic_count),
+                                                      summary_.bodies.size());
+         ++i) {
+      BodySummary& body = summary_.bodies[i];
+      const Vec3& p = r.dynamic_p_world[i];
+      body.nonfinite_steps += p.allFinite() ? 0 : 1;
+      body.max_rise_m = std::max(body.max_rise_m, p.z() - body.start_world.z());
+      last_touching_[i] = r.dynamic_touching[i];
+    }
+    for (std::size_t i = 0;
+         i < std::min<std::size_t>(static_cast<std::size_t>(r.sheet_count), summary_.sheets.size());
+         ++i) {
+      SheetSummary& sheet = summary_.sheets[i];
+      sheet.max_depth_m = std::max(sheet.max_depth_m, r.sheet_depth_m[i]);
+      sheet.final_depth_m = r.sheet_depth_m[i];
+    }
     if (options_.recorder != nullptr) {
       if (!options_.recorder->record(to_recorded_frame(r))) {
         ++summary_.recording_dropped_frames;
@@ -216,8 +246,20 @@ class SessionAccountant {
           ts.contact_steps > 0 ? force_sum_[t] / static_cast<double>(ts.contact_steps) : 0.0;
     }
     summary_.step_us = summarize_samples(cost_us_);
+    // The run has ended: the world is this thread's again.
+    const WorldDescription& desc = world_.description();
+    for (std::size_t i = 0; i < summary_.bodies.size(); ++i) {
+      BodySummary& body = summary_.bodies[i];
+      const std::size_t b = dynamic_bodies_[i];
+      body.final_world = world_.body_pose(b).translation();
+      body.final_speed_m_per_s = world_.state().bodies[b].v_world.norm();
+      for (std::size_t other = 0; other < std::min<std::size_t>(desc.bodies.size(), 64); ++other) {
+        if ((last_touching_[i] >> other) & 1U) {
+          body.touching_at_end.push_back(desc.bodies[other].name);
+        }
+      }
+    }
     if (summary_.teleop) {
-      // The run has ended: the world is this thread's again.
       TeleopSummary& t = *summary_.teleop;
       t.ball_final_world = world_.rig()->ball.p_world();
       if (options_.teleop_target_world) {
@@ -238,6 +280,8 @@ class SessionAccountant {
   // Per-segment touch flags of one step, so a tool-step counts once per segment.
   std::vector<std::uint8_t> touched_;
   double ball_start_z_ = 0.0;
+  std::vector<std::size_t> dynamic_bodies_;  // body index of each BodySummary
+  std::array<std::uint64_t, kMaxCycleDynamicBodies> last_touching_{};
 };
 
 SessionSummary run_inline(World& world, Device& device, const SessionOptions& options,
@@ -423,6 +467,29 @@ std::string format_session_summary(const SessionSummary& s) {
                   "\nsheet        deepest dent %.3f mm\nslave        largest tip error while "
                   "tracking %.3f mm\n",
                   t.max_sheet_deflection_m * 1e3, t.max_slave_tracking_error_m * 1e3);
+    out << line;
+  }
+  for (const BodySummary& b : s.bodies) {
+    std::snprintf(line, sizeof line,
+                  "body %-8s from (%.1f, %.1f, %.1f) mm to (%.1f, %.1f, %.1f) mm, rose %.1f mm; "
+                  "ends at %.1f mm/s",
+                  b.name.c_str(), b.start_world.x() * 1e3, b.start_world.y() * 1e3,
+                  b.start_world.z() * 1e3, b.final_world.x() * 1e3, b.final_world.y() * 1e3,
+                  b.final_world.z() * 1e3, b.max_rise_m * 1e3, b.final_speed_m_per_s * 1e3);
+    out << line;
+    std::string on;
+    for (const std::string& other : b.touching_at_end) {
+      on += (on.empty() ? "" : ", ") + other;
+    }
+    out << (on.empty() ? ", touching nothing" : ", on " + on);
+    if (b.nonfinite_steps > 0) {
+      out << "; NON-FINITE in " << b.nonfinite_steps << " steps";
+    }
+    out << "\n";
+  }
+  for (const SheetSummary& sh : s.sheets) {
+    std::snprintf(line, sizeof line, "sheet %-7s deepest dent %.2f mm, %.2f mm at the end\n",
+                  sh.name.c_str(), sh.max_depth_m * 1e3, sh.final_depth_m * 1e3);
     out << line;
   }
   if (!s.segments.empty()) {

@@ -1,8 +1,8 @@
-// One unattended run of a world driven by a device (architecture.md#real-time, architecture.md#scenes): the deterministic step at a
-// fixed dt, as fast as it goes (offline) or on an absolute 1 kHz deadline (--realtime), with the
-// device safety layer between the world and the device, an optional recorder, and the figures a
-// user wants at the end: contacts and deflection per segment, forces per tool, pop-throughs,
-// force-limit violations and the cost of a step.
+// One unattended run of a world driven by a device (architecture.md#real-time,
+// architecture.md#scenes): the deterministic step at a fixed dt, as fast as it goes (offline) or on
+// an absolute 1 kHz deadline (--realtime), with the device safety layer between the world and the
+// device, an optional recorder, and the figures a user wants at the end: contacts and deflection
+// per segment, forces per tool, pop-throughs, force-limit violations and the cost of a step.
 #pragma once
 
 #include "hapsim/core/progress.h"
@@ -99,6 +99,25 @@ struct TeleopSummary {
   [[nodiscard]] bool placed() const;
 };
 
+/// What a dynamic body did over the run.
+struct BodySummary {
+  std::string name;
+  Vec3 start_world = Vec3::Zero();  ///< its body frame's origin
+  Vec3 final_world = Vec3::Zero();
+  double max_rise_m = 0.0;  ///< highest it rose above its start
+  double final_speed_m_per_s = 0.0;
+  /// The bodies it touches at the end (what it rests on).
+  std::vector<std::string> touching_at_end;
+  std::size_t nonfinite_steps = 0;
+};
+
+/// What a sheet did over the run.
+struct SheetSummary {
+  std::string name;
+  double max_depth_m = 0.0;
+  double final_depth_m = 0.0;
+};
+
 struct SessionSummary {
   std::size_t steps = 0;
   double simulated_s = 0.0;
@@ -125,6 +144,9 @@ struct SessionSummary {
   std::optional<RealtimeSummary> realtime;
   /// Worlds with a teleoperation rig.
   std::optional<TeleopSummary> teleop;
+  /// Dynamic bodies (the first kMaxCycleDynamicBodies) and sheets (the first kMaxCycleSheets).
+  std::vector<BodySummary> bodies;
+  std::vector<SheetSummary> sheets;
 };
 
 /// Runs `world` with `device` for options.duration_s. Throws hapsim::Error on bad options.

@@ -125,19 +125,71 @@ void read_palpation(const SceneReader& r, const Json& j, const std::string& pp,
   }
 }
 
+void read_glove_pick_and_place(const SceneReader& r, const Json& j, const std::string& ptr,
+                               SceneDescription& scene) {
+  r.object(j, ptr, "a glove pick-and-place script");
+  r.allow_keys(j, ptr,
+               {"ball", "sheet", "place_m", "squeeze_m", "press_depth_m", "lift_m",
+                "open_clearance_m", "approach_s", "close_s", "lift_s", "carry_s", "lower_s",
+                "press_s", "open_s", "retreat_s", "settle_s"});
+  DeviceDescription& d = scene.device;
+  d.has_glove_pick_and_place = true;
+  GlovePickAndPlaceDescription& g = d.glove_pick_and_place;
+  g.ball = r.nonempty_string(r.required(j, ptr, "ball"), JsonReader::at(ptr, "ball"), "a body");
+  g.sheet = r.nonempty_string(r.required(j, ptr, "sheet"), JsonReader::at(ptr, "sheet"), "a body");
+  for (const auto& [key, name] : {std::pair{"ball", &g.ball}, std::pair{"sheet", &g.sheet}}) {
+    if (std::none_of(scene.world.bodies.begin(), scene.world.bodies.end(),
+                     [&](const BodyDescription& b) { return b.name == *name; })) {
+      r.fail(JsonReader::at(ptr, key), "no body named '" + *name + "' in /bodies");
+    }
+  }
+  if (j.contains("place_m")) {
+    const std::string pp = JsonReader::at(ptr, "place_m");
+    const Json& p = r.array(j["place_m"], pp, "[x, y] on the sheet, metres");
+    if (p.size() != 2) {
+      r.fail(pp, "expected [x, y] on the sheet, metres");
+    }
+    g.place_sheet = Vec3(r.number(p[0], JsonReader::at(pp, 0), "m"),
+                         r.number(p[1], JsonReader::at(pp, 1), "m"), 0.0);
+  }
+  g.squeeze_m = r.number_in(j, ptr, "squeeze_m", g.squeeze_m, 0.0, 0.05, "m", true);
+  g.press_depth_m = r.number_in(j, ptr, "press_depth_m", g.press_depth_m, 0.0, 0.2, "m");
+  g.lift_m = r.number_in(j, ptr, "lift_m", g.lift_m, 0.0, 1.0, "m", true);
+  g.open_clearance_m =
+      r.number_in(j, ptr, "open_clearance_m", g.open_clearance_m, 0.0, 0.2, "m", true);
+  for (const auto& [key, value] :
+       {std::pair{"approach_s", &g.approach_s}, std::pair{"close_s", &g.close_s},
+        std::pair{"lift_s", &g.lift_s}, std::pair{"carry_s", &g.carry_s},
+        std::pair{"lower_s", &g.lower_s}, std::pair{"press_s", &g.press_s},
+        std::pair{"open_s", &g.open_s}, std::pair{"retreat_s", &g.retreat_s},
+        std::pair{"settle_s", &g.settle_s}}) {
+    *value = r.number_in(j, ptr, key, *value, 0.0, 60.0, "seconds", true);
+  }
+  for (const int finger : {0, 1}) {
+    if (std::none_of(scene.world.tools.begin(), scene.world.tools.end(),
+                     [&](const ToolDescription& tool) { return tool.finger == finger; })) {
+      r.fail(ptr, std::string("the pinch needs a tool on the ") +
+                      (finger == 0 ? "thumb (finger 0)" : "index (finger 1)"));
+    }
+  }
+}
+
 }  // namespace
 
 void read_device(const SceneReader& r, const Json& j, const std::string& ptr,
                  SceneDescription& scene) {
   r.object(j, ptr, "the device");
-  r.allow_keys(j, ptr, {"type", "profile", "trajectory", "palpation", "hand", "glove_palpation"});
+  r.allow_keys(j, ptr,
+               {"type", "profile", "trajectory", "palpation", "hand", "glove_palpation",
+                "glove_pick_and_place"});
   DeviceDescription& d = scene.device;
   if (j.contains("type")) {
     d.type = r.one_of(j["type"], JsonReader::at(ptr, "type"), {"simulated", "glove"});
   }
   const bool glove = d.type == "glove";
-  if (!glove && (j.contains("hand") || j.contains("glove_palpation"))) {
-    r.fail(ptr, "'hand' and 'glove_palpation' need \"type\": \"glove\"");
+  if (!glove &&
+      (j.contains("hand") || j.contains("glove_palpation") || j.contains("glove_pick_and_place"))) {
+    r.fail(ptr, "'hand', 'glove_palpation' and 'glove_pick_and_place' need \"type\": \"glove\"");
   }
   if (glove) {
     scene.world.has_hand = true;
@@ -180,6 +232,16 @@ void read_device(const SceneReader& r, const Json& j, const std::string& ptr,
     }
   }
   const char* script = glove ? "glove_palpation" : "palpation";
+  if (glove && j.contains("glove_pick_and_place")) {
+    if (j.contains("trajectory") || j.contains("glove_palpation")) {
+      r.fail(ptr,
+             "expected exactly one of 'trajectory' (a CSV file), 'glove_palpation' or "
+             "'glove_pick_and_place' (a script)");
+    }
+    read_glove_pick_and_place(r, j["glove_pick_and_place"],
+                              JsonReader::at(ptr, "glove_pick_and_place"), scene);
+    return;
+  }
   if (j.contains("trajectory") == j.contains(script)) {
     r.fail(ptr, std::string("expected exactly one of 'trajectory' (a CSV file) or '") + script +
                     "' (a script)");

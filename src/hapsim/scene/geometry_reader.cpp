@@ -85,6 +85,7 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
     const double r = r_.number_in(s, kp, "radius_m", 0.0, 0.0, 100.0, "m", true);
     const auto n = static_cast<int>(r_.number_in(s, kp, "segments", 64, 8, 1024, ""));
     add(body_name, make_uv_sphere(r, n, n / 2), std::nullopt);
+    body.segments.back().sphere = ExactSphere{Vec3::Zero(), r};  // contact: the sphere, exactly
   } else if (kind == "sheet") {
     const Json& s = r_.object(j[kind], kp, "sheet settings");
     r_.allow_keys(s, kp, {"size_m", "nodes_per_side"});

@@ -2,6 +2,7 @@
 
 #include "hapsim/core/device_io.h"
 #include "hapsim/core/error.h"
+#include "hapsim/geometry/mass_properties.h"
 #include "hapsim/scene/device_reader.h"
 #include "hapsim/scene/geometry_reader.h"
 #include "hapsim/scene/scene_reader.h"
@@ -10,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -35,6 +37,8 @@ class Parser : public SceneReader {
  private:
   void parse_materials(const Json& j, const std::string& ptr, WorldDescription& world);
   void parse_body(const Json& j, const std::string& ptr, WorldDescription& world);
+  void parse_dynamics(const Json& j, const std::string& ptr, BodyDescription& body) const;
+  void parse_deformation(const Json& j, const std::string& ptr, BodyDescription& body) const;
   void parse_body_materials(const Json& j, const std::string& ptr, BodyDescription& body,
                             const std::vector<std::optional<TissueKind>>& tissues);
   ToolDescription parse_tool(const Json& j, const std::string& ptr) const;
@@ -81,7 +85,14 @@ SceneDescription Parser::parse(const Json& root) {
   }
   if (root.contains("world")) {
     const Json& w = object(root["world"], "/world", "world settings");
-    allow_keys(w, "/world", {"name", "passivity_damping_factor"});
+    allow_keys(w, "/world", {"name", "passivity_damping_factor", "gravity_m_per_s2"});
+    if (w.contains("gravity_m_per_s2")) {
+      scene.world.gravity_m_per_s2 =
+          vec3(w["gravity_m_per_s2"], "/world/gravity_m_per_s2", "m/s^2");
+      if (!(scene.world.gravity_m_per_s2.norm() <= 1000.0)) {
+        fail("/world/gravity_m_per_s2", "expected at most 1000 m/s^2");
+      }
+    }
     if (w.contains("name")) {
       scene.world.name = nonempty_string(w["name"], "/world/name", "a world name");
     }
@@ -203,7 +214,9 @@ std::uint32_t Parser::material_ref(const Json& j, const std::string& ptr) const 
 
 void Parser::parse_body(const Json& j, const std::string& ptr, WorldDescription& world) {
   object(j, ptr, "a body");
-  allow_keys(j, ptr, {"name", "type", "pose", "contact_method", "geometry", "materials"});
+  allow_keys(j, ptr,
+             {"name", "type", "pose", "contact_method", "geometry", "materials", "mass_kg",
+              "deformation", "sheet"});
   BodyDescription body;
   body.name = nonempty_string(required(j, ptr, "name"), at(ptr, "name"), "a body name");
   if (j.contains("type")) {
@@ -226,7 +239,82 @@ void Parser::parse_body(const Json& j, const std::string& ptr, WorldDescription&
       geometry_.read(required(j, ptr, "geometry"), at(ptr, "geometry"), body.name);
   body.segments = std::move(geometry.segments);
   parse_body_materials(required(j, ptr, "materials"), at(ptr, "materials"), body, geometry.tissues);
+  parse_dynamics(j, ptr, body);
+  parse_deformation(j, ptr, body);
   world.bodies.push_back(std::move(body));
+}
+
+// A dynamic body's mass; its centre of mass and inertia follow from its shape at uniform density
+// (a sphere's exactly: 2/5·m·r² about its centre).
+void Parser::parse_dynamics(const Json& j, const std::string& ptr, BodyDescription& body) const {
+  if (body.kind != BodyKind::kDynamic) {
+    if (j.contains("mass_kg")) {
+      fail(at(ptr, "mass_kg"), "only a \"dynamic\" body has a mass");
+    }
+    return;
+  }
+  if (!j.contains("mass_kg")) {
+    fail(ptr, "a dynamic body needs 'mass_kg'");
+  }
+  RigidBodyDescription& r = body.rigid;
+  r.mass_kg = number_in(j, ptr, "mass_kg", 0.0, 0.0, 10000.0, "kg", true);
+  if (body.segments.size() == 1 && body.segments.front().sphere) {
+    const ExactSphere& s = *body.segments.front().sphere;
+    r.com_body = s.center_body;
+    r.inertia_kg_m2 = Mat3::Identity() * 0.4 * r.mass_kg * s.radius_m * s.radius_m;
+    return;
+  }
+  TriangleMesh all;
+  for (const SegmentDescription& s : body.segments) {
+    const auto first = static_cast<std::uint32_t>(all.vertices.size());
+    all.vertices.insert(all.vertices.end(), s.mesh.vertices.begin(), s.mesh.vertices.end());
+    for (const TriangleIndices& t : s.mesh.triangles) {
+      all.triangles.push_back({t[0] + first, t[1] + first, t[2] + first});
+    }
+  }
+  try {
+    const MassProperties m = mass_properties(all);
+    r.com_body = m.com;
+    r.inertia_kg_m2 = m.inertia_per_density * (r.mass_kg / m.volume_m3);
+  } catch (const Error& e) {
+    fail(at(ptr, "geometry"), std::string("a dynamic body needs a closed shape: ") + e.what());
+  }
+}
+
+// How a deformable body deforms: vertex deflection, or the virtual sheet (its sheet geometry's
+// grid, with the Gaussian profile of "sheet").
+void Parser::parse_deformation(const Json& j, const std::string& ptr, BodyDescription& body) const {
+  const bool sheet = j.contains("deformation") && one_of(j["deformation"], at(ptr, "deformation"),
+                                                         {"deflection", "sheet"}) == "sheet";
+  if (j.contains("deformation") && body.kind != BodyKind::kDeformable) {
+    fail(at(ptr, "deformation"), "only a \"deformable\" body has a deformation");
+  }
+  if (j.contains("sheet") && !sheet) {
+    fail(at(ptr, "sheet"), "sheet settings need \"deformation\": \"sheet\"");
+  }
+  if (!sheet) {
+    return;
+  }
+  const auto nodes = static_cast<int>(
+      std::lround(std::sqrt(static_cast<double>(body.segments.front().mesh.vertex_count()))));
+  if (body.segments.size() != 1 || !body.segments.front().two_sided ||
+      static_cast<std::size_t>(nodes) * static_cast<std::size_t>(nodes) !=
+          body.segments.front().mesh.vertex_count()) {
+    fail(at(ptr, "geometry"), "a sheet body needs the \"sheet\" geometry");
+  }
+  body.deformation = BodyDeformation::kGaussianSheet;
+  body.sheet.nodes_per_side = nodes;
+  body.sheet.side_m = body.segments.front().mesh.bounds().sizes().x();
+  if (j.contains("sheet")) {
+    const std::string sp = at(ptr, "sheet");
+    const Json& s = object(j["sheet"], sp, "sheet settings");
+    allow_keys(s, sp, {"cutoff_radius_mm", "width_mm", "sensitivity_n_per_mm", "max_depth_m"});
+    body.sheet_profile = GaussianSheetParams::from_mm(
+        number_in(s, sp, "cutoff_radius_mm", 44.0, 0.0, 10000.0, "mm", true),
+        number_in(s, sp, "width_mm", 40.1, 0.0, 10000.0, "mm", true),
+        number_in(s, sp, "sensitivity_n_per_mm", 3.0, 0.0, 1e6, "N/mm", true));
+    body.sheet.max_depth_m = number_in(s, sp, "max_depth_m", kInf, 0.0, 100.0, "m", true);
+  }
 }
 
 void Parser::parse_body_materials(const Json& j, const std::string& ptr, BodyDescription& body,

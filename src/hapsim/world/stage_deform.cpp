@@ -33,10 +33,12 @@ void deform_sheet(const WorldModel& model, WorldState& state, const SegmentModel
 // haptic path
 void deform(const WorldModel& model, WorldState& state, double dt_s) noexcept {
   const std::vector<SegmentModel>& segs = model.segments();
+  std::size_t sheet_index = 0;
   for (std::size_t i = 0; i < segs.size(); ++i) {
     SegmentState& seg = state.segments[i];
     if (seg.sheet) {
       deform_sheet(model, state, segs[i], seg);
+      state.sheet_depth_m[sheet_index++] = seg.sheet->max_depth_m();
       continue;
     }
     if (!seg.deflection) {

@@ -51,6 +51,7 @@ void place_bodies(const WorldModel& model, std::vector<BodyState>& bodies) {
     body.X_world_body = d.bodies[b].X_world_body;
     body.X_body_world = body.X_world_body.inverse();
     if (d.bodies[b].kind == BodyKind::kDynamic) {
+      body.dynamic = true;
       body.v_world = d.bodies[b].rigid.v_world;
       body.w_world = d.bodies[b].rigid.w_world;
     }
@@ -67,6 +68,10 @@ WorldState::WorldState(const WorldModel& model) {
   place_bodies(model, bodies);
   body_pairs.resize(model.dynamic_bodies().size() * segs.size());
   body_contacts.resize(std::max<std::size_t>(body_pairs.size(), 1));
+  sheet_depth_m.assign(
+      static_cast<std::size_t>(
+          std::count_if(segs.begin(), segs.end(), [](const SegmentModel& s) { return s.sheet; })),
+      0.0);
   for (std::size_t i = 0; i < segs.size(); ++i) {
     const SegmentModel& seg = segs[i];
     if (seg.sheet) {
@@ -152,6 +157,8 @@ WorldState::WorldState(const WorldModel& model) {
   result.tools = tool_states;
   result.contacts = {contacts.data(), 0};
   result.body_contacts = {body_contacts.data(), 0};
+  result.bodies = bodies;
+  result.sheet_depth_m = sheet_depth_m;
   result.teleop = rig ? &rig->result : nullptr;
   model_ = &model;
 }
@@ -189,6 +196,7 @@ void WorldState::reset() {
   }
   place_bodies(*model_, bodies);
   std::fill(body_pairs.begin(), body_pairs.end(), BodyPairState{});
+  std::fill(sheet_depth_m.begin(), sheet_depth_m.end(), 0.0);
   body_contact_count = 0;
   for (ToolState& state : tool_states) {
     state = ToolState{};
@@ -201,6 +209,8 @@ void WorldState::reset() {
   result.tools = tool_states;
   result.contacts = {contacts.data(), 0};
   result.body_contacts = {body_contacts.data(), 0};
+  result.bodies = bodies;
+  result.sheet_depth_m = sheet_depth_m;
   result.teleop = rig ? &rig->result : nullptr;
 }
 

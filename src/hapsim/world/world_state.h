@@ -53,6 +53,7 @@ struct BodyContact {
 
 /// Where a body is and how it moves (every body; only dynamic ones change, integrate stage).
 struct BodyState {
+  bool dynamic = false;
   Iso3 X_world_body = Iso3::Identity();
   Iso3 X_body_world = Iso3::Identity();
   /// Dynamic bodies: the centre of mass's velocity and the angular velocity, world frame.
@@ -116,6 +117,10 @@ struct StepResult {
   std::int32_t penalty_pop_throughs = 0;
   /// Contacts of dynamic bodies with other bodies this step.
   std::span<const BodyContact> body_contacts;
+  /// Every body's pose and motion after this step (dynamic bodies move).
+  std::span<const BodyState> bodies;
+  /// Per sheet (in flat segment order): its deepest dent below rest after this step.
+  std::span<const double> sheet_depth_m;
   /// Body contacts found but not reported because the per-step buffer was full.
   std::int32_t dropped_body_contacts = 0;
   /// The teleoperation rig's step, or null when the world has no rig.
@@ -261,6 +266,8 @@ struct WorldState {
   /// Body contacts stage: this step's contacts of dynamic bodies, capacity fixed at construction.
   std::vector<BodyContact> body_contacts;
   std::size_t body_contact_count = 0;
+  /// Deform stage: per sheet (in flat segment order), its deepest dent below rest.
+  std::vector<double> sheet_depth_m;
   std::unique_ptr<RigState> rig;  ///< when the world has a teleoperation rig
   double time_s = 0.0;
   /// Steps taken since construction or reset (the first step is 1).

@@ -72,6 +72,8 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   r.command = state.command;
   r.dropped_contacts = state.dropped_contacts;
   r.body_contacts = {state.body_contacts.data(), state.body_contact_count};
+  r.bodies = state.bodies;
+  r.sheet_depth_m = state.sheet_depth_m;
   r.dropped_body_contacts = state.dropped_body_contacts;
   r.penalty_pop_throughs = state.pop_throughs;
   if (state.rig) {
