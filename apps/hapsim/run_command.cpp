@@ -311,7 +311,7 @@ void run(const RunArgs& args) {
         "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
         "sheet %dx%d\n",
         scene.file.string().c_str(), setup.slave_name.c_str(), rig.slave->chain().dof(),
-        rig.ball.params().mass_kg * 1e3, rig.ball.params().radius_m * 1e3,
+        scene.teleop.ball_mass_kg * 1e3, scene.teleop.ball_radius_m * 1e3,
         scene.teleop.sheet_nodes_per_side, scene.teleop.sheet_nodes_per_side);
   } else {
     std::size_t vertices = 0;

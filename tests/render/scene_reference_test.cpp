@@ -133,7 +133,7 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
   for (int k = 1; k <= 6000; ++k) {
     world.step(setup.trajectory.sample_at(setup.trajectory.start_time_s() + k * dt), dt);
   }
-  ASSERT_TRUE(world.rig()->ball.held());
+  ASSERT_TRUE(world.rig()->held);
   TeleopScene view(world);
   view.update_from_world(world);
   const OrbitCamera camera =
@@ -147,7 +147,8 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
   EXPECT_GT(compare_images(pictures[0], pictures[1], kWidth, kHeight).differing_fraction, 0.01);
   EXPECT_GT(compare_images(pictures[1], pictures[2], kWidth, kHeight).differing_fraction, 0.005);
   // The ball is where the world says, in its colour (red), in the face picture.
-  const Vec3 px = camera.project(world.rig()->ball.p_world(), kWidth, kHeight);
+  const Vec3 px = camera.project(
+      world.body_pose(world.description().teleop->ball_body).translation(), kWidth, kHeight);
   const auto x = static_cast<int>(px.x());
   const auto y = static_cast<int>(px.y());
   ASSERT_TRUE(x >= 0 && x < kWidth && y >= 0 && y < kHeight);

@@ -83,13 +83,14 @@ std::string TeleopSceneTest::why_not_;
 
 TEST_F(TeleopSceneTest, SheetMeshHoldsTheWorldsDentedHeights) {
   const World& world = *world_;
-  ASSERT_GT(world.rig()->sheet->max_depth_m(), 1e-4) << "the ball should rest in a dent";
+  ASSERT_GT(world.sheet(world.description().teleop->sheet_body)->max_depth_m(), 1e-4)
+      << "the ball should rest in a dent";
   TeleopScene from_world(world);
   from_world.update_from_world(world);
   TeleopScene from_snapshot(world);
   from_snapshot.update(make_teleop_snapshot(world));
-  const auto heights = world.rig()->sheet->surface_heights();
-  const TriangleMesh& rest = world.rig()->sheet->mesh();
+  const auto heights = world.sheet(world.description().teleop->sheet_body)->surface_heights();
+  const TriangleMesh& rest = world.sheet(world.description().teleop->sheet_body)->mesh();
   for (const TeleopScene* scene : {&from_world, &from_snapshot}) {
     const RenderMesh& sheet = scene->scene().mesh(scene->sheet_mesh());
     ASSERT_EQ(sheet.geometry().vertices.size(), heights.size());
@@ -102,16 +103,17 @@ TEST_F(TeleopSceneTest, SheetMeshHoldsTheWorldsDentedHeights) {
         sheet.X_world_mesh.isApprox(world.description().teleop->environment.X_world_sheet, 0.0));
   }
   // The dent is under the ball: the node nearest the ball's footprint is the deepest around.
-  const Vec3 ball_sheet =
-      world.description().teleop->environment.X_world_sheet.inverse() * world.rig()->ball.p_world();
-  const int n = world.rig()->sheet->nodes_per_side();
-  const double h = world.rig()->sheet->spacing_m();
-  const auto i =
-      static_cast<int>(std::lround((ball_sheet.x() + 0.5 * world.rig()->sheet->side_m()) / h));
-  const auto j =
-      static_cast<int>(std::lround((ball_sheet.y() + 0.5 * world.rig()->sheet->side_m()) / h));
+  const Vec3 ball_sheet = world.description().teleop->environment.X_world_sheet.inverse() *
+                          world.body_pose(world.description().teleop->ball_body).translation();
+  const int n = world.sheet(world.description().teleop->sheet_body)->nodes_per_side();
+  const double h = world.sheet(world.description().teleop->sheet_body)->spacing_m();
+  const auto i = static_cast<int>(std::lround(
+      (ball_sheet.x() + 0.5 * world.sheet(world.description().teleop->sheet_body)->side_m()) / h));
+  const auto j = static_cast<int>(std::lround(
+      (ball_sheet.y() + 0.5 * world.sheet(world.description().teleop->sheet_body)->side_m()) / h));
   ASSERT_TRUE(i >= 0 && i < n && j >= 0 && j < n);
-  EXPECT_LT(heights[static_cast<std::size_t>(j * n + i)], -0.5 * world.rig()->sheet->max_depth_m());
+  EXPECT_LT(heights[static_cast<std::size_t>(j * n + i)],
+            -0.5 * world.sheet(world.description().teleop->sheet_body)->max_depth_m());
 }
 
 TEST_F(TeleopSceneTest, BallColourAppearsWhereItsCentreProjects) {
@@ -120,7 +122,7 @@ TEST_F(TeleopSceneTest, BallColourAppearsWhereItsCentreProjects) {
   TeleopScene scene(world);
   scene.update_from_world(world);
   // Look at the ball from beyond it (the robot behind it), a little from above.
-  const Vec3 ball = world.rig()->ball.p_world();
+  const Vec3 ball = world.body_pose(world.description().teleop->ball_body).translation();
   OrbitCamera cam;
   cam.target_world = ball;
   cam.yaw_rad = std::atan2(ball.y(), ball.x());
@@ -149,7 +151,7 @@ TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
   scene.update_from_world(world);
   // Independent geometry: the tool from the chain's FK, the pads across its y at the pad depth.
   const Iso3 X_tool = world.rig()->slave->chain().forward(world.rig()->slave->q());
-  const ParallelGripperParams& p = world.rig()->gripper.params();
+  const ParallelGripperParams& p = world.description().teleop->gripper;
   const double w = world.rig()->result.gripper.width_m;
   const Vec3 pad_world[2] = {X_tool * Vec3(0.0, 0.5 * w + p.pad_half_m.y(), p.pad_depth_m),
                              X_tool * Vec3(0.0, -(0.5 * w + p.pad_half_m.y()), p.pad_depth_m)};
@@ -219,7 +221,7 @@ TEST(TeleopScene, LinkMeshesFollowTheirChainFrames) {
   EXPECT_EQ(mesh.geometry().vertices.size(), g.mesh.vertices.size());
   // The bounds frame the whole scene: the ball, the sheet and the master drawn beside.
   const Box3& b = scene.rest_bounds_world();
-  EXPECT_TRUE(b.contains(world.rig()->ball.p_world()));
+  EXPECT_TRUE(b.contains(world.body_pose(world.description().teleop->ball_body).translation()));
   EXPECT_TRUE(b.contains(scene.master_display_origin_world()));
 }
 

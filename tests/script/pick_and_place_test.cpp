@@ -71,9 +71,11 @@ Outcome run(TeleopRigDescription d, const PickAndPlaceScript& script) {
       EXPECT_TRUE(std::isfinite(r.command.joint_torque_nm[static_cast<std::size_t>(j)]));
     }
   }
-  o.ball_final = world.rig()->ball.p_world();
-  o.final_sheet_depth_m = world.rig()->sheet->max_depth_m();
-  o.final_kinetic_energy_j = world.rig()->ball.kinetic_energy_j();
+  o.ball_final = world.body_pose(world.description().teleop->ball_body).translation();
+  o.final_sheet_depth_m = world.sheet(world.description().teleop->sheet_body)->max_depth_m();
+  o.final_kinetic_energy_j =
+      (0.5 * world.description().teleop->ball.mass_kg *
+       world.state().bodies[world.description().teleop->ball_body].v_world.squaredNorm());
   return o;
 }
 

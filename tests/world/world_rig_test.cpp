@@ -36,7 +36,7 @@ DeviceInput master(double base_rad) {
 TEST(WorldRig, BallFallsOnTheSheetAndResetPutsEverythingBack) {
   World world(rig());
   ASSERT_NE(world.rig(), nullptr);
-  const Vec3 start = world.rig()->ball.p_world();
+  const Vec3 start = world.body_pose(world.description().teleop->ball_body).translation();
   const auto q0 =
       std::vector<double>(world.rig()->slave->q().begin(), world.rig()->slave->q().end());
   for (int k = 0; k < 1500; ++k) {
@@ -45,12 +45,12 @@ TEST(WorldRig, BallFallsOnTheSheetAndResetPutsEverythingBack) {
     ASSERT_TRUE(r.teleop->ball_p_world.allFinite());
   }
   // Fallen and resting on the dented sheet (sheet at z = 0.05, ball radius 0.03).
-  EXPECT_LT(world.rig()->ball.p_world().z(), 0.08 + 1e-3);
-  EXPECT_GT(world.rig()->sheet->max_depth_m(), 0.0);
+  EXPECT_LT(world.body_pose(world.description().teleop->ball_body).translation().z(), 0.08 + 1e-3);
+  EXPECT_GT(world.sheet(world.description().teleop->sheet_body)->max_depth_m(), 0.0);
   EXPECT_NEAR(world.last_result().time_s, 1.5, 1e-9);
   world.reset();
-  EXPECT_EQ(world.rig()->ball.p_world(), start);
-  EXPECT_EQ(world.rig()->sheet->max_depth_m(), 0.0);
+  EXPECT_EQ(world.body_pose(world.description().teleop->ball_body).translation(), start);
+  EXPECT_EQ(world.sheet(world.description().teleop->sheet_body)->max_depth_m(), 0.0);
   const auto q = world.rig()->slave->q();
   EXPECT_TRUE(std::equal(q.begin(), q.end(), q0.begin()));
   EXPECT_EQ(world.last_result().teleop, &world.rig()->result);

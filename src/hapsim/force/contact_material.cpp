@@ -19,10 +19,8 @@ ContactMaterial combine_materials(const ContactMaterial& a, const ContactMateria
   m.damping_n_s_per_m = in_series(a.damping_n_s_per_m, b.damping_n_s_per_m);
   m.max_penetration_m = a.max_penetration_m + b.max_penetration_m;
   m.max_force_n = std::min(a.max_force_n, b.max_force_n);
-  m.static_friction =
-      std::sqrt(std::max(a.static_friction, 0.0) * std::max(b.static_friction, 0.0));
-  m.dynamic_friction =
-      std::sqrt(std::max(a.dynamic_friction, 0.0) * std::max(b.dynamic_friction, 0.0));
+  m.static_friction = std::max(a.static_friction, b.static_friction);
+  m.dynamic_friction = std::max(a.dynamic_friction, b.dynamic_friction);
   return m;
 }
 

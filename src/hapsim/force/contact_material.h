@@ -25,7 +25,8 @@ namespace hapsim {
 /// The contact between two bodies of materials `a` and `b` (paper 000 §3.2.1: one spring between
 /// the points of closest approach, equal and opposite on both): both give way in series —
 /// stiffness and damping in series (so each one's passivity floor holds for the pair), the
-/// penetrations add up, the force is capped by the weaker; friction the geometric mean.
+/// penetrations add up, the force is capped by the weaker; friction the larger of the two (as
+/// MuJoCo does), so a frictionless body takes the other's.
 [[nodiscard]] ContactMaterial combine_materials(const ContactMaterial& a,
                                                 const ContactMaterial& b) noexcept;
 

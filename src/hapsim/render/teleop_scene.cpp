@@ -59,7 +59,7 @@ TeleopScene::TeleopScene(const World& world, TeleopSceneOptions options)
   build_slave();
   build_gripper();
   // The sheet, placed by the environment; its x, y never change, z follows the heights.
-  const VirtualSheet& sheet = *world_.rig()->sheet;
+  const VirtualSheet& sheet = *world_.sheet(world_.description().teleop->sheet_body);
   sheet_ = scene_.add_mesh(sheet.mesh(), options_.colours.sheet,
                            world_.description().teleop->environment.X_world_sheet);
   scene_.mesh(sheet_).name = "sheet";
@@ -151,7 +151,7 @@ void TeleopScene::build_slave() {
 }
 
 void TeleopScene::build_gripper() {
-  const ParallelGripperParams& p = world_.rig()->gripper.params();
+  const ParallelGripperParams& p = world_.description().teleop->gripper;
   const double max_width = world_.description().teleop->follower.gripper_max_width_m;
   // A palm across the pads' travel just above them, and a stem from the flange down to it.
   const double palm_half_z = 0.25 * p.pad_half_m.z();
@@ -230,12 +230,16 @@ void TeleopScene::pose_from(const TeleopSnapshot& s) {
   for (const MeshId id : gripper_body_) {
     scene_.mesh(id).X_world_mesh = s.X_world_tool;
   }
-  const ParallelGripper& gripper = world_.rig()->gripper;
+  const ParallelGripperParams& gripper = world_.description().teleop->gripper;
   for (int i = 0; i < 2; ++i) {
     RenderMesh& pad = scene_.mesh(pads_[static_cast<std::size_t>(i)]);
     pad.X_world_mesh = Iso3::Identity();
     pad.X_world_mesh.linear() = s.X_world_tool.linear();
-    pad.X_world_mesh.translation() = gripper.pad_center_world(s.X_world_tool, s.gripper_width_m, i);
+    // As the rig places its pad bodies (stage_place_tools.cpp): +y side first.
+    const double side = i == 0 ? 1.0 : -1.0;
+    pad.X_world_mesh.translation() =
+        s.X_world_tool *
+        Vec3(0.0, side * (0.5 * s.gripper_width_m + gripper.pad_half_m.y()), gripper.pad_depth_m);
     pad.colour = s.held ? options_.colours.pad_holding : options_.colours.pad;
   }
 
@@ -243,7 +247,7 @@ void TeleopScene::pose_from(const TeleopSnapshot& s) {
   scene_.segments.clear();
   scene_.shadow_marks.clear();
   scene_.spheres.push_back(
-      {s.ball_p_world, world_.rig()->ball.params().radius_m, options_.colours.ball, false});
+      {s.ball_p_world, world_.description().teleop->ball.radius_m, options_.colours.ball, false});
   if (options_.show_joints) {
     for (std::size_t k = 0; k < joint_radius_m_.size() && k < frames_.size(); ++k) {
       scene_.spheres.push_back(
@@ -251,7 +255,7 @@ void TeleopScene::pose_from(const TeleopSnapshot& s) {
     }
   }
   // The tool point (between the pads) marked on the floor.
-  const Vec3 tool_point_world = s.X_world_tool * Vec3(0.0, 0.0, gripper.params().pad_depth_m);
+  const Vec3 tool_point_world = s.X_world_tool * Vec3(0.0, 0.0, gripper.pad_depth_m);
   scene_.shadow_marks.push_back({tool_point_world, 0.03, 0.005, options_.colours.shadow});
   if (options_.show_master) {
     add_master_lines(s);

@@ -120,7 +120,7 @@ class SessionAccountant {
     }
     if (world.rig() != nullptr) {
       summary_.teleop.emplace();
-      ball_start_z_ = world.rig()->ball.p_world().z();
+      ball_start_z_ = world.body_pose(desc.teleop->ball_body).translation().z();
     }
     cost_us_.reserve(steps);
     touched_.assign(summary_.segments.size() * desc.tools.size(), 0);
@@ -261,7 +261,7 @@ class SessionAccountant {
     }
     if (summary_.teleop) {
       TeleopSummary& t = *summary_.teleop;
-      t.ball_final_world = world_.rig()->ball.p_world();
+      t.ball_final_world = world_.body_pose(desc.teleop->ball_body).translation();
       if (options_.teleop_target_world) {
         t.target_error_m = (t.ball_final_world - *options_.teleop_target_world).norm();
       }

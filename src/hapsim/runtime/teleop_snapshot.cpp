@@ -1,5 +1,7 @@
 #include "hapsim/runtime/teleop_snapshot.h"
 
+#include "hapsim/deform/virtual_sheet.h"
+
 #include <algorithm>
 
 namespace hapsim {
@@ -8,7 +10,8 @@ TeleopSnapshot make_teleop_snapshot(const World& world) {
   TeleopSnapshot s;
   const RigState& rig = *world.rig();
   s.slave_q.assign(rig.slave->q().size(), 0.0);
-  s.sheet_heights_m.assign(rig.sheet->surface_heights().size(), 0.0);
+  s.sheet_heights_m.assign(
+      world.sheet(world.description().teleop->sheet_body)->surface_heights().size(), 0.0);
   s.time_s = rig.result.time_s;
   fill_teleop_snapshot(s, world);
   return s;
@@ -27,10 +30,12 @@ void fill_teleop_snapshot(TeleopSnapshot& s, const World& world) noexcept {
   s.pad_force_n = r.gripper.pad_force_n;
   s.grasp_force_n = r.gripper.grasp_force_n();
   s.held = r.held;
-  s.ball_p_world = rig.ball.p_world();
-  const auto h = rig.sheet->surface_heights();
+  const TeleopRigDescription& d = *world.description().teleop;
+  s.ball_p_world = world.body_pose(d.ball_body).translation();
+  const VirtualSheet& sheet = *world.sheet(d.sheet_body);
+  const auto h = sheet.surface_heights();
   std::copy_n(h.begin(), std::min(h.size(), s.sheet_heights_m.size()), s.sheet_heights_m.begin());
-  s.sheet_depth_m = rig.sheet->max_depth_m();
+  s.sheet_depth_m = sheet.max_depth_m();
   s.master_joint_rad = r.master_arm_rad;
   s.master_finger_rad = r.master_finger_rad;
   s.X_master_hand = world.model().master()->hand_pose(r.master_arm_rad);

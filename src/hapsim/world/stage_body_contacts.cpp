@@ -78,10 +78,9 @@ void body_contacts(const WorldModel& model, WorldState& state, double /*dt_s*/) 
       const Vec3 n_world = other.X_world_body.linear() * sp.normal;
       const Vec3 point_world = other.X_world_body * sp.point;
       const Vec3 p_ball = c_world - sphere.radius_m * n_world;  // the ball's deepest point
-      Vec3 v_rel = body.velocity_at(p_ball, bm.com_body);
-      if (seg.dynamic) {
-        v_rel -= other.velocity_at(point_world, other_model.com_body);
-      }
+      // Relative to the other body's surface there (static: at rest; a pad: moving with the rig).
+      const Vec3 v_rel = body.velocity_at(p_ball, bm.com_body) -
+                         other.velocity_at(point_world, other_model.com_body);
       const ContactMaterial material =
           combine_materials(state.body_materials[own.material], state.body_materials[seg.material]);
       const Vec3 f_normal = penalty_force(material, depth, n_world, -v_rel.dot(n_world));
@@ -91,10 +90,9 @@ void body_contacts(const WorldModel& model, WorldState& state, double /*dt_s*/) 
       pair.stick_body = {stick.active, other.X_body_world * stick.p};
       body.force_world_n += f;
       body.torque_world_nm += (p_ball - body.com_world(bm.com_body)).cross(f);
-      if (seg.dynamic) {
-        other.force_world_n -= f;
-        other.torque_world_nm -= (point_world - other.com_world(other_model.com_body)).cross(f);
-      }
+      // The other body gets the opposite (integrated when dynamic; a pad's is what the rig feels).
+      other.force_world_n -= f;
+      other.torque_world_nm -= (point_world - other.com_world(other_model.com_body)).cross(f);
       if (seg.sheet) {
         add_sheet_push(state.segments[flat], other.X_body_world, point_world, f);
       }

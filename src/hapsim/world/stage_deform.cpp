@@ -39,6 +39,9 @@ void deform(const WorldModel& model, WorldState& state, double dt_s) noexcept {
     if (seg.sheet) {
       deform_sheet(model, state, segs[i], seg);
       state.sheet_depth_m[sheet_index++] = seg.sheet->max_depth_m();
+      if (state.rig && i == model.flat_segment(model.description().teleop->sheet_body, 0)) {
+        state.rig->result.sheet_depth_m = seg.sheet->max_depth_m();
+      }
       continue;
     }
     if (!seg.deflection) {

@@ -53,12 +53,31 @@ void integrate(const WorldModel& model, WorldState& state, double dt_s) noexcept
   if (!state.rig) {
     return;
   }
+  (void)dt_s;
+  // The rig's report of where the ball is and what carries it (the sheet, the floor).
   RigState& rig = *state.rig;
+  const TeleopRigDescription& d = *model.description().teleop;
   TeleopStepResult& r = rig.result;
-  r.ball_contacts = rig.environment->step(rig.ball, r.gripper.force_on_ball_world_n, dt_s);
-  r.ball_p_world = rig.ball.p_world();
+  BallContactReport& b = r.ball_contacts;
+  b = BallContactReport{};
+  for (std::size_t k = 0; k < state.body_contact_count; ++k) {
+    const BodyContact& c = state.body_contacts[k];
+    if (c.body != static_cast<std::int32_t>(d.ball_body)) {
+      continue;
+    }
+    if (c.other_body == static_cast<std::int32_t>(d.sheet_body)) {
+      b.on_sheet = c.force_world_n.squaredNorm() > 0.0;
+      b.sheet_force_world_n += c.force_world_n;
+      const Iso3& X_sheet_world = state.bodies[d.sheet_body].X_body_world;
+      b.sheet_contact_sheet = X_sheet_world * c.point_world;
+      b.sheet_push_n = std::max(0.0, (X_sheet_world.linear() * c.force_world_n).z());
+    } else if (c.other_body == static_cast<std::int32_t>(d.floor_body)) {
+      b.on_floor = c.force_world_n.squaredNorm() > 0.0;
+      b.floor_force_world_n += c.force_world_n;
+    }
+  }
+  r.ball_p_world = state.bodies[d.ball_body].X_world_body.translation();
   r.held = r.gripper.held;
-  r.sheet_depth_m = rig.sheet->max_depth_m();
 }
 
 }  // namespace hapsim::stage

@@ -12,10 +12,41 @@ namespace hapsim::stage {
 
 namespace {
 
+// The gripper's pads at the slave's tool (000 §1): two boxes that close symmetrically along the
+// tool's y axis, pad_depth_m out along its z, to the slave's gripper opening — stopped where they
+// would press the ball at the gripper's force limit, as a force-limited gripper closing on an
+// object does (the pad material's force cap holds the rest). Kinematic bodies: the rig moves them.
+void place_pads(const TeleopRigDescription& d, RigState& rig, WorldState& state,
+                double dt_s) noexcept {
+  const ParallelGripperParams& g = d.gripper;
+  const Iso3& X_world_tool = rig.result.slave_tool;
+  const Iso3 X_tool_world = X_world_tool.inverse();
+  const Vec3 c = X_tool_world * state.bodies[d.ball_body].X_world_body.translation();
+  const Vec3& half = g.pad_half_m;
+  double width = std::max(rig.slave->gripper_width_m(), 0.0);
+  if (std::abs(c.x()) <= half.x() && std::abs(c.z() - g.pad_depth_m) <= half.z()) {
+    const double pen_max = g.max_force_n / g.pad_contact.stiffness_n_per_m;
+    width = std::max(width, 2.0 * (d.ball.radius_m - pen_max + std::abs(c.y())));
+  }
+  rig.result.gripper.width_m = width;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const double side = i == 0 ? 1.0 : -1.0;
+    BodyState& pad = state.bodies[d.pad_body[i]];
+    pad.X_world_body =
+        X_world_tool * Eigen::Translation3d(0.0, side * (0.5 * width + half.y()), g.pad_depth_m);
+    pad.X_body_world = pad.X_world_body.inverse();
+    const Vec3 p = pad.X_world_body.translation();
+    pad.v_world = rig.has_pad_previous && dt_s > 0.0 ? Vec3((p - rig.pad_previous_world[i]) / dt_s)
+                                                     : Vec3::Zero();
+    rig.pad_previous_world[i] = p;
+  }
+  rig.has_pad_previous = true;
+}
+
 // The rig's tool is the slave's gripper: the master's hand pose, scaled into the slave's frame,
 // is the slave's IK target; the master's grip opening is the gripper's. On an unusable input the
 // slave holds where it is.
-void place_rig(const WorldModel& model, RigState& rig, const DeviceInput& input,
+void place_rig(const WorldModel& model, RigState& rig, WorldState& state, const DeviceInput& input,
                double dt_s) noexcept {
   const TeleopRigDescription& d = *model.description().teleop;
   TeleopStepResult& r = rig.result;
@@ -38,6 +69,7 @@ void place_rig(const WorldModel& model, RigState& rig, const DeviceInput& input,
     r.slave = rig.slave->step(rig.slave->tip_pose(), width_command, dt_s);
   }
   r.slave_tool = rig.slave->tip_pose();
+  place_pads(d, rig, state, dt_s);
 }
 
 }  // namespace
@@ -47,7 +79,7 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
                  double dt_s) noexcept {
   const WorldDescription& d = model.description();
   if (state.rig) {
-    place_rig(model, *state.rig, input, dt_s);
+    place_rig(model, *state.rig, state, input, dt_s);
   }
   state.input_usable = input.healthy && input.p_world.allFinite() &&
                        input.q_world.coeffs().allFinite() && input.q_world.squaredNorm() > 0.5;

@@ -14,9 +14,9 @@ namespace hapsim::stage {
 
 namespace {
 
-// The rig's forces back to the master: the pads' reaction at the slave's tool (plus, while held,
-// the ball's weight and whatever the sheet pushes on it), scaled into the master's frame and
-// turned into joint torques through the master's Jᵀ; the grasp force on both fingers.
+// The rig's forces back to the master: the pads' reaction at the slave's tool, scaled into the
+// master's frame and turned into joint torques through the master's Jᵀ; the grasp force on both
+// fingers.
 void rig_command(const WorldModel& model, RigState& rig) noexcept {
   TeleopStepResult& r = rig.result;
   r.command = DeviceCommand{};
@@ -24,11 +24,9 @@ void rig_command(const WorldModel& model, RigState& rig) noexcept {
     return;
   }
   const TeleopRigDescription& d = *model.description().teleop;
-  Vec3 at_tool = -r.gripper.force_on_ball_world_n;
-  if (r.held) {
-    at_tool = rig.ball.params().mass_kg * rig.ball.params().gravity_m_per_s2 +
-              r.ball_contacts.sheet_force_world_n + r.ball_contacts.floor_force_world_n;
-  }
+  // What the ball pushes on the pads (held by friction: its weight and whatever the sheet or
+  // the floor push on it, carried through the grasp).
+  const Vec3 at_tool = -r.gripper.force_on_ball_world_n;
   const Vec3 at_master = d.mapping.X_slave_master.linear().transpose() * at_tool * d.force_scale;
   const MasterTorques t =
       model.master()->torques(r.master_arm_rad, at_master, r.gripper.grasp_force_n());

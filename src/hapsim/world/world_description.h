@@ -19,6 +19,7 @@
 #include "hapsim/kinematics/serial_chain.h"
 #include "hapsim/kinematics/slave_follower.h"
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -50,6 +51,8 @@ enum class BodyKind : std::uint8_t {
   kStatic,      ///< never moves, never deforms
   kDynamic,     ///< rigid with mass: moves under gravity and its contacts (integrate stage)
   kDeformable,  ///< deforms under contact and recovers (architecture.md#deformation)
+  /// Rigid, moved by the rig each step (a gripper pad): pushes dynamic bodies, is never pushed.
+  kKinematic,
 };
 
 /// How a deformable body deforms.
@@ -158,6 +161,13 @@ struct TeleopRigDescription {
   BallEnvironmentOptions environment;
   /// How the contact force at the slave's tool is scaled back onto the master's hand.
   double force_scale = 1.0;
+  /// The rig's bodies in WorldDescription::bodies (rig_world() adds them): the ball (dynamic),
+  /// the sheet, the two gripper pads (kinematic; 0: the +y side), the floor (or kNoBody).
+  static constexpr std::size_t kNoBody = static_cast<std::size_t>(-1);
+  std::size_t ball_body = kNoBody;
+  std::size_t sheet_body = kNoBody;
+  std::array<std::size_t, 2> pad_body{kNoBody, kNoBody};
+  std::size_t floor_body = kNoBody;
 };
 
 struct WorldDescription {
@@ -179,7 +189,10 @@ struct WorldDescription {
   std::optional<TeleopRigDescription> teleop;
 };
 
-/// A world made of a teleoperation rig alone (the teleoperation scenes).
+/// A world made of a teleoperation rig (the teleoperation scenes): the rig, and as ordinary bodies
+/// its floor (static), sheet (deformable, Gaussian), ball (dynamic sphere) and gripper pads
+/// (kinematic boxes), each with a penalty material made from the rig's contact springs, so the
+/// ball meets them through the same contact code as every other body.
 [[nodiscard]] WorldDescription rig_world(TeleopRigDescription rig, std::string name = "teleop");
 
 /// A content hash of a world description (meshes, materials, tools), as recordings carry it.

@@ -57,6 +57,31 @@ void check_rig(const TeleopRigDescription& d) {
   if (!d.ball_start_world.allFinite() || !std::isfinite(d.force_scale) || d.force_scale < 0.0) {
     throw Error("teleop", "ball start must be finite and the force scale >= 0");
   }
+  const ParallelGripperParams& g = d.gripper;
+  if (!(g.pad_half_m.minCoeff() > 0.0) || !g.pad_half_m.allFinite() ||
+      !std::isfinite(g.pad_depth_m) || !(g.pad_contact.stiffness_n_per_m > 0.0) ||
+      !(g.max_force_n > 0.0) || !std::isfinite(g.max_force_n) || !(g.safety_factor >= 1.0)) {
+    throw Error("teleop",
+                "gripper pads need finite sizes > 0, a stiffness and force limit > 0 "
+                "and a safety factor >= 1");
+  }
+}
+
+// The rig's bodies are where rig_world() put them, of the kinds the rig's stages expect.
+void check_rig_bodies(const WorldDescription& w) {
+  const TeleopRigDescription& d = *w.teleop;
+  const auto is = [&](std::size_t b, BodyKind kind) {
+    return b < w.bodies.size() && w.bodies[b].kind == kind;
+  };
+  if (!is(d.ball_body, BodyKind::kDynamic) || !w.bodies[d.ball_body].segments.front().sphere ||
+      !is(d.sheet_body, BodyKind::kDeformable) ||
+      w.bodies[d.sheet_body].deformation != BodyDeformation::kGaussianSheet ||
+      !is(d.pad_body[0], BodyKind::kKinematic) || !is(d.pad_body[1], BodyKind::kKinematic) ||
+      (d.floor_body != TeleopRigDescription::kNoBody && !is(d.floor_body, BodyKind::kStatic))) {
+    throw Error("teleop",
+                "the rig's ball, sheet, pads and floor must be bodies of the world "
+                "(build the world with rig_world())");
+  }
 }
 
 // A dynamic body needs a usable mass and inertia; its segments answer by penalty (a god-object's
@@ -219,6 +244,7 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
   }
   if (description_.teleop) {
     check_rig(*description_.teleop);
+    check_rig_bodies(description_);
     master_ = std::make_unique<MasterArm>(description_.teleop->master);
   }
   build_ms_ = watch.elapsed_ms();

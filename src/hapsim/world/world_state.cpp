@@ -21,20 +21,14 @@ std::vector<double> start_joints(const TeleopRigDescription& d) {
 
 RigState::RigState(const TeleopRigDescription& rig)
     : description(&rig),
-      slave(std::make_unique<SlaveFollower>(*rig.slave, start_joints(rig), rig.follower)),
-      gripper(rig.gripper),
-      ball(rig.ball, rig.ball_start_world),
-      sheet(std::make_unique<VirtualSheet>(rig.sheet)),
-      environment(std::make_unique<BallEnvironment>(*sheet, rig.environment)) {}
+      slave(std::make_unique<SlaveFollower>(*rig.slave, start_joints(rig), rig.follower)) {}
 
 void RigState::reset() {
   const TeleopRigDescription& d = *description;
   slave = std::make_unique<SlaveFollower>(*d.slave, start_joints(d), d.follower);
-  gripper = ParallelGripper(d.gripper);
-  ball = RigidBall(d.ball, d.ball_start_world);
-  sheet = std::make_unique<VirtualSheet>(d.sheet);
-  environment = std::make_unique<BallEnvironment>(*sheet, d.environment);
   input_usable = false;
+  has_pad_previous = false;
+  held = false;
   result = TeleopStepResult{};
 }
 

@@ -214,27 +214,31 @@ struct ToolRuntime {
   bool has_previous = false;
 };
 
-/// Per-step state of a teleoperation rig: the slave following the master (place stage), the
-/// gripper (respond stage), the ball and the sheet under it (integrate stage).
+/// Per-step state of a teleoperation rig: the slave following the master and the gripper pads it
+/// carries (place stage), the grasp read off the pads' contacts with the ball (respond stage).
+/// The ball, the sheet, the pads and the floor are ordinary bodies of the world
+/// (TeleopRigDescription::ball_body …): their state is in WorldState::bodies and ::segments.
 struct RigState {
-  /// Throws hapsim::Error on unusable slave, gripper, ball or sheet settings.
+  /// Throws hapsim::Error on unusable slave settings.
   explicit RigState(const TeleopRigDescription& rig);
   ~RigState();
   RigState(const RigState&) = delete;
   RigState& operator=(const RigState&) = delete;
-  /// Back to the start: slave at its start joints with the gripper open, the ball where it
-  /// started, the sheet flat. Rebuilds the parts (allocates): a user's reset, not a cycle's work.
+  /// Back to the start: slave at its start joints with the gripper open. Rebuilds the slave
+  /// (allocates): a user's reset, not a cycle's work.
   void reset();
 
   const TeleopRigDescription* description = nullptr;  ///< the model's; outlives this state
 
   std::unique_ptr<SlaveFollower> slave;
-  ParallelGripper gripper;
-  RigidBall ball;
-  std::unique_ptr<VirtualSheet> sheet;
-  std::unique_ptr<BallEnvironment> environment;
   /// Place stage: the master's input was usable (healthy, finite joints).
   bool input_usable = false;
+  /// Place stage: the pads' centres last step (their velocity), world frame.
+  std::array<Vec3, 2> pad_previous_world{Vec3::Zero(), Vec3::Zero()};
+  bool has_pad_previous = false;
+  /// Respond stage: the grasp holds (both pads press the ball from opposite sides hard enough
+  /// that friction carries its weight). A report: the ball is held by friction, not attached.
+  bool held = false;
   TeleopStepResult result;
 };
 
