@@ -195,6 +195,12 @@ nlohmann::json summary_json(const SceneDescription& scene, const World& world,
     methods.emplace_back(to_string(b.method));
   }
   j["methods"] = methods;
+  j["stiffness_clamps"] = nlohmann::json::array();
+  for (const StiffnessClamp& c : s.stiffness_clamps) {
+    j["stiffness_clamps"].push_back({{"material", c.material},
+                                     {"stiffness_n_per_m", c.stiffness_n_per_m},
+                                     {"clamped_to_n_per_m", c.clamped_n_per_m}});
+  }
   j["world_build_ms"] = world.build_ms();
   j["query_memory_bytes"] = world.query_memory_bytes();
   return j;

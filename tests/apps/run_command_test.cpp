@@ -5,6 +5,8 @@
 
 #include "hapsim_process.h"
 
+#include "hapsim/core/device_profile.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -177,6 +179,50 @@ TEST(RunCommand, PlaysATrajectoryFile) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j.at("steps").get<std::size_t>(), 1000u);
   EXPECT_EQ(j.at("peak_command_force_n").get<double>(), 0.0);
+}
+
+std::size_t count(const std::string& text, const std::string& part) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) {
+    ++n;
+  }
+  return n;
+}
+
+// The glove's actuators are rated 400 N/m (device_profile.h, rutgers_master): the knee_hand
+// materials above that are named once in the summary and listed in the JSON, each with its own
+// stiffness read from the scene file.
+TEST(RunCommand, KneeHandNamesTheMaterialsClampedToTheGlovesStiffness) {
+  const std::string scene_file = std::string(HAPSIM_SCENES_DIR) + "/knee_hand.json";
+  const auto json_path = temp_path("knee_hand_clamps.json");
+  const RunResult r =
+      run_hapsim("run " + scene_file + " --duration 0.05 -q --json " + json_path.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const double rating = hapsim::device_profile("rutgers_master").max_stiffness_n_per_m;
+  std::ifstream scene_in(scene_file);
+  const nlohmann::json scene = nlohmann::json::parse(scene_in);
+  std::map<std::string, double> stiffer;
+  for (const auto& [name, m] : scene.at("materials").items()) {
+    if (m.at("stiffness_n_per_m").get<double>() > rating) {
+      stiffer[name] = m.at("stiffness_n_per_m").get<double>();
+    }
+  }
+  ASSERT_FALSE(stiffer.empty());
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  std::map<std::string, double> listed;
+  for (const auto& c : j.at("stiffness_clamps")) {
+    listed[c.at("material").get<std::string>()] = c.at("stiffness_n_per_m").get<double>();
+    EXPECT_EQ(c.at("clamped_to_n_per_m").get<double>(), rating);
+  }
+  EXPECT_EQ(listed, stiffer);
+  EXPECT_EQ(count(r.output, "stiffness clamped to the device's rated 400 N/m: material "), 1u)
+      << r.output;
+  for (const auto& [name, k] : stiffer) {
+    char part[128];
+    std::snprintf(part, sizeof part, "'%s' %g N/m", name.c_str(), k);
+    EXPECT_NE(r.output.find(part), std::string::npos) << part << "\n" << r.output;
+  }
 }
 
 TEST(RunCommand, BadInputsAreOneNamedLineAndExitTwo) {

@@ -1,8 +1,8 @@
-// One unattended run of a world driven by a device (architecture.md#real-time, architecture.md#scenes): the deterministic step at a
-// fixed dt, as fast as it goes (offline) or on an absolute 1 kHz deadline (--realtime), with the
-// device safety layer between the world and the device, an optional recorder, and the figures a
-// user wants at the end: contacts and deflection per segment, forces per tool, pop-throughs,
-// force-limit violations and the cost of a step.
+// One unattended run of a world driven by a device (architecture.md#real-time,
+// architecture.md#scenes): the deterministic step at a fixed dt, as fast as it goes (offline) or on
+// an absolute 1 kHz deadline (--realtime), with the device safety layer between the world and the
+// device, an optional recorder, and the figures a user wants at the end: contacts and deflection
+// per segment, forces per tool, pop-throughs, force-limit violations and the cost of a step.
 #pragma once
 
 #include "hapsim/core/progress.h"
@@ -99,6 +99,19 @@ struct TeleopSummary {
   [[nodiscard]] bool placed() const;
 };
 
+/// A material the world renders softer than described: its stiffness is above the device's
+/// rated maximum (WorldOptions::max_stiffness_n_per_m, which run assembly sets from the device
+/// profile), so contact on it uses the maximum instead.
+struct StiffnessClamp {
+  std::string material;
+  double stiffness_n_per_m = 0.0;  ///< as described
+  double clamped_n_per_m = 0.0;    ///< as rendered: the device's rated maximum
+};
+
+/// The materials of `world` used by at least one segment whose stiffness its options clamp, in
+/// the description's order (empty when nothing is clamped).
+[[nodiscard]] std::vector<StiffnessClamp> stiffness_clamps(const World& world);
+
 struct SessionSummary {
   std::size_t steps = 0;
   double simulated_s = 0.0;
@@ -125,6 +138,8 @@ struct SessionSummary {
   std::optional<RealtimeSummary> realtime;
   /// Worlds with a teleoperation rig.
   std::optional<TeleopSummary> teleop;
+  /// Materials rendered at the device's rated stiffness instead of their own (stiffness_clamps).
+  std::vector<StiffnessClamp> stiffness_clamps;
 };
 
 /// Runs `world` with `device` for options.duration_s. Throws hapsim::Error on bad options.
@@ -137,7 +152,7 @@ struct SessionSummary {
 /// The "real time: …" line(s) of a summary.
 [[nodiscard]] std::string format_realtime_summary(const RealtimeSummary& realtime);
 
-/// Short human summary (a dozen lines).
+/// Short human summary (a dozen lines), with one line naming the clamped materials, if any.
 [[nodiscard]] std::string format_session_summary(const SessionSummary& summary);
 
 }  // namespace hapsim
