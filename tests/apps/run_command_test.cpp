@@ -184,6 +184,12 @@ TEST(RunCommand, PlaysATrajectoryFile) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j.at("steps").get<std::size_t>(), 1000u);
   EXPECT_EQ(j.at("peak_command_force_n").get<double>(), 0.0);
+  // ... which the run says before it starts.
+  ASSERT_EQ(j.at("warnings").size(), 1u);
+  EXPECT_EQ(j["warnings"][0].get<std::string>().rfind(
+                traj.string() + ": the trajectory never comes within reach of a body", 0),
+            0u)
+      << j["warnings"];
 }
 
 std::size_t count(const std::string& text, const std::string& part) {
@@ -195,13 +201,14 @@ std::size_t count(const std::string& text, const std::string& part) {
 }
 
 // What was silently changed is said (docs/scene-format.md, "Warnings"): a mesh in millimetres
-// read as metres warns once, through the log, before the run, and the JSON lists the same line.
-TEST(RunCommand, AMisScaledMeshWarnsOnce) {
+// read as metres and a trajectory far from everything each warn once, through the log, before the
+// run, and the JSON lists the same lines.
+TEST(RunCommand, AMisScaledMeshAndAFarTrajectoryWarnOnceEach) {
   const auto mesh = temp_path("patella.stl");
   hapsim::MeshSaveOptions mm;
   mm.scale = 1000.0;  // file units per metre: the numbers are millimetres
   hapsim::save_mesh(mesh, hapsim::make_box(hapsim::Vec3::Constant(0.021)), mm);
-  const auto still = write_file("still.csv",
+  const auto far = write_file("far.csv",
                               "t,x,y,z,qw,qx,qy,qz\n0,0,0,100,1,0,0,0\n"
                               "0.5,0,0,100,1,0,0,0\n");
   const auto scene = write_file("misscaled.json", R"({
@@ -212,23 +219,26 @@ TEST(RunCommand, AMisScaledMeshWarnsOnce) {
                   "materials": "bone" } ],
     "tools": [ { "name": "tip", "radius_m": 0.005 } ],
     "device": { "profile": "touch", "trajectory": ")" +
-                                                      still.string() + R"(" }
+                                                      far.string() + R"(" }
   })");
   const auto json_path = temp_path("misscaled_run.json");
   const RunResult r = run_hapsim("run " + scene.string() + " -q --json " + json_path.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string mesh_warning =
       scene.string() + ":/bodies/0/geometry/mesh: " + mesh.string() + " is 42 m across at scale 1";
+  const std::string far_warning = far.string() + ": the trajectory never comes within reach";
   EXPECT_EQ(count(r.output, mesh_warning), 1u) << r.output;
-  EXPECT_EQ(count(r.output, "[warning]"), 1u) << r.output;
+  EXPECT_EQ(count(r.output, far_warning), 1u) << r.output;
+  EXPECT_EQ(count(r.output, "[warning]"), 2u) << r.output;
   EXPECT_NE(r.output.find("Use \"scale\": 0.001"), std::string::npos) << r.output;
   // Before the run's figures.
-  EXPECT_LT(r.output.find(mesh_warning), r.output.find("steps,")) << r.output;
+  EXPECT_LT(r.output.find(far_warning), r.output.find("steps,")) << r.output;
   std::ifstream in(json_path);
   const nlohmann::json j = nlohmann::json::parse(in);
-  ASSERT_EQ(j.at("warnings").size(), 1u);
+  ASSERT_EQ(j.at("warnings").size(), 2u);
   EXPECT_EQ(j["warnings"][0].get<std::string>().rfind(mesh_warning, 0), 0u) << j["warnings"];
-  EXPECT_NE(r.output.find(j["warnings"][0].get<std::string>()), std::string::npos);
+  EXPECT_EQ(j["warnings"][1].get<std::string>().rfind(far_warning, 0), 0u) << j["warnings"];
+  EXPECT_NE(r.output.find(j["warnings"][1].get<std::string>()), std::string::npos);
 }
 
 // The glove's actuators are rated 400 N/m (device_profile.h, rutgers_master): the knee_hand

@@ -1,7 +1,9 @@
 // Scene warnings (docs/scene-format.md, "Warnings"): what loads but is probably not what was
 // meant is said once, naming the file and what would fix it. A mesh file written in millimetres
 // and read as metres (and the reverse) names the scale that gives the part its real size, checked
-// by loading it again at that scale. The shipped scenes load and assemble without any.
+// by loading it again at that scale; a trajectory that never reaches a body says how far it
+// stays, checked against the gap worked out by hand from the box, the tool and the path. The
+// shipped scenes load and assemble without any.
 #include "hapsim/core/data_dir.h"
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/procedural.h"
@@ -147,8 +149,80 @@ TEST_F(SceneWarningsTest, TheOneOddFileOfAFolderIsNamed) {
   EXPECT_FALSE(contains(s.warnings[0], "femur")) << s.warnings[0];
 }
 
-// The shipped scenes: no mesh is implausibly sized (the knee_vhf and teleop_gp7 ones only where
-// the real data is present).
+// The block's half extent is 20 mm, the tool's radius 5 mm: a probe coming straight down the z
+// axis from 200 mm to 100 mm stays 100 − 20 − 5 = 75 mm from the block's box, nearest at the end.
+TEST_F(SceneWarningsTest, ATrajectoryThatNeverReachesABodySaysHowFarItStays) {
+  const Json box = {{"box", {{"half_extents_m", {0.02, 0.02, 0.02}}}}};
+  const SceneDescription scene = load(scene_with({box}));
+  EXPECT_TRUE(scene.warnings.empty());
+  const fs::path far =
+      write("far.csv", "t,x,y,z,qw,qx,qy,qz\n0,0,0,0.2,1,0,0,0\n1,0,0,0.1,1,0,0,0\n");
+  const RunSetup setup = make_run_setup(scene, DeviceChoice::trajectory(far));
+  ASSERT_EQ(setup.scene.warnings.size(), 1u);
+  EXPECT_EQ(setup.scene.warnings[0],
+            far.string() +
+                ": the trajectory never comes within reach of a body: its tools stay at least "
+                "75.0 mm from every body's bounding box (nearest: tool 'tip' to body 'b0', at "
+                "t = 1.000 s), so nothing will be touched");
+  // The device starts where the trajectory does (the check read it to its end).
+  EXPECT_NEAR(setup.script_start.p_world.z(), 0.2, 1e-12);
+
+  // Down to 24 mm: the 5 mm sphere reaches 19 mm, inside the box's 20 mm: no warning.
+  const fs::path near =
+      write("near.csv", "t,x,y,z,qw,qx,qy,qz\n0,0,0,0.2,1,0,0,0\n1,0,0,0.024,1,0,0,0\n");
+  EXPECT_TRUE(make_run_setup(scene, DeviceChoice::trajectory(near)).scene.warnings.empty());
+
+  // The scene's own trajectory key is checked the same way and named the same way.
+  Json own = scene_with({box});
+  own["device"].erase("palpation");
+  own["device"]["trajectory"] = far.string();
+  const RunSetup own_setup = make_run_setup(load(own), DeviceChoice::scene_script());
+  ASSERT_EQ(own_setup.scene.warnings.size(), 1u);
+  EXPECT_EQ(own_setup.scene.warnings[0].rfind(far.string() + ": the trajectory never", 0), 0u);
+
+  // A dynamic body may move into the path: nothing is claimed.
+  Json dynamic = scene_with({box});
+  dynamic["bodies"][0]["type"] = "dynamic";
+  EXPECT_TRUE(make_run_setup(load(dynamic), DeviceChoice::trajectory(far)).scene.warnings.empty());
+}
+
+// The glove's tools are its fingertips, placed from the tracker pose and the finger angles: a
+// hand 3 m above the knee (whose parts lie within 0.3 m of the origin; fingers are under 0.2 m
+// long) stays more than 2.5 m away.
+TEST_F(SceneWarningsTest, AGloveTrajectoryFarFromTheKneeWarns) {
+  const SceneDescription scene =
+      load_scene(fs::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_hand.json");
+  // Appended piece by piece: `",j" + std::to_string(j)` trips GCC 12's -Wrestrict false
+  // positive at -O3 (GCC bug 105651).
+  std::string csv = "t,x,y,z,qw,qx,qy,qz";
+  for (int j = 0; j < 15; ++j) {
+    csv += ",j";
+    csv += std::to_string(j);
+  }
+  csv += '\n';
+  for (const char* t : {"0", "1"}) {
+    csv += t;
+    csv += ",0,0,3,1,0,0,0";
+    for (int j = 0; j < 15; ++j) {
+      csv += ",0.3";
+    }
+    csv += '\n';
+  }
+  const fs::path far = write("glove_far.csv", csv);
+  const RunSetup setup = make_run_setup(scene, DeviceChoice::trajectory(far));
+  ASSERT_EQ(setup.scene.warnings.size(), 1u);
+  const std::string& w = setup.scene.warnings[0];
+  double gap_mm = 0.0;
+  const std::size_t at = w.find("at least ");
+  ASSERT_NE(at, std::string::npos) << w;
+  ASSERT_EQ(std::sscanf(w.c_str() + at, "at least %lf mm", &gap_mm), 1) << w;
+  EXPECT_GT(gap_mm, 2500.0) << w;
+  EXPECT_LT(gap_mm, 3000.0) << w;
+  EXPECT_TRUE(contains(w, "body 'knee'")) << w;
+}
+
+// The shipped scenes: no mesh is implausibly sized, and every scene script comes within reach of
+// what it palpates (the knee_vhf and teleop_gp7 ones only where the real data is present).
 TEST(SceneWarnings, ShippedScenesLoadAndAssembleWithoutWarnings) {
   const fs::path scenes = fs::path(HAPSIM_SOURCE_DIR) / "scenes";
   const std::optional<fs::path> root = find_data_dir(HAPSIM_TEST_DATA_DIR);
