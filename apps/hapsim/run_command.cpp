@@ -15,6 +15,7 @@
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 
+#include <spdlog/spdlog.h>
 #include <nlohmann/json.hpp>
 
 #include <unistd.h>
@@ -216,6 +217,13 @@ nlohmann::json summary_json(const SceneDescription& scene, const World& world,
     methods.emplace_back(to_string(b.method));
   }
   j["methods"] = methods;
+  j["warnings"] = scene.warnings;
+  j["stiffness_clamps"] = nlohmann::json::array();
+  for (const StiffnessClamp& c : s.stiffness_clamps) {
+    j["stiffness_clamps"].push_back({{"material", c.material},
+                                     {"stiffness_n_per_m", c.stiffness_n_per_m},
+                                     {"clamped_to_n_per_m", c.clamped_n_per_m}});
+  }
   j["world_build_ms"] = world.build_ms();
   j["query_memory_bytes"] = world.query_memory_bytes();
   return j;
@@ -338,6 +346,11 @@ void run(const RunArgs& args) {
   }
   std::printf("device       %s; %.3f s at %.0f Hz%s\n", device_name.c_str(), duration_s,
               1.0 / scene.run.dt_s, args.realtime ? " in real time" : " as fast as possible");
+  // What the load and the run's assembly let through but noticed: through the log, as mesh
+  // defects are, once each, before the run (and in the JSON).
+  for (const std::string& warning : scene.warnings) {
+    spdlog::warn("{}", warning);
+  }
 
   // A replay without --record still records, to a temporary file, to compare bit for bit.
   std::filesystem::path record_path = args.record_path;

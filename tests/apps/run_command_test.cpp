@@ -5,13 +5,20 @@
 
 #include "hapsim_process.h"
 
+#include "hapsim/core/data_dir.h"
+#include "hapsim/core/device_profile.h"
+#include "hapsim/geometry/mesh_io.h"
+#include "hapsim/geometry/procedural.h"
+
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <string>
+#include <utility>
 
 namespace {
 
@@ -177,6 +184,130 @@ TEST(RunCommand, PlaysATrajectoryFile) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j.at("steps").get<std::size_t>(), 1000u);
   EXPECT_EQ(j.at("peak_command_force_n").get<double>(), 0.0);
+  // ... which the run says before it starts.
+  ASSERT_EQ(j.at("warnings").size(), 1u);
+  EXPECT_EQ(j["warnings"][0].get<std::string>().rfind(
+                traj.string() + ": the trajectory never comes within reach of a body", 0),
+            0u)
+      << j["warnings"];
+}
+
+std::size_t count(const std::string& text, const std::string& part) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) {
+    ++n;
+  }
+  return n;
+}
+
+// What was silently changed is said (docs/scene-format.md, "Warnings"): a mesh in millimetres
+// read as metres and a trajectory far from everything each warn once, through the log, before the
+// run, and the JSON lists the same lines.
+TEST(RunCommand, AMisScaledMeshAndAFarTrajectoryWarnOnceEach) {
+  const auto mesh = temp_path("patella.stl");
+  hapsim::MeshSaveOptions mm;
+  mm.scale = 1000.0;  // file units per metre: the numbers are millimetres
+  hapsim::save_mesh(mesh, hapsim::make_box(hapsim::Vec3::Constant(0.021)), mm);
+  const auto far = write_file("far.csv",
+                              "t,x,y,z,qw,qx,qy,qz\n0,0,0,100,1,0,0,0\n"
+                              "0.5,0,0,100,1,0,0,0\n");
+  const auto scene = write_file("misscaled.json", R"({
+    "format": "hapsim-scene/1",
+    "materials": { "bone": { "stiffness_n_per_m": 300 } },
+    "bodies": [ { "name": "patella", "geometry": { "mesh": { "file": ")" +
+                                                      mesh.string() + R"(" } },
+                  "materials": "bone" } ],
+    "tools": [ { "name": "tip", "radius_m": 0.005 } ],
+    "device": { "profile": "touch", "trajectory": ")" +
+                                                      far.string() + R"(" }
+  })");
+  const auto json_path = temp_path("misscaled_run.json");
+  const RunResult r = run_hapsim("run " + scene.string() + " -q --json " + json_path.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const std::string mesh_warning =
+      scene.string() + ":/bodies/0/geometry/mesh: " + mesh.string() + " is 42 m across at scale 1";
+  const std::string far_warning = far.string() + ": the trajectory never comes within reach";
+  EXPECT_EQ(count(r.output, mesh_warning), 1u) << r.output;
+  EXPECT_EQ(count(r.output, far_warning), 1u) << r.output;
+  EXPECT_EQ(count(r.output, "[warning]"), 2u) << r.output;
+  EXPECT_NE(r.output.find("Use \"scale\": 0.001"), std::string::npos) << r.output;
+  // Before the run's figures.
+  EXPECT_LT(r.output.find(far_warning), r.output.find("steps,")) << r.output;
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j.at("warnings").size(), 2u);
+  EXPECT_EQ(j["warnings"][0].get<std::string>().rfind(mesh_warning, 0), 0u) << j["warnings"];
+  EXPECT_EQ(j["warnings"][1].get<std::string>().rfind(far_warning, 0), 0u) << j["warnings"];
+  EXPECT_NE(r.output.find(j["warnings"][1].get<std::string>()), std::string::npos);
+}
+
+// The glove's actuators are rated 400 N/m (device_profile.h, rutgers_master): the knee_hand
+// materials above that are named once in the summary and listed in the JSON, each with its own
+// stiffness read from the scene file.
+TEST(RunCommand, KneeHandNamesTheMaterialsClampedToTheGlovesStiffness) {
+  const std::string scene_file = std::string(HAPSIM_SCENES_DIR) + "/knee_hand.json";
+  const auto json_path = temp_path("knee_hand_clamps.json");
+  const RunResult r =
+      run_hapsim("run " + scene_file + " --duration 0.05 -q --json " + json_path.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const double rating = hapsim::device_profile("rutgers_master").max_stiffness_n_per_m;
+  std::ifstream scene_in(scene_file);
+  const nlohmann::json scene = nlohmann::json::parse(scene_in);
+  std::map<std::string, double> stiffer;
+  for (const auto& [name, m] : scene.at("materials").items()) {
+    if (m.at("stiffness_n_per_m").get<double>() > rating) {
+      stiffer[name] = m.at("stiffness_n_per_m").get<double>();
+    }
+  }
+  ASSERT_FALSE(stiffer.empty());
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  std::map<std::string, double> listed;
+  for (const auto& c : j.at("stiffness_clamps")) {
+    listed[c.at("material").get<std::string>()] = c.at("stiffness_n_per_m").get<double>();
+    EXPECT_EQ(c.at("clamped_to_n_per_m").get<double>(), rating);
+  }
+  EXPECT_EQ(listed, stiffer);
+  EXPECT_EQ(count(r.output, "stiffness clamped to the device's rated 400 N/m: material "), 1u)
+      << r.output;
+  for (const auto& [name, k] : stiffer) {
+    char part[128];
+    std::snprintf(part, sizeof part, "'%s' %g N/m", name.c_str(), k);
+    EXPECT_NE(r.output.find(part), std::string::npos) << part << "\n" << r.output;
+  }
+  EXPECT_TRUE(j.at("warnings").empty()) << j["warnings"];
+}
+
+// The shipped scenes run without a warning, and (but knee_hand, above) without a clamp; the
+// real-data ones where the data is present.
+TEST(RunCommand, ShippedScenesRunWithoutWarnings) {
+  const std::optional<std::filesystem::path> root = hapsim::find_data_dir(HAPSIM_TEST_DATA_DIR);
+  for (const auto& [name, data] :
+       {std::pair{"knee", ""}, std::pair{"knee_hand", ""}, std::pair{"csg_block", ""},
+        std::pair{"teleop", ""}, std::pair{"teleop_gp7", "motoman_gp7"},
+        std::pair{"knee_vhf", "knee_vhf_left"}}) {
+    SCOPED_TRACE(name);
+    std::string args = "run " + std::string(HAPSIM_SCENES_DIR) + "/" + name + ".json";
+    if (*data != '\0') {
+      if (!root || !std::filesystem::is_directory(*root / data)) {
+        std::printf("skipping %s: real data '%s' not found\n", name, data);
+        continue;
+      }
+      args += " --data " + (*root / data).string();
+    }
+    const auto json_path = temp_path(std::string(name) + "_warnings.json");
+    // Whole runs (a teleoperation scene is judged on its whole pick-and-place): under 3 s each.
+    const RunResult r = run_hapsim(args + " -q --json " + json_path.string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(r.output.find("[warning]"), std::string::npos) << r.output;
+    std::ifstream in(json_path);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_TRUE(j.at("warnings").empty()) << j["warnings"];
+    if (std::string(name) != "knee_hand") {
+      EXPECT_TRUE(j.at("stiffness_clamps").empty()) << j["stiffness_clamps"];
+      EXPECT_EQ(r.output.find("stiffness clamped"), std::string::npos) << r.output;
+    }
+  }
 }
 
 TEST(RunCommand, BadInputsAreOneNamedLineAndExitTwo) {

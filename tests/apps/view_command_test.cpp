@@ -78,6 +78,34 @@ TEST(ViewCommand, MouseProbeUnderXvfbDentsTheKneeAndShowsTheForce) {
   EXPECT_GT(d.differing_fraction, 0.002) << d.describe();
 }
 
+// The viewer prints the scene's warnings once (through the log, as `hapsim run` does) and lists
+// them in its JSON: here a trajectory 100 m above the knee.
+TEST(ViewCommand, PrintsTheScenesWarningsOnceAndListsThemInItsJson) {
+  if (!have("xvfb-run")) {
+    GTEST_SKIP() << "xvfb-run missing (scripts/setup.sh installs it)";
+  }
+  const auto far = test::write_file("view_far.csv",
+                                    "t,x,y,z,qw,qx,qy,qz\n0,0,0,100,1,0,0,0\n1,0,0,100,1,0,0,0\n");
+  const auto json = test::temp_path("view_warnings.json");
+  const auto log = test::temp_path("view_warnings.log");
+  const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' ") + HAPSIM_BIN_PATH +
+                          " view " + HAPSIM_SCENES_DIR + "/knee.json --device sim:" + far.string() +
+                          " --duration 2 --size 640x480 --json " + json.string() + " > " +
+                          log.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  std::ifstream log_in(log);
+  const std::string output((std::istreambuf_iterator<char>(log_in)), {});
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << output;
+  const std::string warning = far.string() + ": the trajectory never comes within reach";
+  const std::size_t first = output.find(warning);
+  ASSERT_NE(first, std::string::npos) << output;
+  EXPECT_EQ(output.find(warning, first + 1), std::string::npos) << output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j.at("warnings").size(), 1u);
+  EXPECT_EQ(j["warnings"][0].get<std::string>().rfind(warning, 0), 0u) << j["warnings"];
+}
+
 TEST(ViewCommand, NoDisplayIsAClearError) {
   const std::string cmd = std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + HAPSIM_BIN_PATH +
                           " view " + HAPSIM_SCENES_DIR + "/knee.json > " +

@@ -213,5 +213,41 @@ TEST(Session, ToolPushedThroughAPenaltyPlateIsAPopThrough) {
   EXPECT_GT(s.segments[0].contacts, 0u);
 }
 
+// A material stiffer than the device's rating is rendered at the rating: the summary says so
+// once, naming it, its own stiffness and the clamp. The bone (3000 N/m, two_body_world.h) on a
+// Touch (rated 400 N/m, device_profile_test) is; the 300 N/m muscle is not; nor is a stiffer
+// material no segment uses.
+TEST(Session, NamesTheMaterialsClampedToTheDevicesStiffness) {
+  const DeviceProfile& touch = device_profile("touch");
+  WorldDescription w = two_body_world();
+  w.materials.push_back(test::material("unused", ContactResponse::kProxy, 9000.0, 10.0));
+  WorldOptions wo;
+  wo.max_stiffness_n_per_m = touch.max_stiffness_n_per_m;
+  World world(std::move(w), wo);
+  SimulatedDevice device(touch, script, 0.01);
+  SessionOptions options;
+  options.duration_s = 0.01;
+  const SessionSummary s = run_session(world, device, options);
+  ASSERT_EQ(s.stiffness_clamps.size(), 1u);
+  EXPECT_EQ(s.stiffness_clamps[0].material, "bone");
+  EXPECT_EQ(s.stiffness_clamps[0].stiffness_n_per_m, 3000.0);
+  EXPECT_EQ(s.stiffness_clamps[0].clamped_n_per_m, 400.0);
+  const std::string text = format_session_summary(s);
+  const std::string line =
+      "stiffness clamped to the device's rated 400 N/m: material 'bone' "
+      "3000 N/m\n";
+  ASSERT_NE(text.find(line), std::string::npos) << text;
+  EXPECT_EQ(text.find("stiffness clamped", text.find(line) + 1), std::string::npos) << text;
+
+  // On an omega.3 (5000 N/m) nothing is clamped and nothing is said.
+  WorldOptions omega;
+  omega.max_stiffness_n_per_m = device_profile("omega3").max_stiffness_n_per_m;
+  World unclamped(two_body_world(), omega);
+  SimulatedDevice device2(touch, script, 0.01);
+  const SessionSummary u = run_session(unclamped, device2, options);
+  EXPECT_TRUE(u.stiffness_clamps.empty());
+  EXPECT_EQ(format_session_summary(u).find("stiffness"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace hapsim

@@ -416,8 +416,29 @@ SessionSummary run_session(World& world, Device& device, const SessionOptions& o
                                " s is shorter than one step of " + std::to_string(options.dt_s) +
                                " s");
   }
-  return options.realtime ? run_realtime(world, device, options, steps)
-                          : run_inline(world, device, options, steps);
+  SessionSummary summary = options.realtime ? run_realtime(world, device, options, steps)
+                                            : run_inline(world, device, options, steps);
+  summary.stiffness_clamps = stiffness_clamps(world);
+  return summary;
+}
+
+std::vector<StiffnessClamp> stiffness_clamps(const World& world) {
+  const double max_k = world.model().options().max_stiffness_n_per_m;
+  const WorldDescription& d = world.description();
+  std::vector<bool> used(d.materials.size(), false);
+  for (const SegmentModel& seg : world.model().segments()) {
+    if (seg.material < used.size()) {
+      used[seg.material] = true;
+    }
+  }
+  std::vector<StiffnessClamp> clamps;
+  for (std::size_t m = 0; m < d.materials.size(); ++m) {
+    const double k = d.materials[m].contact.stiffness_n_per_m;
+    if (used[m] && k > max_k) {
+      clamps.push_back({d.materials[m].name, k, max_k});
+    }
+  }
+  return clamps;
 }
 
 bool TeleopSummary::placed() const {
@@ -435,6 +456,19 @@ std::string format_session_summary(const SessionSummary& s) {
                 "step cost: p50 %.2f us, p99 %.2f us, max %.1f us, mean %.2f us\n", s.step_us.p50,
                 s.step_us.p99, s.step_us.max, s.step_us.mean);
   out << line;
+  if (!s.stiffness_clamps.empty()) {
+    const auto n_per_m = [&line](double k) {
+      std::snprintf(line, sizeof line, "%.6g N/m", k);
+      return std::string(line);
+    };
+    out << "stiffness clamped to the device's rated "
+        << n_per_m(s.stiffness_clamps.front().clamped_n_per_m) << ": material";
+    for (std::size_t i = 0; i < s.stiffness_clamps.size(); ++i) {
+      const StiffnessClamp& c = s.stiffness_clamps[i];
+      out << (i == 0 ? " '" : ", '") << c.material << "' " << n_per_m(c.stiffness_n_per_m);
+    }
+    out << "\n";
+  }
   for (const ToolSummary& t : s.tools) {
     std::snprintf(line, sizeof line,
                   "tool %-14s peak %.3f N, mean %.3f N while touching (%zu steps in contact)\n",

@@ -118,6 +118,19 @@ struct SheetSummary {
   double final_depth_m = 0.0;
 };
 
+/// A material the world renders softer than described: its stiffness is above the device's
+/// rated maximum (WorldOptions::max_stiffness_n_per_m, which run assembly sets from the device
+/// profile), so contact on it uses the maximum instead.
+struct StiffnessClamp {
+  std::string material;
+  double stiffness_n_per_m = 0.0;  ///< as described
+  double clamped_n_per_m = 0.0;    ///< as rendered: the device's rated maximum
+};
+
+/// The materials of `world` used by at least one segment whose stiffness its options clamp, in
+/// the description's order (empty when nothing is clamped).
+[[nodiscard]] std::vector<StiffnessClamp> stiffness_clamps(const World& world);
+
 struct SessionSummary {
   std::size_t steps = 0;
   double simulated_s = 0.0;
@@ -147,6 +160,8 @@ struct SessionSummary {
   /// Dynamic bodies (the first kMaxCycleDynamicBodies) and sheets (the first kMaxCycleSheets).
   std::vector<BodySummary> bodies;
   std::vector<SheetSummary> sheets;
+  /// Materials rendered at the device's rated stiffness instead of their own (stiffness_clamps).
+  std::vector<StiffnessClamp> stiffness_clamps;
 };
 
 /// Runs `world` with `device` for options.duration_s. Throws hapsim::Error on bad options.
@@ -159,7 +174,7 @@ struct SessionSummary {
 /// The "real time: …" line(s) of a summary.
 [[nodiscard]] std::string format_realtime_summary(const RealtimeSummary& realtime);
 
-/// Short human summary (a dozen lines).
+/// Short human summary (a dozen lines), with one line naming the clamped materials, if any.
 [[nodiscard]] std::string format_session_summary(const SessionSummary& summary);
 
 }  // namespace hapsim

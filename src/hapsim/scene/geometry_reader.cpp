@@ -1,16 +1,71 @@
 #include "hapsim/scene/geometry_reader.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/geometry/body_part_size.h"
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/scene/csg_reader.h"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 #include <set>
+#include <utility>
 
 namespace hapsim {
 
 using Json = JsonReader::Json;
+
+void GeometryReader::check_sizes(const std::string& ptr, const std::vector<LoadedMesh>& meshes,
+                                 double scale, const std::filesystem::path& folder) {
+  struct Implausible {
+    std::filesystem::path file;
+    MeshScaleAdvice advice;
+  };
+  // Files one scale would fix share a warning: (too large, suggested scale) -> files.
+  std::map<std::pair<bool, double>, std::vector<Implausible>> groups;
+  std::vector<std::pair<bool, double>> order;
+  for (const LoadedMesh& m : meshes) {
+    if (!size_checked_.insert(std::filesystem::absolute(m.file).lexically_normal()).second) {
+      continue;  // once per file
+    }
+    const Box3 bounds = m.mesh->bounds();
+    if (bounds.isEmpty()) {
+      continue;
+    }
+    if (const auto advice = check_body_part_size(bounds.sizes().maxCoeff(), scale)) {
+      const std::pair<bool, double> key{advice->too_large, advice->suggested_scale};
+      if (groups[key].empty()) {
+        order.push_back(key);
+      }
+      groups[key].push_back({m.file, *advice});
+    }
+  }
+  const std::string where = r_.file().string() + ":" + ptr + ": ";
+  for (const auto& key : order) {
+    const std::vector<Implausible>& files = groups[key];
+    if (files.size() == 1) {
+      warnings_.push_back(where + files[0].file.string() + " " + describe(files[0].advice));
+      continue;
+    }
+    // The most implausible file speaks for the group.
+    const Implausible& worst = *std::max_element(
+        files.begin(), files.end(), [](const Implausible& a, const Implausible& b) {
+          return std::abs(std::log(a.advice.extent_m)) < std::abs(std::log(b.advice.extent_m));
+        });
+    std::string names;
+    for (std::size_t i = 0; i < files.size() && i < 3; ++i) {
+      names += (i == 0 ? "" : ", ") + files[i].file.filename().string();
+    }
+    if (files.size() > 3) {
+      names += " and " + std::to_string(files.size() - 3) + " more";
+    }
+    warnings_.push_back(where + std::to_string(files.size()) + " of " +
+                        std::to_string(meshes.size()) + " mesh files in " + folder.string() + " (" +
+                        names + "); " + worst.file.filename().string() + " " +
+                        describe(worst.advice));
+  }
+}
 
 BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
                                   const std::string& body_name) {
@@ -116,6 +171,7 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
       const std::filesystem::path file =
           r_.path(r_.required(m, kp, "file"), fp, "a mesh file path");
       add(body_name, load(file, fp), std::nullopt);
+      check_sizes(kp, {{file, &body.segments.back().mesh}}, lo.scale, {});
     } else {
       const std::string fp = JsonReader::at(kp, "folder");
       const std::filesystem::path folder =
@@ -170,6 +226,11 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
         }
         add(name, load(files[i], fp), std::nullopt);
       }
+      std::vector<LoadedMesh> loaded;
+      for (std::size_t i = 0; i < files.size(); ++i) {
+        loaded.push_back({files[i], &body.segments[i].mesh});
+      }
+      check_sizes(kp, loaded, lo.scale, folder);
     }
   }
   return body;

@@ -8,7 +8,9 @@
 #include "hapsim/scene/scene_reader.h"
 #include "hapsim/world/world_description.h"
 
+#include <filesystem>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,10 @@ struct BodyGeometry {
   std::vector<std::optional<TissueKind>> tissues;
 };
 
+/// Reads the geometries of one scene's bodies, and collects its warnings: a mesh file whose size
+/// at its "scale" is implausible for a body part (check_body_part_size, body_part_size.h) gets
+/// one, naming the file and the scale that would fix it, however many bodies use the file; the
+/// files of one mesh_folder that one scale would fix share one.
 class GeometryReader {
  public:
   explicit GeometryReader(const SceneReader& reader) : r_(reader) {}
@@ -31,8 +37,21 @@ class GeometryReader {
   [[nodiscard]] BodyGeometry read(const JsonReader::Json& j, const std::string& ptr,
                                   const std::string& body_name);
 
+  /// The warnings so far, in the order found: "<scene file>:<JSON pointer>: <what>".
+  [[nodiscard]] const std::vector<std::string>& warnings() const { return warnings_; }
+
  private:
+  struct LoadedMesh {
+    std::filesystem::path file;
+    const TriangleMesh* mesh = nullptr;
+  };
+  /// Checks the sizes of the meshes loaded at `ptr` (a mesh, or a mesh_folder's `folder`).
+  void check_sizes(const std::string& ptr, const std::vector<LoadedMesh>& meshes, double scale,
+                   const std::filesystem::path& folder);
+
   const SceneReader& r_;
+  std::set<std::filesystem::path> size_checked_;
+  std::vector<std::string> warnings_;
 };
 
 }  // namespace hapsim

@@ -4,10 +4,44 @@
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/teleop_setup.h"
+#include "hapsim/scene/trajectory_reach.h"
 
+#include <cstdio>
+#include <string>
 #include <utility>
 
 namespace hapsim {
+namespace {
+
+// A scripted trajectory that never brings a tool within reach of a body makes a run of zeros:
+// say so, naming the trajectory (its file, or the scene's script) and how far it stays.
+void warn_if_out_of_reach(SceneDescription& scene, const World& world, Device& device,
+                          double length_s,
+                          const std::optional<std::filesystem::path>& trajectory_file) {
+  const TrajectoryReach reach = trajectory_reach(world, device, length_s, scene.run.dt_s);
+  if (!reach.checked || !(reach.gap_m > 0.0)) {
+    return;
+  }
+  std::string w;
+  if (trajectory_file || !scene.device.trajectory_file.empty()) {
+    w = (trajectory_file ? *trajectory_file : scene.device.trajectory_file).string() +
+        ": the trajectory";
+  } else if (scene.device.has_glove_palpation) {
+    w = scene.file.string() + ":/device/glove_palpation: the glove palpation script";
+  } else {
+    w = scene.file.string() + ":/device/palpation: the palpation script";
+  }
+  char number[64];
+  std::snprintf(number, sizeof number, "%.1f mm", reach.gap_m * 1e3);
+  w += std::string(" never comes within reach of a body: its tools stay at least ") + number +
+       " from every body's bounding box (nearest: tool '" + reach.tool + "' to body '" +
+       reach.body + "', at t = ";
+  std::snprintf(number, sizeof number, "%.3f s", reach.time_s);
+  w += std::string(number) + "), so nothing will be touched";
+  scene.warnings.push_back(std::move(w));
+}
+
+}  // namespace
 
 RunSetup make_run_setup(SceneDescription scene, const DeviceChoice& choice,
                         const RunSetupOptions& options) {
@@ -81,7 +115,8 @@ RunSetup make_run_setup(SceneDescription scene, const DeviceChoice& choice,
       } else {
         auto sim = make_scene_device(scene, *r.world, trajectory);
         device_length_s = sim->duration_end_s();
-        r.script_start = sim->read(0.0);
+        warn_if_out_of_reach(scene, *r.world, *sim, device_length_s, trajectory);
+        r.script_start = sim->read(0.0);  // also the device's first read again
         r.device_name = "simulated " + r.profile->name +
                         (trajectory                   ? " playing " + trajectory->string()
                          : scene.device.has_palpation ? " (palpation script)"

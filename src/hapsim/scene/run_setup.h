@@ -71,7 +71,9 @@ struct RunSetup {
 
 /// Builds the run. Throws hapsim::Error naming the file and what is wrong: a recording made on
 /// another scene (content hash) or with no frames, a trajectory that does not load or lacks the
-/// columns the scene's device needs, a script that cannot reach its targets.
+/// columns the scene's device needs, a script that cannot reach its targets. A scripted device
+/// (the scene's script or trajectory, or a trajectory file) whose tools never come within reach
+/// of a body (trajectory_reach.h) adds a warning to the scene's warnings.
 [[nodiscard]] RunSetup make_run_setup(SceneDescription scene, const DeviceChoice& choice,
                                       const RunSetupOptions& options = {});
 

@@ -142,6 +142,12 @@ struct SceneDescription {
   WorldDescription world;
   DeviceDescription device;
   RunDescription run;
+  /// What the load and the run's assembly let through but a user should know, one line each,
+  /// "<where>: <what>" (docs/scene-format.md, "Warnings"): a mesh implausibly sized at its scale
+  /// (scene_file.h), a scripted trajectory that never comes within reach of a body
+  /// (run_setup.h). Not part of the world (the content hash ignores them); `hapsim run` and
+  /// `hapsim view` print each once and the run's JSON lists them.
+  std::vector<std::string> warnings;
 };
 
 }  // namespace hapsim

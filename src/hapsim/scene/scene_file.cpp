@@ -115,6 +115,7 @@ SceneDescription Parser::parse(const Json& root) {
            "expected a unique body name; '" + scene.world.bodies.back().name + "' is used twice");
     }
   }
+  scene.warnings = geometry_.warnings();
 
   const Json& tools = array(required(root, "", "tools"), "/tools", "a list of tools");
   if (tools.empty()) {

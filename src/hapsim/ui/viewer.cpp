@@ -267,6 +267,14 @@ class Viewer {
     }
     session_ = std::move(next);
     built_once_ = true;
+    // The scene's warnings, through the log as mesh defects are: once each, however often the
+    // session is rebuilt (the JSON summary lists them all).
+    for (const std::string& warning : session_->warnings()) {
+      if (std::find(warnings_.begin(), warnings_.end(), warning) == warnings_.end()) {
+        spdlog::warn("{}", warning);
+        warnings_.push_back(warning);
+      }
+    }
     session_->set_paused(paused_);
     pending_config_ = config_;
     glfwSetWindowTitle(window_, ("hapsim — " + session_->title()).c_str());
@@ -472,6 +480,11 @@ class Viewer {
       if (!status_message_.empty()) {
         ImGui::TextWrapped("%s", status_message_.c_str());
       }
+      for (const std::string& warning : session_->warnings()) {
+        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.8f, 0.3f, 1.0f));
+        ImGui::TextWrapped("warning: %s", warning.c_str());
+        ImGui::PopStyleColor();
+      }
     }
     if (ImGui::CollapsingHeader("Display", ImGuiTreeNodeFlags_DefaultOpen)) {
       RenderScene& scene = session_->render_scene();
@@ -622,6 +635,7 @@ class Viewer {
                      {"stall_events", st.stall_events}};
       j["peak_force_n"] = forces_.peaks();
       j["max_deflection_m"] = peak_deflection_m_;
+      j["warnings"] = warnings_;
       j["ok"] = ok;
       std::ofstream out(options_.json);
       out << j.dump(2) << '\n';
@@ -657,6 +671,8 @@ class Viewer {
   std::array<bool, 512> key_down_{};
   double peak_deflection_m_ = 0.0;
   std::string status_message_;
+  /// Every warning printed so far (each once), for the JSON summary.
+  std::vector<std::string> warnings_;
   std::string recording_path_;
 };
 

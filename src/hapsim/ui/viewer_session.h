@@ -73,6 +73,11 @@ class ViewerSession {
   /// Where the probe starts (in front of the scene, as seen from the default camera).
   [[nodiscard]] virtual Vec3 probe_start_world() const = 0;
   [[nodiscard]] virtual const std::string& device_name() const = 0;
+  /// What loading the scene and assembling the run warned about (SceneDescription::warnings).
+  [[nodiscard]] virtual const std::vector<std::string>& warnings() const {
+    static const std::vector<std::string> kNone;
+    return kNone;
+  }
   [[nodiscard]] virtual const std::string& title() const = 0;
 
   virtual void set_paused(bool paused) = 0;

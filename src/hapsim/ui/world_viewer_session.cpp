@@ -247,6 +247,9 @@ class WorldViewerSession final : public ViewerSession {
   const std::string& device_name() const override {
     return device_name_;
   }
+  const std::vector<std::string>& warnings() const override {
+    return scene_.warnings;
+  }
   const std::string& title() const override {
     return title_;
   }
