@@ -5,32 +5,43 @@
 // the time since the last good cycle), never as wall-clock bounds on this shared machine.
 #include "hapsim/runtime/haptic_loop.h"
 
-#include "hapsim/core/error.h"
 #include "hapsim/core/device_profile.h"
+#include "hapsim/core/error.h"
 #include "hapsim/runtime/deadline_clock.h"
 #include "support/allocation_counter.h"
 
 #include <gtest/gtest.h>
+#include <spdlog/sinks/base_sink.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <thread>
 #include <vector>
 
 namespace hapsim {
 namespace {
 
-// A device that logs every write with its time (the loop serialises writes; the index is atomic
-// anyway) and can be told to stop answering: report itself unhealthy, or hang inside read().
+// A device that logs every write with its time and whether the haptic thread made it (the thread
+// of the first read(): only the haptic thread reads; every other write is the supervisor's, or the
+// final zero of wait()). The loop serialises writes; the index is atomic anyway. It can be told to
+// report itself unhealthy, or to hang inside read() until something happened (e.g. the supervisor
+// wrote a zero), and can call a hook on every write that is not the haptic thread's.
 class LoggingDevice final : public Device {
  public:
   struct Write {
     std::int64_t t_ns = 0;
     double force_n = 0.0;
     bool finite = true;
+    bool haptic = false;
+    /// For a haptic write: when its cycle read the device (before that cycle's heartbeat).
+    std::int64_t cycle_read_ns = 0;
   };
 
   explicit LoggingDevice(DeviceProfile profile) : profile_(std::move(profile)) {
@@ -39,9 +50,18 @@ class LoggingDevice final : public Device {
 
   DeviceInput read(double time_s) noexcept override {
     const std::uint64_t n = reads_.fetch_add(1);
+    if (n == 0) {
+      haptic_thread_ = std::this_thread::get_id();
+      haptic_known_.store(true, std::memory_order_release);
+    }
+    last_read_ns_ = monotonic_ns();
     if (hang_at_read_ >= 0 && n == static_cast<std::uint64_t>(hang_at_read_)) {
       hang_started_ns_.store(monotonic_ns());
-      std::this_thread::sleep_for(std::chrono::milliseconds(hang_ms_));
+      if (hang_until_) {
+        hold_until(hang_until_);
+      } else {
+        std::this_thread::sleep_for(std::chrono::milliseconds(hang_ms_));
+      }
     }
     DeviceInput in;
     in.time_s = time_s;
@@ -50,10 +70,20 @@ class LoggingDevice final : public Device {
     return in;
   }
   void write(const DeviceCommand& command) noexcept override {
+    const bool haptic = haptic_known_.load(std::memory_order_acquire) &&
+                        std::this_thread::get_id() == haptic_thread_;
+    const double f = command.force_world_n.norm();
     const std::size_t i = count_.fetch_add(1);
     if (i < writes_.size()) {
-      const double f = command.force_world_n.norm();
-      writes_[i] = {monotonic_ns(), f, std::isfinite(f)};
+      writes_[i] = {monotonic_ns(), f, std::isfinite(f), haptic, haptic ? last_read_ns_ : 0};
+    }
+    if (!haptic) {
+      if (f == 0.0) {
+        other_zero_seen_.store(true, std::memory_order_release);
+      }
+      if (on_other_write_) {
+        on_other_write_(f);
+      }
     }
   }
   const DeviceProfile& profile() const noexcept override { return profile_; }
@@ -63,11 +93,32 @@ class LoggingDevice final : public Device {
     hang_at_read_ = read_index;
     hang_ms_ = ms;
   }
+  /// read() number `read_index` hangs until `until` holds (at most 10 s: a bound on a hang).
+  void hang_at(int read_index, std::function<bool()> until) {
+    hang_at_read_ = read_index;
+    hang_until_ = std::move(until);
+  }
   void unhealthy_from(int read_index) { unhealthy_from_read_ = read_index; }
+  /// Called (on the writing thread, inside write()) for every write not made by the haptic thread.
+  void on_other_write(std::function<void(double force_n)> hook) {
+    on_other_write_ = std::move(hook);
+  }
+  /// A zero was written by a thread other than the haptic one (the supervisor's ramp ended).
+  [[nodiscard]] bool other_zero_seen() const {
+    return other_zero_seen_.load(std::memory_order_acquire);
+  }
   [[nodiscard]] std::int64_t hang_started_ns() const { return hang_started_ns_.load(); }
   [[nodiscard]] std::vector<Write> writes() const {
     return {writes_.begin(),
             writes_.begin() + static_cast<std::ptrdiff_t>(std::min(count_.load(), writes_.size()))};
+  }
+
+  /// Waits until `until` holds, at most 10 s (only a bound on a hang: tests assert on events).
+  static void hold_until(const std::function<bool()>& until) {
+    const std::int64_t give_up_ns = monotonic_ns() + 10'000'000'000;
+    while (!until() && monotonic_ns() < give_up_ns) {
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
   }
 
  private:
@@ -75,17 +126,26 @@ class LoggingDevice final : public Device {
   std::vector<Write> writes_;
   std::atomic<std::size_t> count_{0};
   std::atomic<std::uint64_t> reads_{0};
+  std::thread::id haptic_thread_;
+  std::atomic<bool> haptic_known_{false};
+  std::int64_t last_read_ns_ = 0;  // haptic thread only
   int hang_at_read_ = -1;
   int hang_ms_ = 0;
+  std::function<bool()> hang_until_;
   std::atomic<std::int64_t> hang_started_ns_{0};
   int unhealthy_from_read_ = -1;
+  std::atomic<bool> other_zero_seen_{false};
+  std::function<void(double)> on_other_write_;
 };
 
-// A simulation that always asks for the same force, can stall in one step, can return NaN, and
-// counts the haptic thread's allocations from its first to its last step.
+// A simulation that always asks for the same force, can stall in one step (for a time, or until
+// something happened), can return NaN, keeps each cycle's output (what the loop meant to write),
+// and counts the haptic thread's allocations from its first to its last step.
 class ConstantForceClient final : public HapticClient {
  public:
-  explicit ConstantForceClient(Vec3 force_n) { command_.force_world_n = force_n; }
+  explicit ConstantForceClient(Vec3 force_n) : outputs_(kKeptOutputs, -1.0) {
+    command_.force_world_n = force_n;
+  }
 
   const DeviceCommand& step(const DeviceInput& /*input*/, double /*dt_s*/) override {
     const std::uint64_t n = steps_++;
@@ -94,8 +154,12 @@ class ConstantForceClient final : public HapticClient {
     }
     allocations_at_last_ = test::thread_allocation_count();
     if (stall_at_ >= 0 && n == static_cast<std::uint64_t>(stall_at_)) {
-      stall_started_ns_ = monotonic_ns();
-      std::this_thread::sleep_for(std::chrono::milliseconds(stall_ms_));
+      stall_started_ns_.store(monotonic_ns(), std::memory_order_release);
+      if (stall_until_) {
+        LoggingDevice::hold_until(stall_until_);
+      } else {
+        std::this_thread::sleep_for(std::chrono::milliseconds(stall_ms_));
+      }
     }
     if (nan_at_ >= 0 && n == static_cast<std::uint64_t>(nan_at_)) {
       nan_command_ = command_;
@@ -104,7 +168,13 @@ class ConstantForceClient final : public HapticClient {
     }
     return command_;
   }
-  void after_cycle(const HapticCycle& cycle) noexcept override { last_cost_us_ = cycle.cost_us; }
+  void after_cycle(const HapticCycle& cycle) noexcept override {
+    last_cost_us_ = cycle.cost_us;
+    if (cycle.index < outputs_.size()) {
+      outputs_[cycle.index] = cycle.output->force_world_n.norm();
+    }
+    cycles_done_.store(cycle.index + 1, std::memory_order_release);
+  }
   bool take_soft_start() noexcept override {
     return soft_at_ >= 0 && steps_ == static_cast<std::uint64_t>(soft_at_) + 1;
   }
@@ -114,22 +184,40 @@ class ConstantForceClient final : public HapticClient {
     stall_at_ = step;
     stall_ms_ = ms;
   }
+  /// Step `step` stalls until `until` holds (at most 10 s).
+  void stall_at(int step, std::function<bool()> until) {
+    stall_at_ = step;
+    stall_until_ = std::move(until);
+  }
   void nan_at(int step) { nan_at_ = step; }
-  /// When the injected stall began (read after the loop stopped).
-  [[nodiscard]] std::int64_t stall_started_ns() const { return stall_started_ns_; }
+  /// When the injected stall began (0 before it did).
+  [[nodiscard]] std::int64_t stall_started_ns() const {
+    return stall_started_ns_.load(std::memory_order_acquire);
+  }
+  /// Waits (at most 10 s) until cycle `index` has finished; false if it did not.
+  [[nodiscard]] bool wait_for_cycle(std::uint64_t index) const {
+    LoggingDevice::hold_until([&] { return cycles_done_.load(std::memory_order_acquire) > index; });
+    return cycles_done_.load(std::memory_order_acquire) > index;
+  }
+  /// What cycle `index` meant to write (its output after safety, ramp and resume), N.
+  [[nodiscard]] double output_n(std::uint64_t index) const { return outputs_.at(index); }
   [[nodiscard]] long allocations_during_run() const {
     return allocations_at_last_ - allocations_at_start_;
   }
 
  private:
+  static constexpr std::size_t kKeptOutputs = 4096;
   DeviceCommand command_;
   DeviceCommand nan_command_;
   std::uint64_t steps_ = 0;
   int stall_at_ = -1;
   int stall_ms_ = 0;
+  std::function<bool()> stall_until_;
   int nan_at_ = -1;
   int soft_at_ = -1;
-  std::int64_t stall_started_ns_ = 0;
+  std::atomic<std::int64_t> stall_started_ns_{0};
+  std::vector<double> outputs_;
+  std::atomic<std::uint64_t> cycles_done_{0};
   long allocations_at_start_ = 0;
   long allocations_at_last_ = 0;
   double last_cost_us_ = 0.0;
@@ -290,6 +378,105 @@ TEST(HapticLoop, DeviceThatHangsInReadIsRampedBySupervisor) {
   ASSERT_LT(first_zero, w.size() - 1) << "the force never reached zero during a 50 ms hang";
   expect_under_ramp_profile(w, f0, first_low, options.ramp, w[good].t_ns, first_zero + 1);
   EXPECT_GE(loop.status().stall_events, 1u);
+}
+
+// The supervisor's ramp is a ceiling for the haptic thread as well: once the device has seen the
+// supervisor's lowered force, the cycle that resumes after the stall must not write more than that
+// (full force right after ~0 is the kick the ramp exists to prevent). The stalled cycle is let go
+// while the supervisor's first write is still inside the device, so it resumes in the window
+// between that write and whatever the supervisor does after it.
+TEST(HapticLoop, SupervisorLowersTheCeilingBeforeTheDeviceSeesItsRamp) {
+  LoggingDevice device(device_profile("omega3"));
+  const double f0 = 4.0;
+  ConstantForceClient client(Vec3(f0, 0, 0));
+  constexpr std::uint64_t kStalled = 200;
+  std::atomic<bool> release{false};
+  client.stall_at(static_cast<int>(kStalled), [&] { return release.load(); });
+  double supervisor_n = -1.0;  // the supervisor's first write during the stall
+  bool resumed = false;
+  device.on_other_write([&](double force_n) {
+    if (client.stall_started_ns() == 0 || release.load()) {
+      return;  // a hiccup of this VM before the injected stall, or the final zero
+    }
+    supervisor_n = force_n;
+    release.store(true);
+    resumed = client.wait_for_cycle(kStalled);
+  });
+  HapticLoop loop(device, client, stall_options(kStalled + 100));
+  loop.start();
+  loop.wait();
+  ASSERT_GE(supervisor_n, 0.0) << "the supervisor never wrote during the stall";
+  ASSERT_TRUE(resumed) << "the stalled cycle never finished";
+  // The supervisor scaled the haptic thread's last write before the stall by its gain.
+  const auto w = device.writes();
+  double base_n = -1.0;
+  for (const auto& write : w) {
+    if (write.haptic && write.t_ns < client.stall_started_ns()) {
+      base_n = write.force_n;
+    }
+  }
+  ASSERT_GT(base_n, 0.0);
+  EXPECT_LT(supervisor_n, base_n) << "the supervisor's write was not a ramp";
+  const double gain = supervisor_n / base_n;
+  EXPECT_LE(client.output_n(kStalled), f0 * gain + 1e-9)
+      << "the cycle after the stall meant to write " << client.output_n(kStalled)
+      << " N right after the device saw " << supervisor_n << " N";
+}
+
+// A log sink that holds the thread logging a warning (stderr into a full pipe) while `armed` and
+// until it is opened; at most 10 s (then it notes that it gave up).
+class BlockingSink final : public spdlog::sinks::base_sink<std::mutex> {
+ public:
+  explicit BlockingSink(std::function<bool()> armed) : armed_(std::move(armed)) {}
+  void open() { open_.store(true); }
+  [[nodiscard]] bool gave_up() const { return gave_up_.load(); }
+
+ protected:
+  void sink_it_(const spdlog::details::log_msg& msg) override {
+    if (msg.level >= spdlog::level::warn && armed_()) {
+      LoggingDevice::hold_until([this] { return open_.load(); });
+      gave_up_.store(!open_.load());
+    }
+  }
+  void flush_() override {}
+
+ private:
+  std::function<bool()> armed_;
+  std::atomic<bool> open_{false};
+  std::atomic<bool> gave_up_{false};
+};
+
+// The supervisor protects the device first and tells people after: a warning that cannot get out
+// (stderr blocked) must not keep the force on the device.
+TEST(HapticLoop, SupervisorWritesBeforeItLogs) {
+  LoggingDevice device(device_profile("omega3"));
+  const double f0 = 4.0;
+  ConstantForceClient client(Vec3(0, 0, f0));
+  constexpr int kStalled = 200;
+  std::atomic<bool> release{false};
+  client.stall_at(kStalled, [&] { return release.load(); });
+  // Warnings block from the injected stall on (a hiccup of this VM before it may log freely).
+  auto sink = std::make_shared<BlockingSink>([&] { return client.stall_started_ns() != 0; });
+  double supervisor_n = -1.0;
+  device.on_other_write([&](double force_n) {
+    if (client.stall_started_ns() == 0 || release.load()) {
+      return;
+    }
+    supervisor_n = force_n;
+    sink->open();  // only a write during the stall lets the log go
+    release.store(true);
+  });
+  const auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("blocked stderr", sink));
+  {
+    HapticLoop loop(device, client, stall_options(kStalled + 100));
+    loop.start();
+    loop.wait();
+  }
+  spdlog::set_default_logger(previous);
+  EXPECT_FALSE(sink->gave_up()) << "the supervisor waited for its log before writing";
+  ASSERT_GE(supervisor_n, 0.0) << "the supervisor never wrote during the stall";
+  EXPECT_LT(supervisor_n, f0);
 }
 
 TEST(HapticLoop, DeviceReportingItselfUnhealthyRampsToZeroAndStays) {
