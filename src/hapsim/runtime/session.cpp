@@ -170,7 +170,7 @@ class SessionAccountant {
       account_teleop(r.teleop);
     }
     if (options_.recorder != nullptr) {
-      if (!options_.recorder->record(to_recorded_frame(r))) {
+      if (!options_.recorder->record(to_recorded_frame(r, profile_))) {
         ++summary_.recording_dropped_frames;
       } else {
         ++summary_.recorded_frames;

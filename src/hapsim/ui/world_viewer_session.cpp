@@ -171,7 +171,7 @@ class WorldViewerSession final : public ViewerSession {
     SpscRing<CycleRecord>& records = *client_->records();
     while (const CycleRecord* r = records.front()) {
       if (recorder_) {
-        if (!recorder_->record(to_recorded_frame(*r))) {
+        if (!recorder_->record(to_recorded_frame(*r, device_->profile()))) {
           ++recorded_dropped_;
         }
         if (recorder_->frames_buffered() >= recorder_->capacity_frames() / 2) {
