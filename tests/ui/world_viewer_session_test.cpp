@@ -17,7 +17,9 @@
 
 #include <unistd.h>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
+#include <functional>
 #include <thread>
 
 namespace hapsim {
@@ -51,13 +53,26 @@ SceneDescription soft_sphere_scene() {
   return scene;
 }
 
-void run_for(ViewerSession& session, double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) {
+// Calls session.update() (as the viewer's frame loop does) until `holds` is true. The test asserts
+// on the condition; the 10 s limit only bounds a hang (a busy machine may take any time).
+[[nodiscard]] bool eventually(ViewerSession& session, const std::function<bool()>& holds) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (true) {
     session.update();
-    std::this_thread::sleep_for(std::chrono::milliseconds(16));
+    if (holds()) {
+      return true;
+    }
+    if (std::chrono::steady_clock::now() > give_up) {
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
-  session.update();
+}
+
+// The readout's force on the one tool (0 before the first snapshot arrived).
+double readout_force_n(const ViewerSession& session) {
+  const auto& tools = session.readout().tools;
+  return tools.empty() ? 0.0 : tools[0].force_n;
 }
 
 TEST(WorldViewerSession, MouseProbeForceFollowsHookeAndLiveStiffness) {
@@ -71,24 +86,33 @@ TEST(WorldViewerSession, MouseProbeForceFollowsHookeAndLiveStiffness) {
   DeviceInput in;
   in.p_world = Vec3(0.0, 0.0, 0.026);
   mouse->set_input(in);
-  run_for(*session, 0.3);
+  // After more than 200 cycles the force settles at Hooke's k·x, in the readout and on the device.
+  const auto settles_at = [&](double force_n, double tolerance_n) {
+    const std::uint64_t from = session->loop_status().cycles;
+    return [&session, mouse, from, force_n, tolerance_n] {
+      return session->loop_status().cycles > from + 200 &&
+             std::abs(readout_force_n(*session) - force_n) <= tolerance_n &&
+             std::abs(mouse->last_command().force_world_n.z() - force_n) <= tolerance_n;
+    };
+  };
+  EXPECT_TRUE(eventually(*session, settles_at(300.0 * 0.004, 0.02)))  // pushes up
+      << "readout " << readout_force_n(*session) << " N, device "
+      << mouse->last_command().force_world_n.transpose() << " N after "
+      << session->loop_status().cycles << " cycles";
   ASSERT_EQ(session->readout().tools.size(), 1u);
-  EXPECT_NEAR(session->readout().tools[0].force_n, 300.0 * 0.004, 0.02);
-  EXPECT_NEAR(mouse->last_command().force_world_n.z(), 300.0 * 0.004, 0.02);  // pushes up
-  EXPECT_GT(session->loop_status().cycles, 200u);
   // The control area's stiffness change reaches the haptic thread: twice as stiff, twice the
   // force at the same depth.
   ContactMaterial stiffer = soft_sphere_scene().world.materials[0].contact;
   stiffer.stiffness_n_per_m = 600.0;
   ASSERT_TRUE(session->set_material_contact(0, stiffer));
-  run_for(*session, 0.2);
-  EXPECT_NEAR(session->readout().tools[0].force_n, 600.0 * 0.004, 0.04);
+  EXPECT_TRUE(eventually(*session, settles_at(600.0 * 0.004, 0.04)))
+      << "readout " << readout_force_n(*session) << " N";
   EXPECT_FALSE(session->set_material_contact(7, stiffer));  // no such material
   // Out of the sphere: no force.
   in.p_world = Vec3(0.0, 0.0, 0.05);
   mouse->set_input(in);
-  run_for(*session, 0.1);
-  EXPECT_EQ(session->readout().tools[0].force_n, 0.0);
+  EXPECT_TRUE(eventually(*session, settles_at(0.0, 0.0)))
+      << "readout " << readout_force_n(*session) << " N";
 }
 
 TEST(WorldViewerSession, RecordingWritesEveryCycleWithTheWorldsHash) {
@@ -101,7 +125,8 @@ TEST(WorldViewerSession, RecordingWritesEveryCycleWithTheWorldsHash) {
   std::string error;
   ASSERT_TRUE(session->set_recording(&path, error)) << error;
   EXPECT_TRUE(session->recording());
-  run_for(*session, 0.5);
+  // The recording restarted the loop at cycle 0: record until well over 300 cycles.
+  EXPECT_TRUE(eventually(*session, [&] { return session->loop_status().cycles > 400; }));
   ASSERT_TRUE(session->set_recording(nullptr, error));
   EXPECT_FALSE(session->recording());
   const Recording r = read_recording(path);
