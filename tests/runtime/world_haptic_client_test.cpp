@@ -222,6 +222,39 @@ TEST(WorldHapticClient, ResumingAfterAPauseHasNoDampingSpikeAndAsksForASoftStart
   EXPECT_NEAR(f, 1.5, 0.1);
 }
 
+// Records are numbered by the cycles that stepped the world, not by the loop's cycle index: a
+// pause in the middle of a run (cycles that step nothing and record nothing) leaves no gap, so a
+// recording across it replays frame for frame (a replay numbers its frames 0, 1, 2, ...).
+TEST(WorldHapticClient, RecordsAreNumberedByTheCyclesThatStepped) {
+  World world(test::two_body_world());
+  WorldHapticClientOptions co;
+  co.publish_snapshots = false;
+  co.record_capacity = 256;
+  WorldHapticClient client(world, co);
+  std::uint64_t stepped = 0;
+  for (std::uint64_t i = 0; i < 150; ++i) {  // the loop's cycles
+    client.set_paused(i >= 50 && i < 80);
+    const DeviceInput in = press_ball(0.001 * static_cast<double>(stepped));
+    const DeviceCommand out = client.step(in, 0.001);
+    HapticCycle cycle;
+    cycle.index = i;
+    cycle.time_s = 0.001 * static_cast<double>(i);
+    cycle.input = &in;
+    cycle.output = &out;
+    client.after_cycle(cycle);
+    stepped += client.paused() ? 0 : 1;
+  }
+  ASSERT_EQ(stepped, 120u);
+  std::uint64_t expected = 0;
+  while (const CycleRecord* r = client.records()->front()) {
+    EXPECT_EQ(r->cycle, expected) << "the record after " << expected << " stepped cycle(s)";
+    EXPECT_EQ(r->input.time_s, 0.001 * static_cast<double>(expected));
+    client.records()->pop();
+    ++expected;
+  }
+  EXPECT_EQ(expected, 120u);
+}
+
 TEST(WorldHapticClient, ResetAndPauseReachTheSnapshot) {
   World world(test::two_body_world());
   SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);

@@ -146,6 +146,82 @@ TEST(WorldViewerSession, RecordingWritesEveryCycleWithTheWorldsHash) {
   EXPECT_NE(error.find("/nonexistent/dir/x.rec"), std::string::npos) << error;
 }
 
+// The mouse probe 4 mm into the sphere's top: the recordings below hold a force, not zeros.
+InteractiveDevice& press_into_the_sphere(ViewerSession& session) {
+  InteractiveDevice* mouse = session.mouse_device();
+  EXPECT_NE(mouse, nullptr);
+  DeviceInput in;
+  in.p_world = Vec3(0.0, 0.0, 0.026);
+  mouse->set_input(in);
+  return *mouse;
+}
+
+// Every frame of a recording, numbered 0, 1, 2, ... (none missing, none from before it began).
+void expect_numbered_from_zero(const Recording& r) {
+  ASSERT_FALSE(r.frames.empty());
+  for (std::size_t i = 0; i < r.frames.size(); ++i) {
+    ASSERT_EQ(r.frames[i].cycle_index, i);
+  }
+}
+
+// Pausing ends a recording, as a reset does: after a pause the world forgets the tool's motion
+// and the force comes back softly, which no replay of one continuous run does. The file up to the
+// pause replays bit for bit, and resuming does not add to it.
+TEST(WorldViewerSession, PausingEndsTheRecordingWhichReplaysUpToThePause) {
+  ViewerConfig config;
+  config.scene = "soft_sphere.json";
+  const auto session = make_world_viewer_session(config, soft_sphere_scene());
+  InteractiveDevice& mouse = press_into_the_sphere(*session);
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("hapsim_view_pause_" + std::to_string(::getpid()) + ".rec");
+  std::string error;
+  ASSERT_TRUE(session->set_recording(&path, error)) << error;
+  EXPECT_TRUE(eventually(*session, [&] {
+    return session->loop_status().cycles > 300 && mouse.last_command().force_world_n.z() > 1.0;
+  }));
+  session->set_paused(true);
+  EXPECT_FALSE(session->recording()) << "the recording went on through the pause";
+  session->set_paused(false);
+  const std::uint64_t resumed = session->loop_status().cycles;
+  EXPECT_TRUE(eventually(*session, [&] { return session->loop_status().cycles > resumed + 300; }));
+  (void)session->set_recording(nullptr, error);
+  const Recording r = read_recording(path);
+  expect_numbered_from_zero(r);
+  EXPECT_LE(r.frames.size(), resumed + 1);                    // nothing after the pause
+  EXPECT_GT(r.frames.back().command.force_world_n.z(), 1.0);  // it recorded the press
+  EXPECT_TRUE(test::replays_bit_for_bit(soft_sphere_scene(), path));
+  std::filesystem::remove(path);
+}
+
+// A recording started while paused begins with the first cycle that steps the world, as frame 0,
+// and replays bit for bit (the paused cycles before it recorded nothing, and the soft start of the
+// force on resuming is not in the recorded command).
+TEST(WorldViewerSession, RecordingStartedWhilePausedBeginsAtTheFirstStep) {
+  ViewerConfig config;
+  config.scene = "soft_sphere.json";
+  const auto session = make_world_viewer_session(config, soft_sphere_scene());
+  InteractiveDevice& mouse = press_into_the_sphere(*session);
+  session->set_paused(true);
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("hapsim_view_paused_" + std::to_string(::getpid()) + ".rec");
+  std::string error;
+  ASSERT_TRUE(session->set_recording(&path, error)) << error;
+  EXPECT_TRUE(eventually(*session, [&] { return session->loop_status().cycles > 100; }));
+  EXPECT_TRUE(session->recording());
+  session->set_paused(false);
+  const std::uint64_t resumed = session->loop_status().cycles;
+  EXPECT_TRUE(eventually(*session, [&] {
+    return session->loop_status().cycles > resumed + 300 &&
+           mouse.last_command().force_world_n.z() > 1.0;
+  }));
+  ASSERT_TRUE(session->set_recording(nullptr, error));
+  const Recording r = read_recording(path);
+  expect_numbered_from_zero(r);
+  EXPECT_GT(r.frames.size(), 300u);
+  EXPECT_TRUE(test::replays_bit_for_bit(soft_sphere_scene(), path));
+  std::filesystem::remove(path);
+}
+
 TEST(WorldViewerSession, UnknownDeviceAndMissing3dMouseAreClearErrors) {
   ViewerConfig config;
   config.scene = "soft_sphere.json";
