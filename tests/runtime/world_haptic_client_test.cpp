@@ -4,22 +4,26 @@
 // nothing with a real World, and a real-time session reports the same contacts as an inline one.
 #include "hapsim/runtime/world_haptic_client.h"
 
-#include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/core/device_profile.h"
+#include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/device/simulated_device.h"
 #include "hapsim/geometry/procedural.h"
+#include "hapsim/runtime/deadline_clock.h"
 #include "hapsim/runtime/session.h"
+#include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
 #include "runtime/two_body_world.h"
 #include "support/allocation_counting_client.h"
+#include "support/replay_check.h"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <thread>
 
 #include <unistd.h>
@@ -35,6 +39,60 @@ DeviceInput press_ball(double t) {
   in.p_world = Vec3(0.2, 0.0, 0.004 - depth);
   return in;
 }
+
+// Wraps a device so that the loop stalls once while the force is on: the first read() from number
+// `from_read` on that follows a haptic write of at least `min_force_n` hangs until the supervisor
+// (a write from a thread other than the one that reads) has ramped the force to zero (10 s at
+// most: only a bound on a hang). The stall is an event, not a time: the supervisor's ramp and the
+// loop's gradual return are in the run however the machine is scheduled.
+class StallingDevice final : public Device {
+ public:
+  StallingDevice(Device& inner, std::uint64_t from_read, double min_force_n)
+      : inner_(inner), from_read_(from_read), min_force_n_(min_force_n) {}
+
+  DeviceInput read(double time_s) noexcept override {
+    const std::uint64_t n = reads_++;
+    if (n == 0) {
+      reader_ = std::this_thread::get_id();
+      reader_known_.store(true, std::memory_order_release);
+    }
+    if (!stalled_.load() && n >= from_read_ && last_haptic_n_ >= min_force_n_) {
+      stalled_.store(true);
+      const std::int64_t give_up_ns = monotonic_ns() + 10'000'000'000;
+      while (!supervisor_zero_.load() && monotonic_ns() < give_up_ns) {
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+      }
+    }
+    return inner_.read(time_s);
+  }
+  void write(const DeviceCommand& command) noexcept override {
+    const bool haptic =
+        reader_known_.load(std::memory_order_acquire) && std::this_thread::get_id() == reader_;
+    const double f = command.force_world_n.norm();
+    if (haptic) {
+      last_haptic_n_ = f;
+    } else if (stalled_.load() && f == 0.0) {
+      supervisor_zero_.store(true);
+    }
+    inner_.write(command);
+  }
+  const DeviceProfile& profile() const noexcept override { return inner_.profile(); }
+  DeviceStatus status() const noexcept override { return inner_.status(); }
+
+  /// The stall happened and the supervisor ramped the force to zero during it.
+  [[nodiscard]] bool stalled_to_zero() const { return supervisor_zero_.load(); }
+
+ private:
+  Device& inner_;
+  std::uint64_t from_read_;
+  double min_force_n_;
+  std::uint64_t reads_ = 0;     // haptic thread only
+  double last_haptic_n_ = 0.0;  // haptic thread only
+  std::thread::id reader_;
+  std::atomic<bool> reader_known_{false};
+  std::atomic<bool> stalled_{false};
+  std::atomic<bool> supervisor_zero_{false};
+};
 
 TEST(WorldHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   World world(test::two_body_world());
@@ -164,6 +222,39 @@ TEST(WorldHapticClient, ResumingAfterAPauseHasNoDampingSpikeAndAsksForASoftStart
   EXPECT_NEAR(f, 1.5, 0.1);
 }
 
+// Records are numbered by the cycles that stepped the world, not by the loop's cycle index: a
+// pause in the middle of a run (cycles that step nothing and record nothing) leaves no gap, so a
+// recording across it replays frame for frame (a replay numbers its frames 0, 1, 2, ...).
+TEST(WorldHapticClient, RecordsAreNumberedByTheCyclesThatStepped) {
+  World world(test::two_body_world());
+  WorldHapticClientOptions co;
+  co.publish_snapshots = false;
+  co.record_capacity = 256;
+  WorldHapticClient client(world, co);
+  std::uint64_t stepped = 0;
+  for (std::uint64_t i = 0; i < 150; ++i) {  // the loop's cycles
+    client.set_paused(i >= 50 && i < 80);
+    const DeviceInput in = press_ball(0.001 * static_cast<double>(stepped));
+    const DeviceCommand out = client.step(in, 0.001);
+    HapticCycle cycle;
+    cycle.index = i;
+    cycle.time_s = 0.001 * static_cast<double>(i);
+    cycle.input = &in;
+    cycle.output = &out;
+    client.after_cycle(cycle);
+    stepped += client.paused() ? 0 : 1;
+  }
+  ASSERT_EQ(stepped, 120u);
+  std::uint64_t expected = 0;
+  while (const CycleRecord* r = client.records()->front()) {
+    EXPECT_EQ(r->cycle, expected) << "the record after " << expected << " stepped cycle(s)";
+    EXPECT_EQ(r->input.time_s, 0.001 * static_cast<double>(expected));
+    client.records()->pop();
+    ++expected;
+  }
+  EXPECT_EQ(expected, 120u);
+}
+
 TEST(WorldHapticClient, ResetAndPauseReachTheSnapshot) {
   World world(test::two_body_world());
   SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);
@@ -227,7 +318,10 @@ TEST(Session, RealtimeRunAccountsTheSameContactsAsAnInlineRun) {
 }
 
 // A real-time run's recording (frames handed off the haptic thread through the ring) replays
-// offline bit for bit: the same inputs give the same world, contacts and commands.
+// offline bit for bit: the same inputs give the same world, contacts and commands — also when the
+// loop stalled mid-press, so that the supervisor ramped the output to zero and it came back over
+// the ramp time (wall-clock safety the offline replay does not redo: the recording holds the
+// world's command clamped to the device, the summary the output).
 TEST(Session, RealtimeRecordingReplaysBitForBitOffline) {
   const DeviceProfile& omega = device_profile("omega3");
   const auto path = std::filesystem::temp_directory_path() /
@@ -237,7 +331,8 @@ TEST(Session, RealtimeRecordingReplaysBitForBitOffline) {
   SessionSummary rt;
   {
     World world(test::two_body_world());
-    SimulatedDevice device(omega, press_ball, 1.0);
+    SimulatedDevice simulated(omega, press_ball, 1.0);
+    StallingDevice device(simulated, 100, 0.2);                 // mid-press
     SessionRecorder recorder(path, world.content_hash(), 256);  // flushed many times meanwhile
     SessionOptions o;
     o.duration_s = 0.6;
@@ -245,8 +340,11 @@ TEST(Session, RealtimeRecordingReplaysBitForBitOffline) {
     o.recorder = &recorder;
     rt = run_session(world, device, o);
     recorder.close();
+    EXPECT_TRUE(device.stalled_to_zero());
   }
   ASSERT_TRUE(rt.realtime.has_value());
+  EXPECT_GE(rt.realtime->stall_events, 1u);
+  EXPECT_GT(rt.realtime->ramp_cycles, 0u);
   EXPECT_EQ(rt.recorded_frames, 600u);
   EXPECT_EQ(rt.recording_dropped_frames, 0u);
   const Recording original = read_recording(path);
@@ -260,11 +358,39 @@ TEST(Session, RealtimeRecordingReplaysBitForBitOffline) {
   (void)run_session(world, replay, o);
   recorder.close();
   const RecordingDifference d = compare_recordings(original, read_recording(again));
-  if (rt.realtime->ramp_cycles == 0) {  // a stall on a loaded machine would scale the output
-    EXPECT_TRUE(d.identical) << d.message;
-  }
+  EXPECT_TRUE(d.identical) << d.message;
   std::filesystem::remove(path);
   std::filesystem::remove(again);
+}
+
+// `hapsim run scenes/knee.json --realtime --record F` then `--replay F`: the shipped scene with its
+// palpation script on the real-time loop, stalled once while the fingertip presses, replays bit for
+// bit the way the command replays it (make_run_setup with the recording, an inline run).
+TEST(Session, RealtimeKneeRecordingReplaysBitForBitAfterAStall) {
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("hapsim_rt_knee_" + std::to_string(::getpid()) + ".rec");
+  RunSetup setup = make_run_setup(scene, DeviceChoice::scene_script());
+  StallingDevice device(*setup.device, 1000, 0.5);  // the first press starts at ~1 s
+  SessionSummary rt;
+  {
+    SessionRecorder recorder(path, setup.world->content_hash(), 8192);
+    SessionOptions o;
+    o.duration_s = 1.5;
+    o.dt_s = setup.scene.run.dt_s;
+    o.realtime = true;
+    o.recorder = &recorder;
+    rt = run_session(*setup.world, device, o);
+    recorder.close();
+  }
+  EXPECT_TRUE(device.stalled_to_zero());
+  ASSERT_TRUE(rt.realtime.has_value());
+  EXPECT_GE(rt.realtime->stall_events, 1u);
+  EXPECT_GT(rt.realtime->ramp_cycles, 0u);
+  EXPECT_EQ(rt.recording_dropped_frames, 0u);
+  EXPECT_TRUE(test::replays_bit_for_bit(scene, path));
+  std::filesystem::remove(path);
 }
 
 }  // namespace

@@ -17,7 +17,9 @@
 
 #include <unistd.h>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
+#include <functional>
 #include <thread>
 
 namespace hapsim {
@@ -51,13 +53,26 @@ SceneDescription soft_sphere_scene() {
   return scene;
 }
 
-void run_for(ViewerSession& session, double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (std::chrono::steady_clock::now() < end) {
+// Calls session.update() (as the viewer's frame loop does) until `holds` is true. The test asserts
+// on the condition; the 10 s limit only bounds a hang (a busy machine may take any time).
+[[nodiscard]] bool eventually(ViewerSession& session, const std::function<bool()>& holds) {
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (true) {
     session.update();
-    std::this_thread::sleep_for(std::chrono::milliseconds(16));
+    if (holds()) {
+      return true;
+    }
+    if (std::chrono::steady_clock::now() > give_up) {
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
-  session.update();
+}
+
+// The readout's force on the one tool (0 before the first snapshot arrived).
+double readout_force_n(const ViewerSession& session) {
+  const auto& tools = session.readout().tools;
+  return tools.empty() ? 0.0 : tools[0].force_n;
 }
 
 TEST(WorldViewerSession, MouseProbeForceFollowsHookeAndLiveStiffness) {
@@ -71,24 +86,33 @@ TEST(WorldViewerSession, MouseProbeForceFollowsHookeAndLiveStiffness) {
   DeviceInput in;
   in.p_world = Vec3(0.0, 0.0, 0.026);
   mouse->set_input(in);
-  run_for(*session, 0.3);
+  // After more than 200 cycles the force settles at Hooke's k·x, in the readout and on the device.
+  const auto settles_at = [&](double force_n, double tolerance_n) {
+    const std::uint64_t from = session->loop_status().cycles;
+    return [&session, mouse, from, force_n, tolerance_n] {
+      return session->loop_status().cycles > from + 200 &&
+             std::abs(readout_force_n(*session) - force_n) <= tolerance_n &&
+             std::abs(mouse->last_command().force_world_n.z() - force_n) <= tolerance_n;
+    };
+  };
+  EXPECT_TRUE(eventually(*session, settles_at(300.0 * 0.004, 0.02)))  // pushes up
+      << "readout " << readout_force_n(*session) << " N, device "
+      << mouse->last_command().force_world_n.transpose() << " N after "
+      << session->loop_status().cycles << " cycles";
   ASSERT_EQ(session->readout().tools.size(), 1u);
-  EXPECT_NEAR(session->readout().tools[0].force_n, 300.0 * 0.004, 0.02);
-  EXPECT_NEAR(mouse->last_command().force_world_n.z(), 300.0 * 0.004, 0.02);  // pushes up
-  EXPECT_GT(session->loop_status().cycles, 200u);
   // The control area's stiffness change reaches the haptic thread: twice as stiff, twice the
   // force at the same depth.
   ContactMaterial stiffer = soft_sphere_scene().world.materials[0].contact;
   stiffer.stiffness_n_per_m = 600.0;
   ASSERT_TRUE(session->set_material_contact(0, stiffer));
-  run_for(*session, 0.2);
-  EXPECT_NEAR(session->readout().tools[0].force_n, 600.0 * 0.004, 0.04);
+  EXPECT_TRUE(eventually(*session, settles_at(600.0 * 0.004, 0.04)))
+      << "readout " << readout_force_n(*session) << " N";
   EXPECT_FALSE(session->set_material_contact(7, stiffer));  // no such material
   // Out of the sphere: no force.
   in.p_world = Vec3(0.0, 0.0, 0.05);
   mouse->set_input(in);
-  run_for(*session, 0.1);
-  EXPECT_EQ(session->readout().tools[0].force_n, 0.0);
+  EXPECT_TRUE(eventually(*session, settles_at(0.0, 0.0)))
+      << "readout " << readout_force_n(*session) << " N";
 }
 
 TEST(WorldViewerSession, RecordingWritesEveryCycleWithTheWorldsHash) {
@@ -101,7 +125,8 @@ TEST(WorldViewerSession, RecordingWritesEveryCycleWithTheWorldsHash) {
   std::string error;
   ASSERT_TRUE(session->set_recording(&path, error)) << error;
   EXPECT_TRUE(session->recording());
-  run_for(*session, 0.5);
+  // The recording restarted the loop at cycle 0: record until well over 300 cycles.
+  EXPECT_TRUE(eventually(*session, [&] { return session->loop_status().cycles > 400; }));
   ASSERT_TRUE(session->set_recording(nullptr, error));
   EXPECT_FALSE(session->recording());
   const Recording r = read_recording(path);
@@ -119,6 +144,82 @@ TEST(WorldViewerSession, RecordingWritesEveryCycleWithTheWorldsHash) {
   const std::filesystem::path bad = "/nonexistent/dir/x.rec";
   EXPECT_FALSE(session->set_recording(&bad, error));
   EXPECT_NE(error.find("/nonexistent/dir/x.rec"), std::string::npos) << error;
+}
+
+// The mouse probe 4 mm into the sphere's top: the recordings below hold a force, not zeros.
+InteractiveDevice& press_into_the_sphere(ViewerSession& session) {
+  InteractiveDevice* mouse = session.mouse_device();
+  EXPECT_NE(mouse, nullptr);
+  DeviceInput in;
+  in.p_world = Vec3(0.0, 0.0, 0.026);
+  mouse->set_input(in);
+  return *mouse;
+}
+
+// Every frame of a recording, numbered 0, 1, 2, ... (none missing, none from before it began).
+void expect_numbered_from_zero(const Recording& r) {
+  ASSERT_FALSE(r.frames.empty());
+  for (std::size_t i = 0; i < r.frames.size(); ++i) {
+    ASSERT_EQ(r.frames[i].cycle_index, i);
+  }
+}
+
+// Pausing ends a recording, as a reset does: after a pause the world forgets the tool's motion
+// and the force comes back softly, which no replay of one continuous run does. The file up to the
+// pause replays bit for bit, and resuming does not add to it.
+TEST(WorldViewerSession, PausingEndsTheRecordingWhichReplaysUpToThePause) {
+  ViewerConfig config;
+  config.scene = "soft_sphere.json";
+  const auto session = make_world_viewer_session(config, soft_sphere_scene());
+  InteractiveDevice& mouse = press_into_the_sphere(*session);
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("hapsim_view_pause_" + std::to_string(::getpid()) + ".rec");
+  std::string error;
+  ASSERT_TRUE(session->set_recording(&path, error)) << error;
+  EXPECT_TRUE(eventually(*session, [&] {
+    return session->loop_status().cycles > 300 && mouse.last_command().force_world_n.z() > 1.0;
+  }));
+  session->set_paused(true);
+  EXPECT_FALSE(session->recording()) << "the recording went on through the pause";
+  session->set_paused(false);
+  const std::uint64_t resumed = session->loop_status().cycles;
+  EXPECT_TRUE(eventually(*session, [&] { return session->loop_status().cycles > resumed + 300; }));
+  (void)session->set_recording(nullptr, error);
+  const Recording r = read_recording(path);
+  expect_numbered_from_zero(r);
+  EXPECT_LE(r.frames.size(), resumed + 1);                    // nothing after the pause
+  EXPECT_GT(r.frames.back().command.force_world_n.z(), 1.0);  // it recorded the press
+  EXPECT_TRUE(test::replays_bit_for_bit(soft_sphere_scene(), path));
+  std::filesystem::remove(path);
+}
+
+// A recording started while paused begins with the first cycle that steps the world, as frame 0,
+// and replays bit for bit (the paused cycles before it recorded nothing, and the soft start of the
+// force on resuming is not in the recorded command).
+TEST(WorldViewerSession, RecordingStartedWhilePausedBeginsAtTheFirstStep) {
+  ViewerConfig config;
+  config.scene = "soft_sphere.json";
+  const auto session = make_world_viewer_session(config, soft_sphere_scene());
+  InteractiveDevice& mouse = press_into_the_sphere(*session);
+  session->set_paused(true);
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("hapsim_view_paused_" + std::to_string(::getpid()) + ".rec");
+  std::string error;
+  ASSERT_TRUE(session->set_recording(&path, error)) << error;
+  EXPECT_TRUE(eventually(*session, [&] { return session->loop_status().cycles > 100; }));
+  EXPECT_TRUE(session->recording());
+  session->set_paused(false);
+  const std::uint64_t resumed = session->loop_status().cycles;
+  EXPECT_TRUE(eventually(*session, [&] {
+    return session->loop_status().cycles > resumed + 300 &&
+           mouse.last_command().force_world_n.z() > 1.0;
+  }));
+  ASSERT_TRUE(session->set_recording(nullptr, error));
+  const Recording r = read_recording(path);
+  expect_numbered_from_zero(r);
+  EXPECT_GT(r.frames.size(), 300u);
+  EXPECT_TRUE(test::replays_bit_for_bit(soft_sphere_scene(), path));
+  std::filesystem::remove(path);
 }
 
 TEST(WorldViewerSession, UnknownDeviceAndMissing3dMouseAreClearErrors) {

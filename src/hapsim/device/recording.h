@@ -1,5 +1,6 @@
-// Session recording: every haptic cycle's device input, the command sent and the contacts, to a
-// versioned binary file that replays bit-for-bit (docs/recording-format.md).
+// Session recording: every haptic cycle's device input, the command (the world's, clamped to the
+// device: the deterministic part of the safety layer, not a real-time loop's wall-clock ramps) and
+// the contacts, to a versioned binary file that replays bit-for-bit (docs/recording-format.md).
 //
 // Real-time trade-off (this issue): record() copies the frame into a vector reserved at
 // construction, so the haptic path never allocates or touches the disk; flush() encodes and
@@ -47,6 +48,7 @@ struct RecordedContact {
 struct RecordedFrame {
   std::uint64_t cycle_index = 0;
   DeviceInput input;
+  /// The world's command clamped to the device's profile (to_recorded_frame, cycle_record.h).
   DeviceCommand command;
   std::int32_t contact_count = 0;
   std::array<RecordedContact, kMaxRecordedContacts> contacts{};

@@ -1,5 +1,7 @@
 #include "hapsim/runtime/cycle_record.h"
 
+#include "hapsim/device/force_safety.h"
+
 #include <algorithm>
 
 namespace hapsim {
@@ -47,11 +49,11 @@ void fill_cycle_record(CycleRecord& record, std::uint64_t cycle, const DeviceInp
   record.cost_us = cost_us;
 }
 
-RecordedFrame to_recorded_frame(const CycleRecord& record) noexcept {
+RecordedFrame to_recorded_frame(const CycleRecord& record, const DeviceProfile& profile) noexcept {
   RecordedFrame frame;
   frame.cycle_index = record.cycle;
   frame.input = record.input;
-  frame.command = record.output;
+  frame.command = clamp_command(record.world_command, profile);
   const int n = std::min(record.contact_count, kMaxRecordedContacts);
   frame.contact_count = n;
   for (int i = 0; i < n; ++i) {

@@ -23,7 +23,8 @@ struct CycleRecord {
   DeviceInput input;
   /// The world's command, before the safety layer.
   DeviceCommand world_command;
-  /// What was written to the device (after clamp and ramp).
+  /// What was written to the device (after clamp and ramp): the run's figures. Not recorded: the
+  /// real-time loop's stall and resume ramps depend on wall-clock time, which a replay cannot redo.
   DeviceCommand output;
   std::array<ToolState, kMaxCycleTools> tools{};
   std::int32_t tool_count = 0;
@@ -52,7 +53,11 @@ void fill_cycle_record(CycleRecord& record, std::uint64_t cycle, const DeviceInp
                        const StepResult& result, const DeviceCommand& output,
                        double cost_us) noexcept;
 
-/// The recorder's frame of a cycle (its first kMaxRecordedContacts contacts).
-[[nodiscard]] RecordedFrame to_recorded_frame(const CycleRecord& record) noexcept;
+/// The recorder's frame of a cycle (its first kMaxRecordedContacts contacts). Its command is the
+/// deterministic part of the safety layer, the world's command clamped to `profile`
+/// (clamp_command): what a replay recomputes from the recorded inputs, whatever the loop's ramps
+/// did to the output at the time (they depend on wall-clock time; CycleRecord::output has them).
+[[nodiscard]] RecordedFrame to_recorded_frame(const CycleRecord& record,
+                                              const DeviceProfile& profile) noexcept;
 
 }  // namespace hapsim

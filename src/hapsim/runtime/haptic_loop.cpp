@@ -34,7 +34,9 @@ struct HapticLoop::Shared {
   std::atomic<std::int64_t> start_ns{0};
   std::atomic<std::int64_t> end_ns{0};
   std::atomic<std::int64_t> heartbeat_ns{0};  // end of the last completed cycle
-  std::atomic<double> supervisor_gain{1.0};   // lowest gain the supervisor wrote, unseen
+  // Ceiling on the haptic thread's output: the lowest gain the supervisor wrote (lowered before
+  // each write), until the haptic thread takes it.
+  std::atomic<double> supervisor_gain{1.0};
   std::atomic<bool> device_healthy{true};
   std::atomic<bool> realtime_priority{false};
   std::atomic<std::uint64_t> cycles{0};
@@ -54,6 +56,13 @@ double command_magnitude_n(const DeviceCommand& c) {
     m = std::max(m, c.finger_force_n[static_cast<std::size_t>(f)]);
   }
   return m;
+}
+
+// Lowers `gain` to `to` unless it is lower already (the haptic thread may reset it at any time).
+void lower_gain(std::atomic<double>& gain, double to) noexcept {
+  double current = gain.load();
+  while (to < current && !gain.compare_exchange_weak(current, to)) {
+  }
 }
 
 // Single-writer counter increment (no read-modify-write needed with one writer).
@@ -258,7 +267,20 @@ void HapticLoop::supervisor_thread_main() noexcept {
     const bool started = s.cycles.load(std::memory_order_acquire) > 0;
     if (started && since_s > options_.ramp.stale_timeout_s &&
         running_.load(std::memory_order_acquire)) {
+      if (s.last_written.update()) {
+        base = s.last_written.read_slot();
+      }
+      // Evaluated one supervisor period ahead, so zero is reached by zero_by_s() at the latest.
+      const double gain = ramp_gain(since_s + options_.supervisor_period_s, true, options_.ramp);
+      // The ceiling first, then the write: a haptic cycle resuming at any point after the device
+      // sees the lowered force already finds the lowered ceiling (published after the write, a
+      // cycle resuming in between would write full force right after the device saw ~0). If the
+      // write does not happen (the haptic thread is writing: it has resumed), the ceiling only
+      // makes its force come back over the ramp time.
+      lower_gain(s.supervisor_gain, gain);
+      (void)try_write(scaled_command(base, gain));
       if (!stalled) {
+        // Logged after the protective write: a blocked stderr must not keep the force on.
         stalled = true;
         stall_start_ns = heartbeat;
         bump(s.stall_events);
@@ -269,14 +291,6 @@ void HapticLoop::supervisor_thread_main() noexcept {
               since_s * 1e3, options_.ramp.zero_by_s() * 1e3);
         } catch (...) {
         }
-      }
-      if (s.last_written.update()) {
-        base = s.last_written.read_slot();
-      }
-      // Evaluated one supervisor period ahead, so zero is reached by zero_by_s() at the latest.
-      const double gain = ramp_gain(since_s + options_.supervisor_period_s, true, options_.ramp);
-      if (try_write(scaled_command(base, gain))) {
-        s.supervisor_gain.store(std::min(gain, s.supervisor_gain.load()));
       }
     } else if (stalled && since_s <= options_.ramp.stale_timeout_s) {
       stalled = false;

@@ -200,7 +200,7 @@ class SessionAccountant {
       sheet.final_depth_m = r.sheet_depth_m[i];
     }
     if (options_.recorder != nullptr) {
-      if (!options_.recorder->record(to_recorded_frame(r))) {
+      if (!options_.recorder->record(to_recorded_frame(r, profile_))) {
         ++summary_.recording_dropped_frames;
       } else {
         ++summary_.recorded_frames;

@@ -108,11 +108,11 @@ void WorldHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
   if (snapshots_) {
     publish_snapshot(cycle);
   }
-  // Records of stepped cycles only: a paused cycle changed nothing (a recording of a session with
-  // pauses replays the steps it took).
+  // Records of stepped cycles only, numbered by them (a paused cycle changed nothing: a replay
+  // numbers the steps it takes 0, 1, 2, ...).
   if (records_ && stepped_ && last_result_ != nullptr) {
-    fill_cycle_record(scratch_record_, cycle.index, *cycle.input, *last_result_, *cycle.output,
-                      cycle.cost_us);
+    fill_cycle_record(scratch_record_, recorded_cycles_++, *cycle.input, *last_result_,
+                      *cycle.output, cycle.cost_us);
     if (!records_->push(scratch_record_)) {
       dropped_records_.store(dropped_records_.load(std::memory_order_relaxed) + 1,
                              std::memory_order_relaxed);

@@ -88,6 +88,8 @@ class WorldHapticClient final : public HapticClient {
   bool stepped_ = false;     // this cycle stepped the world (not paused)
   bool was_paused_ = false;  // haptic thread's view of the last cycle
   bool soft_start_ = false;
+  // Cycles that stepped the world so far: the records' numbering (haptic thread).
+  std::uint64_t recorded_cycles_ = 0;
   DeviceCommand zero_command_;
   std::unique_ptr<TripleBuffer<WorldSnapshot>> snapshots_;
   std::unique_ptr<SpscRing<CycleRecord>> records_;

@@ -171,7 +171,7 @@ class WorldViewerSession final : public ViewerSession {
     SpscRing<CycleRecord>& records = *client_->records();
     while (const CycleRecord* r = records.front()) {
       if (recorder_) {
-        if (!recorder_->record(to_recorded_frame(*r))) {
+        if (!recorder_->record(to_recorded_frame(*r, device_->profile()))) {
           ++recorded_dropped_;
         }
         if (recorder_->frames_buffered() >= recorder_->capacity_frames() / 2) {
@@ -254,8 +254,16 @@ class WorldViewerSession final : public ViewerSession {
     return title_;
   }
   void set_paused(bool paused) override {
+    const bool pausing = paused && !paused_;
     paused_ = paused;
     client_->set_paused(paused);
+    if (pausing && recorder_) {
+      // Cycles after a pause would not replay as one run (the world forgets the tool's motion
+      // when it resumes): the recording ends here, as on a reset.
+      drain_records();
+      recorder_->close();
+      recorder_.reset();
+    }
   }
   // The loop stops, the world goes back to its start (tools, deformation; a rig's slave, ball and
   // sheet) and a new client and loop start at cycle 0 — so a scripted device starts its script
