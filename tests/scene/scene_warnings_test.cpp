@@ -183,6 +183,9 @@ TEST_F(SceneWarningsTest, ATrajectoryThatNeverReachesABodySaysHowFarItStays) {
   // A dynamic body may move into the path: nothing is claimed.
   Json dynamic = scene_with({box});
   dynamic["bodies"][0]["type"] = "dynamic";
+  dynamic["bodies"][0]["mass_kg"] = 0.1;
+  dynamic["bodies"][0]["geometry"] = Json{{"sphere", Json{{"radius_m", 0.02}}}};
+  dynamic["materials"]["hard"]["response"] = "penalty";
   EXPECT_TRUE(make_run_setup(load(dynamic), DeviceChoice::trajectory(far)).scene.warnings.empty());
 }
 
