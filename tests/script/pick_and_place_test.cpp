@@ -111,6 +111,22 @@ TEST(PickAndPlace, Gp7PlacesTheBallOnTheSheet) {
   expect_pick_and_place(std::make_shared<const SerialChain>(load_urdf_chain(urdf, o)));
 }
 
+// A gripper too weak for the ball (friction μ·2·0.5 N = 0.8 N < 1.5 · its 0.98 N weight): the
+// pads close on it at their force limit but friction cannot carry it — no grasp is reported and
+// the ball is not lifted off the floor (held by friction alone, nothing attaches it).
+TEST(PickAndPlace, AWeakGripperLiftsNothing) {
+  TeleopRigDescription d = scene(std::make_shared<const SerialChain>(make_procedural_motoman()));
+  d.gripper.max_force_n = 0.5;
+  PickAndPlaceScript script;
+  script.pick_world = d.ball_start_world;
+  script.place_world = Vec3(0.5, 0.25, 0.05 + d.ball.radius_m);
+  const Outcome o = run(d, script);
+  EXPECT_FALSE(o.grasped);
+  EXPECT_LT(o.ball_lift_m, 0.005);
+  EXPECT_LT(o.ball_final.z(), d.ball.radius_m + 0.001) << "still on the floor";
+  EXPECT_GT(o.peak_grasp_force_n, 0.4) << "the pads did press it";
+}
+
 TEST(PickAndPlace, OutOfReachScriptIsRefused) {
   PickAndPlaceScript script;
   script.place_world = Vec3(3.0, 0.0, 0.0);

@@ -70,7 +70,7 @@ class TeleopScene {
   /// The slave's link meshes (URDF link meshes, or boxes base → joint 0 → … → tip, skipping
   /// links of zero length), in chain order.
   [[nodiscard]] const std::vector<MeshId>& link_meshes() const { return link_mesh_ids_; }
-  /// Pad i (0: tool +y side, 1: −y side, as ParallelGripper::pad_center_world): a box of the
+  /// Pad i (0: tool +y side, 1: −y side, as the rig places its pad bodies): a box of the
   /// gripper's pad half extents whose pose X_world_mesh is the pad centre with the tool's
   /// orientation.
   [[nodiscard]] MeshId pad_mesh(int pad) const { return pads_.at(static_cast<std::size_t>(pad)); }

@@ -2,8 +2,8 @@
 // (tools in the respond stage, other bodies in the body-contact stage) by semi-implicit
 // (symplectic) Euler — v += (F/m + g)·dt, then x += v·dt; ω += I⁻¹(τ − ω×Iω)·dt, then the
 // orientation turns by ω·dt — which stays stable for stiff penalty contacts at 1 kHz where
-// explicit Euler gains energy. The rig's ball moves under gravity and the gripper pads' force and
-// rests on its virtual sheet or the floor (its own contact springs, dynamics/ball_environment.h).
+// explicit Euler gains energy. A teleoperation rig's ball is one of these bodies; this stage also
+// fills the rig's report of what carries it (the sheet, the floor).
 #include "hapsim/world/world_model.h"
 #include "hapsim/world/world_stages.h"
 #include "hapsim/world/world_state.h"
