@@ -83,6 +83,30 @@ TEST(HandBallSheet, RecordsAndReplaysBitForBit) {
   fs::remove(recording);
 }
 
+// A replay runs the recording's length, not the scene's run.duration_s: a 0.5 s recording of a
+// scene that says 3 s replays (bit for bit) in 0.5 s.
+TEST(HandBallSheet, AReplayRunsTheRecordingsLengthNotTheScenes) {
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(kScene));
+  j["run"]["duration_s"] = 3.0;
+  const SceneDescription scene = parse_scene(j.dump(), kScene);
+  const fs::path recording = test::temp_path(".rec");
+  {
+    RunSetup setup = make_run_setup(scene, DeviceChoice::scene_script());
+    EXPECT_DOUBLE_EQ(setup.duration_s, 3.0);
+    SessionRecorder recorder(recording, setup.world->content_hash(), 8192,
+                             SessionRecorder::Overflow::kFlushInline);
+    SessionOptions options;
+    options.duration_s = 0.5;
+    options.dt_s = setup.scene.run.dt_s;
+    options.recorder = &recorder;
+    (void)run_session(*setup.world, *setup.device, options);
+    recorder.close();
+  }
+  EXPECT_NEAR(make_run_setup(scene, DeviceChoice::replay(recording)).duration_s, 0.5, 1e-9);
+  EXPECT_TRUE(test::replays_bit_for_bit(scene, recording));
+  fs::remove(recording);
+}
+
 // Bad dynamic and sheet bodies are refused by the loader, each naming its place.
 TEST(HandBallSheet, BadBodiesAreRefusedByPointer) {
   const nlohmann::json base = nlohmann::json::parse(std::ifstream(kScene));

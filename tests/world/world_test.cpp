@@ -491,6 +491,15 @@ TEST(World, BadDescriptionsAreNamed) {
   WorldDescription empty = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0);
   empty.bodies[0].segments[0].mesh = TriangleMesh{};
   EXPECT_THROW(World{std::move(empty)}, std::exception);
+  // More tools than a cycle's record carries: refused, not silently left out of the accounting.
+  WorldDescription crowded = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0);
+  crowded.tools.resize(static_cast<std::size_t>(kMaxTools) + 1, crowded.tools.front());
+  try {
+    World world(std::move(crowded));
+    FAIL() << "accepted " << kMaxTools + 1 << " tools";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("at most 8"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

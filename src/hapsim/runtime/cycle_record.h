@@ -11,7 +11,7 @@
 
 namespace hapsim {
 
-inline constexpr int kMaxCycleTools = 8;
+inline constexpr int kMaxCycleTools = kMaxTools;
 inline constexpr int kMaxCycleContacts = 64;
 /// Dynamic bodies and sheets a cycle record follows (the first ones of the world).
 inline constexpr int kMaxCycleDynamicBodies = 8;

@@ -125,7 +125,10 @@ RunSetup make_run_setup(SceneDescription scene, const DeviceChoice& choice,
       }
       break;
   }
-  r.duration_s = scene.run.duration_s > 0.0 ? scene.run.duration_s : device_length_s;
+  // A replay runs exactly the recording's length, whatever the scene's own run length says.
+  r.duration_s = choice.kind != DeviceChoice::Kind::kReplay && scene.run.duration_s > 0.0
+                     ? scene.run.duration_s
+                     : device_length_s;
   r.scene = std::move(scene);
   return r;
 }

@@ -129,6 +129,10 @@ struct BodyDescription {
   GaussianSheetParams sheet_profile;
 };
 
+/// The most tools a world has: what a cycle's record, the run's accounting and the snapshots carry
+/// per tool (a hand has five).
+inline constexpr int kMaxTools = 8;
+
 /// A contact sphere driven by the device: a stylus tip or a fingertip.
 struct ToolDescription {
   std::string name;

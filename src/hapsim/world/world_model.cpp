@@ -242,6 +242,11 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
   for (const ToolDescription& td : description_.tools) {
     check_tool(td);
   }
+  if (description_.tools.size() > static_cast<std::size_t>(kMaxTools)) {
+    throw Error("world '" + description_.name + "'",
+                "has " + std::to_string(description_.tools.size()) + " tools; at most " +
+                    std::to_string(kMaxTools) + " are supported");
+  }
   if (description_.teleop) {
     check_rig(*description_.teleop);
     check_rig_bodies(description_);
