@@ -3,16 +3,8 @@
 // World holds the read-only model (world_model.h, built once from a WorldDescription) and the
 // per-step state (world_state.h, sized at construction), and steps them with the deterministic,
 // allocation-free step() of world_step.h: the same inputs replay to the same bits. The stages of a
-// step are listed in world_stages.h:
-//  1. place tools: a sphere at the device pose times its offset, or the glove hand's fingertips;
-//  2. detect contacts with penalty segments (skin, muscle), remembering the side a tool entered
-//     from so a thin segment never pulls it through;
-//  3. respond: proxy segments (bone, ligament, sheet) through each tool's god-object (the proxy
-//     never enters them; force = spring from the tool to the proxy); penalty segments F = k·x
-//     along the normal, capped by the segment's maximum penetration and force; normal damping on
-//     both, never below the passivity floor factor·k·dt;
-//  4. deform: deformable segments deflect under every contact (eq. 1), the rest recover;
-//  5. safety: finite forces only, assembled into the device command.
+// step are listed in world_stages.h (place tools, detect contacts, body contacts, respond,
+// integrate, deform, safety) and drawn in architecture.md#one-haptic-cycle-1-ms.
 // Depths are measured against each segment's rest surface (the tissue's spring), which keeps
 // force and deflection consistent: the dent follows the probe instead of pushing it out. The
 // deformed surface has its own exact structure, refitted (never rebuilt) on demand.

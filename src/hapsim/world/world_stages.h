@@ -4,18 +4,21 @@
 //
 //   place_tools      device input → each tool's position and velocity (probe: device pose × offset;
 //                    glove: the hand's fingertips; a teleoperation rig's master arm: the slave
-//                    follows the master's hand through IK, its gripper opening the master's grip);
-//                    an unusable input holds the tools
-//   detect_contacts  penalty segments: each tool against each segment's rest surface, which side
-//                    it presses from (never pulled through a thin segment), less the dent others
-//                    left under it (other tools' presses, an earlier press still recovering)
+//                    follows the master's hand through IK and carries the gripper's pad bodies,
+//                    closed to the master's grip); an unusable input holds the tools
+//   detect_contacts  penalty segments: each tool against each segment's rest surface (a sheet: its
+//                    live field), which side it presses from (never pulled through a thin
+//                    segment), less the dent others left under it
+//   body_contacts    each dynamic body (a sphere) against every other body's segments through their
+//                    sphere trees, refined exactly: one spring of both materials in series, with
+//                    friction, equal and opposite on both; pushes on sheets
 //   respond          proxy segments: the god-object moves its proxy and the spring gives the force;
-//                    penalty segments: F = k·x with damping; contacts reported, deformation fed;
-//                    the rig's gripper pads against the ball (contact springs, grasp and release)
-//   integrate        rigid bodies: the ball under gravity and the pads' force, on the virtual
-//                    sheet (which takes its imprint, Gaussian profile) or the floor
+//                    penalty segments: F = k·x with damping and friction, the reaction on a dynamic
+//                    body, the push on a sheet; contacts reported, deformation fed; a rig's grasp
+//                    read off its pads' contacts with the ball
+//   integrate        dynamic bodies move under gravity and this step's forces (semi-implicit Euler)
 //   deform           deformable segments deflect under this step's contacts (eq. 1), the rest
-//                    recover
+//                    recover; sheets take this step's pushes and the imprint of resting spheres
 //   safety           what leaves the world is finite: per-tool forces, then the device command
 //                    (finger channels and tip force; for the rig the master's joint and finger
 //                    torques through Jᵀ); zero for an unusable input
