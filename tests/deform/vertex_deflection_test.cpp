@@ -202,6 +202,76 @@ TEST(VertexDeflection, OneContactMovesExactlyTheVerticesWithinD0) {
   }
 }
 
+// step() keeps offsets only; mesh() writes the positions of what moved since it was last asked,
+// exactly rest + offset·direction (position(v)), and a released surface is exactly the rest.
+TEST(VertexDeflection, PositionsAreWrittenWhenTheMeshIsAsked) {
+  VertexDeflection deflection(flat_patch());
+  const std::vector<Vec3>& vertices = deflection.mesh().vertices;  // the array, held
+  const auto rest = deflection.rest_positions();
+  const DeflectionContact c{Vec3(0.001, 0.0, 0.0), 0.003, 0.004, 0};
+  for (int k = 0; k < 3; ++k) {
+    deflection.step({&c, 1}, 1e-3);
+  }
+  ASSERT_GT(deflection.deformed_vertex_count(), 100u);
+  // Nobody asked: the haptic path left the display positions alone.
+  for (std::uint32_t v = 0; v < rest.size(); ++v) {
+    ASSERT_EQ(vertices[v], rest[v]) << v;
+  }
+  const TriangleMesh& mesh = deflection.mesh();
+  std::size_t moved = 0;
+  for (std::uint32_t v = 0; v < rest.size(); ++v) {
+    ASSERT_EQ(mesh.vertices[v], deflection.position(v)) << v;
+    ASSERT_EQ(mesh.vertices[v],
+              deflection.deflection_m(v) > 0.0
+                  ? Vec3(rest[v] + deflection.deflection_m(v) * deflection.directions()[v])
+                  : rest[v]);
+    moved += mesh.vertices[v] != rest[v] ? 1 : 0;
+  }
+  EXPECT_EQ(moved, deflection.deformed_vertex_count());
+  for (int k = 0; k < 2000 && deflection.deformed_vertex_count() > 0; ++k) {
+    deflection.step({}, 1e-3);
+    if (k % 97 == 0) {
+      (void)deflection.mesh();  // asked now and then while it recovers
+    }
+  }
+  ASSERT_EQ(deflection.deformed_vertex_count(), 0u);
+  EXPECT_EQ(deflection.mesh().vertices, std::vector<Vec3>(rest.begin(), rest.end()));
+}
+
+// Contacts whose reaches overlap share one pass over the grid; each vertex gets exactly the
+// deepest of what each contact alone gives it (the same bits), whatever the order.
+TEST(VertexDeflection, OverlappingContactsGiveTheDeepestOfEachAlone) {
+  VertexDeflectionOptions options;
+  options.segments = {{.elasticity_factor = 1.5, .max_deflection_m = 0.015}};
+  std::vector<DeflectionContact> fingers;
+  for (int f = 0; f < 5; ++f) {
+    fingers.push_back(
+        {Vec3(-0.03 + 0.015 * f, 0.002 * f, 0.0), 0.004 + 0.001 * (f % 3), 0.006 + 0.0005 * f, 0});
+  }
+  fingers.push_back({Vec3(0.045, 0.045, 0.0), 0.002, 0.003, 0});  // far away: its own pass
+  VertexDeflection together(flat_patch(), options);
+  together.step(fingers, 1e-3);
+  std::reverse(fingers.begin(), fingers.end());
+  VertexDeflection reversed(flat_patch(), options);
+  reversed.step(fingers, 1e-3);
+  std::vector<double> deepest(101 * 101, 0.0);
+  for (const DeflectionContact& c : fingers) {
+    VertexDeflection alone(flat_patch(), options);
+    alone.step({&c, 1}, 1e-3);
+    for (std::uint32_t v = 0; v < deepest.size(); ++v) {
+      deepest[v] = std::max(deepest[v], alone.deflection_m(v));
+    }
+  }
+  std::size_t reached = 0;
+  for (std::uint32_t v = 0; v < deepest.size(); ++v) {
+    ASSERT_EQ(together.deflection_m(v), deepest[v]) << v;
+    ASSERT_EQ(reversed.deflection_m(v), deepest[v]) << v;
+    reached += deepest[v] > 0.0 ? 1 : 0;
+  }
+  EXPECT_EQ(together.deformed_vertex_count(), reached);
+  EXPECT_GT(reached, 3000u);
+}
+
 TEST(VertexDeflection, RepeatedContactDoesNotDrift) {
   VertexDeflection deflection(flat_patch());
   const DeflectionContact c{Vec3(0.0, 0.0, 0.0), 0.002, 0.004, 0};

@@ -204,22 +204,37 @@ VertexDeflection::VertexDeflection(TriangleMesh rest_mesh, VertexDeflectionOptio
   }
   grid_ = std::make_unique<PointHashGrid>(rest_, cell_m);
 
-  // Everything the haptic path touches, sized once.
-  offset_m_.assign(n, 0.0);
-  target_m_.assign(n, 0.0);
-  target_stamp_.assign(n, 0);
+  // Everything the haptic path touches, sized once. The lists are filled once and emptied so
+  // their pages are mapped now, not on the first press that reaches them.
+  const auto presize = [n](std::vector<std::uint32_t>& list) {
+    list.assign(n, 0);
+    list.clear();
+  };
+  slots_.assign(n, Slot{});
+  vertex_of_slot_.assign(grid_->slot_index().begin(), grid_->slot_index().end());
+  slot_of_vertex_.assign(n, 0);
+  for (std::uint32_t s = 0; s < n; ++s) {
+    slot_of_vertex_[vertex_of_slot_[s]] = s;
+  }
+  if (segments_.size() > 1) {
+    segment_of_slot_.resize(n);
+    for (std::uint32_t s = 0; s < n; ++s) {
+      segment_of_slot_[s] = segment_of_vertex_[vertex_of_slot_[s]];
+    }
+  }
   normal_pending_flag_.assign(n, 0);
-  normals_pending_.reserve(n);
+  presize(normals_pending_);
   moved_since_normals_flag_.assign(n, 0);
-  moved_since_normals_.reserve(n);
+  presize(moved_since_normals_);
+  presize(stale_);
   decay_per_segment_.assign(segments_.size(), 0.0);
   triangle_stamp_lazy_.assign(mesh.triangle_count(), 0);
-  in_active_.assign(n, 0);
-  active_.reserve(n);
-  touched_.reserve(n);
-  moved_vertices_.reserve(n);
+  presize(active_);
+  presize(touched_);
+  presize(moved_vertices_);
   moved_triangles_.reserve(mesh.triangle_count());
   last_contacts_.reserve(kMaxHeldContacts);
+  prepared_.resize(kBatch);
 }
 
 double VertexDeflection::deflection_profile_m(double distance_m, double penetration_m,
@@ -234,7 +249,9 @@ double VertexDeflection::deflection_profile_m(double distance_m, double penetrat
 void VertexDeflection::next_stamp() {
   if (++stamp_ == 0) {
     // Wrapped after 2^32 cycles (~50 days at 1 kHz): clear the marks once.
-    std::fill(target_stamp_.begin(), target_stamp_.end(), 0);
+    for (Slot& slot : slots_) {
+      slot.stamp = 0;
+    }
     stamp_ = 1;
   }
   touched_.clear();
@@ -266,18 +283,17 @@ double VertexDeflection::recover_gap_m(const DeflectionParams& p, double decay, 
   return next_m <= p.rest_tolerance_m ? 0.0 : next_m;
 }
 
-// haptic path
-void VertexDeflection::set_offset(std::uint32_t v, double offset_m) {
-  if (offset_m == offset_m_[v]) {
+// haptic path: the offset only; the position waits for mesh() (listed in stale_ once).
+inline void VertexDeflection::set_offset(std::uint32_t slot, double offset_m) {
+  Slot& s = slots_[slot];
+  if (offset_m == s.offset_m) {
     return;
   }
-  offset_m_[v] = offset_m;
-  // Exactly the rest position at zero, so a released surface is bit-identical to rest.
-  mesh_->vertices[v] = offset_m > 0.0 ? Vec3(rest_[v] + offset_m * direction_[v]) : rest_[v];
-  moved_vertices_.push_back(v);
-  if (moved_since_normals_flag_[v] == 0) {
-    moved_since_normals_flag_[v] = 1;
-    moved_since_normals_.push_back(v);
+  s.offset_m = offset_m;
+  moved_vertices_.push_back(vertex_of_slot_[slot]);
+  if (s.stale_epoch != display_epoch_) {
+    s.stale_epoch = display_epoch_;
+    stale_.push_back(slot);
   }
 }
 
@@ -291,27 +307,56 @@ bool VertexDeflection::same_contacts_as_last(std::span<const DeflectionContact> 
                     });
 }
 
-void VertexDeflection::step(std::span<const DeflectionContact> contacts, double dt_s) {
-  if (!std::isfinite(dt_s) || dt_s < 0.0) {
-    dt_s = 0.0;
-  }
-  // A held press (bit-identical contacts, every touched vertex already at its target) gives the
-  // same targets again: keep last step's marks instead of recomputing thousands of vertices.
-  const bool held = same_contacts_as_last(contacts);
-  if (held) {
-    next_moved_stamp();
-  } else {
-    next_stamp();
-  }
-  for (std::size_t s = 0; s < segments_.size(); ++s) {
-    const double tau_s = segments_[s].recovery_time_constant_s;
-    decay_per_segment_[s] = tau_s > 0.0 ? std::exp(-dt_s / tau_s) : 0.0;
-  }
+// haptic path: every slot within d0 of one of `count` contacts gets its target (deepest wins),
+// in one pass over the grid cells of the box [lo, hi] that holds all their reaches.
+void VertexDeflection::press_group(const PreparedContact* first, std::size_t count, const Vec3& lo,
+                                   const Vec3& hi) {
+  const std::span<const Vec3> points = grid_->slot_points();
+  const bool one_segment = segments_.size() == 1;
+  grid_->for_each_candidate_run(lo, hi, [&](std::uint32_t begin, std::uint32_t end) {
+    for (std::uint32_t s = begin; s < end; ++s) {
+      const Vec3& q = points[s];
+      bool reached = false;
+      double deepest_m = 0.0;
+      for (std::size_t k = 0; k < count; ++k) {
+        const PreparedContact& c = first[k];
+        // The same d² as PointHashGrid::for_each_within, so the same vertices and values.
+        const double d2 = (q - c.p_mesh).squaredNorm();
+        if (!(d2 < c.r2_m2) || (!one_segment && segment_of_slot_[s] != c.segment)) {
+          continue;
+        }
+        // A contact no deeper than what the vertex already gets cannot win (δ ≤ x).
+        if (!reached || c.x_m > deepest_m) {
+          // d2 < d0² here, so the profile needs no range checks.
+          const double delta_m = c.x_m * raised_cosine_of_squared(d2 * c.inv_d0_sq);
+          deepest_m = reached ? std::max(deepest_m, delta_m) : delta_m;
+        }
+        reached = true;
+      }
+      if (!reached) {
+        continue;
+      }
+      Slot& slot = slots_[s];
+      if (slot.stamp != stamp_) {
+        slot.stamp = stamp_;
+        slot.target_m = deepest_m;
+        touched_.push_back(s);
+      } else {
+        slot.target_m = std::max(slot.target_m, deepest_m);
+      }
+    }
+  });
+}
 
-  if (!held) {
-    const std::size_t rejected_before = rejected_;
-    // 1. Target deflection of every vertex near a contact (deepest wins).
-    for (const DeflectionContact& c : contacts) {
+// haptic path: targets of this step's contacts, a batch at a time. Contacts whose boxes overlap
+// (fingertips side by side on one muscle) share a pass over the grid, so a vertex several of them
+// reach is fetched once.
+void VertexDeflection::press(std::span<const DeflectionContact> contacts) {
+  std::size_t next = 0;
+  while (next < contacts.size()) {
+    std::size_t prepared = 0;
+    for (; next < contacts.size() && prepared < kBatch; ++next) {
+      const DeflectionContact& c = contacts[next];
       if (!c.p_mesh.allFinite() || !std::isfinite(c.penetration_m) ||
           std::isnan(c.contact_radius_m) || c.segment >= segments_.size()) {
         ++rejected_;
@@ -331,38 +376,99 @@ void VertexDeflection::step(std::span<const DeflectionContact> contacts, double 
       if (!(d0_m > 0.0)) {
         continue;  // an underflowing depth deflects nothing
       }
-      const double inv_d0_sq = 1.0 / (d0_m * d0_m);
-      grid_->for_each_within(c.p_mesh, d0_m, [&](std::uint32_t v, double d2) {
-        if (segment_of_vertex_[v] != c.segment) {
-          return;
-        }
-        // d2 < d0² here (the grid's test), so the profile needs no range checks.
-        const double delta_m = x_m * raised_cosine_of_squared(d2 * inv_d0_sq);
-        if (target_stamp_[v] != stamp_) {
-          target_stamp_[v] = stamp_;
-          target_m_[v] = delta_m;
-          touched_.push_back(v);
-        } else {
-          target_m_[v] = std::max(target_m_[v], delta_m);
-        }
-      });
+      PreparedContact& pc = prepared_[prepared];
+      pc.p_mesh = c.p_mesh;
+      pc.x_m = x_m;
+      pc.r2_m2 = d0_m * d0_m;
+      pc.inv_d0_sq = 1.0 / (d0_m * d0_m);
+      const Vec3 extent = Vec3::Constant(d0_m);
+      pc.lo = c.p_mesh - extent;
+      pc.hi = c.p_mesh + extent;
+      pc.cells = grid_->cells_spanned(pc.lo, pc.hi);
+      pc.segment = c.segment;
+      if (pc.cells > 0.0) {
+        ++prepared;  // a box outside the grid reaches no vertex
+      }
     }
+    // Greedy grouping: a contact joins the first group whose box, grown to hold it, spans no
+    // more cells than the two boxes apart.
+    std::size_t groups = 0;
+    for (std::size_t k = 0; k < prepared; ++k) {
+      PreparedContact& c = prepared_[k];
+      c.group = static_cast<std::uint32_t>(groups);
+      for (std::size_t g = 0; g < groups; ++g) {
+        Box3& box = group_box_[g];
+        Box3 merged = box;
+        merged.extend(c.lo);
+        merged.extend(c.hi);
+        const double cells = grid_->cells_spanned(merged.min(), merged.max());
+        if (cells <= group_cells_[g] + c.cells) {
+          box = merged;
+          group_cells_[g] = cells;
+          c.group = static_cast<std::uint32_t>(g);
+          break;
+        }
+      }
+      if (c.group == groups) {
+        group_box_[groups] = Box3(c.lo, c.hi);
+        group_cells_[groups] = c.cells;
+        ++groups;
+      }
+    }
+    // Each group's contacts side by side, then one pass per group.
+    std::sort(prepared_.begin(), prepared_.begin() + static_cast<std::ptrdiff_t>(prepared),
+              [](const PreparedContact& a, const PreparedContact& b) { return a.group < b.group; });
+    for (std::size_t k = 0; k < prepared;) {
+      std::size_t e = k + 1;
+      while (e < prepared && prepared_[e].group == prepared_[k].group) {
+        ++e;
+      }
+      const Box3& box = group_box_[prepared_[k].group];
+      press_group(prepared_.data() + k, e - k, box.min(), box.max());
+      k = e;
+    }
+  }
+}
+
+void VertexDeflection::step(std::span<const DeflectionContact> contacts, double dt_s) {
+  if (!std::isfinite(dt_s) || dt_s < 0.0) {
+    dt_s = 0.0;
+  }
+  // A held press (bit-identical contacts, every touched vertex already at its target) gives the
+  // same targets again: keep last step's marks instead of recomputing thousands of vertices.
+  const bool held = same_contacts_as_last(contacts);
+  if (held) {
+    next_moved_stamp();
+  } else {
+    next_stamp();
+  }
+  for (std::size_t s = 0; s < segments_.size(); ++s) {
+    const double tau_s = segments_[s].recovery_time_constant_s;
+    decay_per_segment_[s] = tau_s > 0.0 ? std::exp(-dt_s / tau_s) : 0.0;
+  }
+  const bool one_segment = segments_.size() == 1;
+
+  if (!held) {
+    const std::size_t rejected_before = rejected_;
+    // 1. Target deflection of every vertex near a contact (deepest wins).
+    press(contacts);
 
     // 2. Touched vertices: press at once, or recover towards a shallower target.
     bool settled = true;
-    for (const std::uint32_t v : touched_) {
-      const double target_m = target_m_[v];
-      const double current_m = offset_m_[v];
-      const double next_m =
-          target_m >= current_m
-              ? target_m
-              : target_m + recovered_gap_m(segment_of_vertex_[v], current_m - target_m, dt_s);
+    for (const std::uint32_t s : touched_) {
+      Slot& slot = slots_[s];
+      const double target_m = slot.target_m;
+      const double current_m = slot.offset_m;
+      const double next_m = target_m >= current_m
+                                ? target_m
+                                : target_m + recovered_gap_m(one_segment ? 0 : segment_of_slot_[s],
+                                                             current_m - target_m, dt_s);
       settled = settled && next_m == target_m;
-      set_offset(v, next_m);
-      if (next_m > 0.0 && in_active_[v] == 0) {
-        in_active_[v] = 1;
-        active_.push_back(v);
+      // Away from rest exactly while listed in active_ (offsets are never negative).
+      if (next_m > 0.0 && !(current_m > 0.0)) {
+        active_.push_back(s);
       }
+      set_offset(s, next_m);
     }
     held_ = settled && rejected_ == rejected_before && contacts.size() <= last_contacts_.capacity();
     if (held_) {
@@ -373,17 +479,17 @@ void VertexDeflection::step(std::span<const DeflectionContact> contacts, double 
   // 3. Deformed vertices no contact reaches any more: recover towards rest.
   max_deflection_m_ = 0.0;
   for (std::size_t k = 0; k < active_.size();) {
-    const std::uint32_t v = active_[k];
-    if (target_stamp_[v] != stamp_) {
-      set_offset(v, recovered_gap_m(segment_of_vertex_[v], offset_m_[v], dt_s));
+    const std::uint32_t s = active_[k];
+    Slot& slot = slots_[s];
+    if (slot.stamp != stamp_) {
+      set_offset(s, recovered_gap_m(one_segment ? 0 : segment_of_slot_[s], slot.offset_m, dt_s));
     }
-    if (offset_m_[v] == 0.0) {
-      in_active_[v] = 0;
+    if (slot.offset_m == 0.0) {
       active_[k] = active_.back();
       active_.pop_back();
       continue;
     }
-    max_deflection_m_ = std::max(max_deflection_m_, offset_m_[v]);
+    max_deflection_m_ = std::max(max_deflection_m_, slot.offset_m);
     ++k;
   }
 }
@@ -405,7 +511,34 @@ std::span<const std::uint32_t> VertexDeflection::moved_triangles() const {
   return moved_triangles_;
 }
 
+// Writes the positions the last steps left stale: rest + offset·direction (the rest position
+// itself at zero, so a released surface is bit-identical to rest).
+void VertexDeflection::sync_positions() const {
+  if (stale_.empty()) {
+    return;
+  }
+  std::vector<Vec3>& vertices = mesh_->vertices;
+  for (const std::uint32_t s : stale_) {
+    const std::uint32_t v = vertex_of_slot_[s];
+    const double offset_m = slots_[s].offset_m;
+    vertices[v] = offset_m > 0.0 ? Vec3(rest_[v] + offset_m * direction_[v]) : rest_[v];
+    if (moved_since_normals_flag_[v] == 0) {
+      moved_since_normals_flag_[v] = 1;
+      moved_since_normals_.push_back(v);
+    }
+  }
+  stale_.clear();
+  if (++display_epoch_ == 0) {
+    // Wrapped after 2^32 calls that found something stale: clear the marks once.
+    for (const Slot& slot : slots_) {
+      slot.stale_epoch = 0;
+    }
+    display_epoch_ = 1;
+  }
+}
+
 void VertexDeflection::update_normals() {
+  sync_positions();
   TriangleMesh& mesh = *mesh_;
   // A moved vertex changes the normals of every corner of its triangles.
   for (const std::uint32_t m : moved_since_normals_) {
@@ -432,9 +565,8 @@ void VertexDeflection::update_normals() {
 void VertexDeflection::reset() {
   next_stamp();
   held_ = false;
-  for (const std::uint32_t v : active_) {
-    set_offset(v, 0.0);
-    in_active_[v] = 0;
+  for (const std::uint32_t s : active_) {
+    set_offset(s, 0.0);
   }
   active_.clear();
   max_deflection_m_ = 0.0;

@@ -14,12 +14,20 @@
 //    target below `rest_tolerance_m`, so it never overshoots and reaches rest in bounded time.
 //  * The paper's eq. 1 prints d_p/2 as the amplitude; architecture.md#deformation reads x/2 (δ(0) =
 //  x), used here.
+//
+// Cost (architecture.md#real-time): step() keeps only each vertex's offset along its direction —
+// the state eq. 1 and the recovery law need — in the grid's slot order, so a press streams
+// through memory. The deformed positions (rest + offset·direction) and normals are display
+// data: mesh() writes the positions of the vertices that moved since it was last asked, and
+// update_normals() their normals, on whichever call wants them (a viewer, a snapshot, a refit),
+// never inside step().
 #pragma once
 
 #include "hapsim/core/types.h"
 #include "hapsim/deform/point_hash_grid.h"
 #include "hapsim/geometry/triangle_mesh.h"
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -87,16 +95,19 @@ class VertexDeflection {
 
   /// One cycle: deflect from `contacts`, let everything else recover for `dt_s` seconds
   /// (non-finite or negative dt counts as 0). Cost O(vertices within d0 + vertices still
-  /// recovering). Invalid contacts are skipped and counted. haptic path
+  /// recovering); contacts whose reach overlaps are answered in one pass over the grid. Writes
+  /// offsets only (deflection_m()); positions wait for mesh(). Invalid contacts are skipped and
+  /// counted. haptic path
   void step(std::span<const DeflectionContact> contacts, double dt_s);
 
   /// Every vertex back to rest at once (reported as moved).
   void reset();
 
-  /// Recomputes the vertex normals of every vertex whose neighbourhood moved since the last call
-  /// (angle-weighted, like TriangleMesh::compute_vertex_normals). Normals are for display only,
-  /// so step() does not pay for them: call this at display rate, from the thread that owns the
-  /// mesh. Allocation-free; cost O(vertices moved since the last call).
+  /// Brings the mesh's positions up to date (as mesh() does), then recomputes the vertex normals
+  /// of every vertex whose neighbourhood moved since the last call (angle-weighted, like
+  /// TriangleMesh::compute_vertex_normals). Normals are for display only, so step() does not pay
+  /// for them: call this at display rate, from the thread that owns the mesh. Allocation-free;
+  /// cost O(vertices moved since the last call).
   void update_normals();
 
   /// Eq. 1: δ(d) = (x/2)·(cos(π·d/d0) + 1) for 0 ≤ d < d0, else 0.
@@ -119,14 +130,28 @@ class VertexDeflection {
     return (penetration_m + contact_radius_m) * elasticity_factor;
   }
 
-  /// The deformed mesh; vertices are updated in place by step(), vertex normals by
-  /// update_normals(); the addresses of the mesh and its arrays never change (safe to hold in a
-  /// collision structure).
-  [[nodiscard]] const TriangleMesh& mesh() const { return *mesh_; }
+  /// The deformed mesh. Its vertex positions are written here, lazily: each call first writes
+  /// those of the vertices whose offset changed since the last call (O(those vertices),
+  /// allocation-free), so what it returns is the surface as of the last step. Vertex normals are
+  /// updated by update_normals(). The addresses of the mesh and its arrays never change (safe to
+  /// hold in a collision structure, after calling mesh() again before reading the positions).
+  /// Only on the thread that steps.
+  [[nodiscard]] const TriangleMesh& mesh() const {
+    sync_positions();
+    return *mesh_;
+  }
+  /// Vertex v's deformed position: rest + offset·direction, exactly what mesh() writes (the rest
+  /// position itself at offset 0). For a caller that wants a few vertices without mesh().
+  [[nodiscard]] Vec3 position(std::uint32_t v) const {
+    const double offset_m = deflection_m(v);
+    return offset_m > 0.0 ? Vec3(rest_[v] + offset_m * direction_[v]) : rest_[v];
+  }
   [[nodiscard]] std::span<const Vec3> rest_positions() const { return rest_; }
   [[nodiscard]] std::span<const Vec3> directions() const { return direction_; }
   /// Current inward displacement of vertex v along its direction, metres (≥ 0).
-  [[nodiscard]] double deflection_m(std::uint32_t v) const { return offset_m_[v]; }
+  [[nodiscard]] double deflection_m(std::uint32_t v) const {
+    return slots_[slot_of_vertex_[v]].offset_m;
+  }
   /// Vertices whose position changed in the last step()/reset(), each once.
   [[nodiscard]] std::span<const std::uint32_t> moved_vertices() const { return moved_vertices_; }
   /// Triangles with a moved corner in the last step()/reset(), each once (refit these).
@@ -141,9 +166,36 @@ class VertexDeflection {
   [[nodiscard]] std::size_t segment_count() const { return segments_.size(); }
 
  private:
-  void set_offset(std::uint32_t v, double offset_m);
+  /// Per vertex, in the grid's slot order (PointHashGrid::slot_points), what step() reads and
+  /// writes: one cache line holds it for 2-3 vertices that lie side by side.
+  struct Slot {
+    double offset_m = 0.0;  ///< inward displacement now (≥ 0); > 0 exactly while in active_
+    double target_m = 0.0;  ///< this step's target, valid when stamp == stamp_
+    std::uint32_t stamp = 0;
+    /// == display_epoch_: already listed in stale_ (its position is not yet in the mesh).
+    /// Display bookkeeping: the lazy (const) calls may reset it.
+    mutable std::uint32_t stale_epoch = 0;
+  };
+  /// A valid contact ready for the grid pass (eq. 1's x and d0, the query box).
+  struct PreparedContact {
+    Vec3 p_mesh = Vec3::Zero();
+    Vec3 lo = Vec3::Zero();
+    Vec3 hi = Vec3::Zero();
+    double x_m = 0.0;
+    double r2_m2 = 0.0;  ///< d0²
+    double inv_d0_sq = 0.0;
+    double cells = 0.0;  ///< grid cells its box spans
+    std::uint32_t segment = 0;
+    std::uint32_t group = 0;
+  };
+  static constexpr std::size_t kBatch = 16;
+
+  void set_offset(std::uint32_t slot, double offset_m);
   void next_stamp();
   void next_moved_stamp();
+  void press(std::span<const DeflectionContact> contacts);
+  void press_group(const PreparedContact* first, std::size_t count, const Vec3& lo, const Vec3& hi);
+  void sync_positions() const;
   [[nodiscard]] bool same_contacts_as_last(std::span<const DeflectionContact> contacts) const;
   [[nodiscard]] double recovered_gap_m(std::uint32_t segment, double gap_m, double dt_s) const;
 
@@ -157,10 +209,13 @@ class VertexDeflection {
   std::vector<std::uint32_t> vertex_tri_start_;
   std::vector<std::uint32_t> vertex_tris_;
 
-  std::vector<double> offset_m_;
-  std::vector<double> target_m_;
-  /// Per-vertex/triangle "seen in this cycle" marks, so nothing is cleared per cycle.
-  std::vector<std::uint32_t> target_stamp_;
+  /// The haptic state, slot order, and the two permutations.
+  std::vector<Slot> slots_;
+  std::vector<std::uint32_t> vertex_of_slot_;
+  std::vector<std::uint32_t> slot_of_vertex_;
+  /// Segment of each slot (only read when there is more than one segment).
+  std::vector<std::uint32_t> segment_of_slot_;
+  /// Marks targets "seen in this cycle", so nothing is cleared per cycle.
   std::uint32_t stamp_ = 0;
   /// Generation of moved_vertices_/moved_triangles_ (advances every step, also when held).
   std::uint32_t moved_stamp_ = 0;
@@ -169,19 +224,27 @@ class VertexDeflection {
   static constexpr std::size_t kMaxHeldContacts = 64;
   std::vector<DeflectionContact> last_contacts_;
   bool held_ = false;
-  std::vector<std::uint8_t> in_active_;
-  /// Vertices away from rest (recovering or held), pre-sized to the vertex count.
+  /// Slots away from rest (recovering or held), pre-sized to the vertex count.
   std::vector<std::uint32_t> active_;
+  /// Slots within reach of this step's contacts.
   std::vector<std::uint32_t> touched_;
   std::vector<std::uint32_t> moved_vertices_;
+  /// Scratch of step(): a batch of valid contacts, and the groups that share a grid pass (box
+  /// and the cells it spans).
+  std::vector<PreparedContact> prepared_;
+  std::array<Box3, kBatch> group_box_;
+  std::array<double, kBatch> group_cells_{};
   // Filled lazily by moved_triangles() (a cache of the last step's moved vertices).
   mutable std::vector<std::uint32_t> moved_triangles_;
   mutable std::vector<std::uint32_t> triangle_stamp_lazy_;
   mutable bool moved_triangles_ready_ = true;
-  /// Vertices moved since the last update_normals(), each once: their one-ring's normals are
-  /// stale.
-  std::vector<std::uint32_t> moved_since_normals_;
-  std::vector<std::uint8_t> moved_since_normals_flag_;
+  /// Display bookkeeping, written by the lazy calls (mesh(), update_normals()): slots whose offset
+  /// changed since the positions were last written, each once per display epoch; then the
+  /// vertices written since the last update_normals(), whose one-ring's normals are stale.
+  mutable std::vector<std::uint32_t> stale_;
+  mutable std::uint32_t display_epoch_ = 1;
+  mutable std::vector<std::uint32_t> moved_since_normals_;
+  mutable std::vector<std::uint8_t> moved_since_normals_flag_;
   /// Scratch of update_normals(): vertices whose normal is recomputed, each once.
   std::vector<std::uint32_t> normals_pending_;
   std::vector<std::uint8_t> normal_pending_flag_;

@@ -161,12 +161,15 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
     if (pending.empty()) {
       continue;
     }
-    const std::vector<Vec3>& vertices = seg.deflection->mesh().vertices;
+    // Each pending vertex's position from its offset (what mesh() would write, without
+    // writing the whole segment's pending positions there every cycle).
+    const VertexDeflection& deflection = *seg.deflection;
     float* xyz = s.positions_body[seg.flat].data();
     for (const std::uint32_t v : pending) {
-      xyz[3 * v + 0] = static_cast<float>(vertices[v].x());
-      xyz[3 * v + 1] = static_cast<float>(vertices[v].y());
-      xyz[3 * v + 2] = static_cast<float>(vertices[v].z());
+      const Vec3 p = deflection.position(v);
+      xyz[3 * v + 0] = static_cast<float>(p.x());
+      xyz[3 * v + 1] = static_cast<float>(p.y());
+      xyz[3 * v + 2] = static_cast<float>(p.z());
       flag[v] = 0;
     }
     pending.clear();

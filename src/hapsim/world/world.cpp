@@ -63,8 +63,11 @@ const ProximityQuery& World::deformed_query(std::size_t body, std::size_t segmen
   if (!seg.deflection) {
     return *model_.segments()[flat].rest_query;
   }
+  // mesh() writes the deformed positions the steps left pending (they are lazy), then the
+  // structure built on that mesh refits to them.
+  const TriangleMesh& mesh = seg.deflection->mesh();
   if (!seg.deformed_bvh) {
-    seg.deformed_bvh = std::make_unique<MeshBvh>(seg.deflection->mesh());
+    seg.deformed_bvh = std::make_unique<MeshBvh>(mesh);
   } else if (seg.deformed_dirty) {
     seg.deformed_bvh->refit();
   }
