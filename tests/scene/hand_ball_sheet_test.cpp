@@ -68,17 +68,8 @@ TEST(HandBallSheet, TheHandLiftsTheBallAndItEndsAtRestOnTheSheet) {
 
 TEST(HandBallSheet, RecordsAndReplaysBitForBit) {
   const fs::path recording = test::temp_path(".rec");
-  {
-    RunSetup setup = make_run_setup(load_scene(kScene), DeviceChoice::scene_script());
-    SessionRecorder recorder(recording, setup.world->content_hash(), 8192,
-                             SessionRecorder::Overflow::kFlushInline);
-    SessionOptions options;
-    options.duration_s = setup.duration_s;
-    options.dt_s = setup.scene.run.dt_s;
-    options.recorder = &recorder;
-    (void)run_session(*setup.world, *setup.device, options);
-    recorder.close();
-  }
+  RunSetup setup = make_run_setup(load_scene(kScene), DeviceChoice::scene_script());
+  test::record_run(setup, recording);
   EXPECT_TRUE(test::replays_bit_for_bit(load_scene(kScene), recording));
   fs::remove(recording);
 }
@@ -90,18 +81,9 @@ TEST(HandBallSheet, AReplayRunsTheRecordingsLengthNotTheScenes) {
   j["run"]["duration_s"] = 3.0;
   const SceneDescription scene = parse_scene(j.dump(), kScene);
   const fs::path recording = test::temp_path(".rec");
-  {
-    RunSetup setup = make_run_setup(scene, DeviceChoice::scene_script());
-    EXPECT_DOUBLE_EQ(setup.duration_s, 3.0);
-    SessionRecorder recorder(recording, setup.world->content_hash(), 8192,
-                             SessionRecorder::Overflow::kFlushInline);
-    SessionOptions options;
-    options.duration_s = 0.5;
-    options.dt_s = setup.scene.run.dt_s;
-    options.recorder = &recorder;
-    (void)run_session(*setup.world, *setup.device, options);
-    recorder.close();
-  }
+  RunSetup setup = make_run_setup(scene, DeviceChoice::scene_script());
+  EXPECT_DOUBLE_EQ(setup.duration_s, 3.0);
+  test::record_run(setup, recording, 0.5);
   EXPECT_NEAR(make_run_setup(scene, DeviceChoice::replay(recording)).duration_s, 0.5, 1e-9);
   EXPECT_TRUE(test::replays_bit_for_bit(scene, recording));
   fs::remove(recording);

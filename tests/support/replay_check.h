@@ -14,6 +14,19 @@
 
 namespace hapsim::test {
 
+/// Records a run of `setup` (its world and device, `duration_s`; its own length when 0) to `file`.
+inline void record_run(RunSetup& setup, const std::filesystem::path& file,
+                       double duration_s = 0.0) {
+  SessionRecorder recorder(file, setup.world->content_hash(), 8192,
+                           SessionRecorder::Overflow::kFlushInline);
+  SessionOptions options;
+  options.duration_s = duration_s > 0.0 ? duration_s : setup.duration_s;
+  options.dt_s = setup.scene.run.dt_s;
+  options.recorder = &recorder;
+  (void)run_session(*setup.world, *setup.device, options);
+  recorder.close();
+}
+
 /// True when replaying `recording` on a fresh world of `scene` reproduces every frame exactly;
 /// otherwise records a test failure naming the first difference.
 inline bool replays_bit_for_bit(const SceneDescription& scene,
@@ -22,16 +35,7 @@ inline bool replays_bit_for_bit(const SceneDescription& scene,
   const std::filesystem::path again =
       std::filesystem::temp_directory_path() /
       ("hapsim_replay_check_" + std::to_string(::getpid()) + ".rec");
-  {
-    SessionRecorder recorder(again, setup.world->content_hash(), 8192,
-                             SessionRecorder::Overflow::kFlushInline);
-    SessionOptions options;
-    options.duration_s = setup.duration_s;
-    options.dt_s = setup.scene.run.dt_s;
-    options.recorder = &recorder;
-    (void)run_session(*setup.world, *setup.device, options);
-    recorder.close();
-  }
+  record_run(setup, again);
   const RecordingDifference d = compare_recordings(*setup.replayed, read_recording(again));
   std::filesystem::remove(again);
   if (!d.identical) {

@@ -187,6 +187,23 @@ namespace {
 
 using GloveAngles = std::array<double, kGloveAnglesPerFinger>;
 
+// One glove sample: the tracker at `p_world` turned by R, every finger's three angles.
+DeviceInput glove_input(double time_s, const Vec3& p_world, const Mat3& R,
+                        const std::array<GloveAngles, kHandFingers>& angles) {
+  DeviceInput in;
+  in.time_s = time_s;
+  in.p_world = p_world;
+  in.q_world = Quat(R);
+  in.joint_count = kHandFingers * kGloveAnglesPerFinger;
+  for (int f = 0; f < kHandFingers; ++f) {
+    for (int k = 0; k < kGloveAnglesPerFinger; ++k) {
+      in.joint_rad[static_cast<std::size_t>(f * kGloveAnglesPerFinger + k)] =
+          angles[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)];
+    }
+  }
+  return in;
+}
+
 struct HandPoseSolution {
   Vec3 p_world = Vec3::Zero();
   std::array<GloveAngles, kHandFingers> angles{};
@@ -337,18 +354,7 @@ Trajectory make_scene_glove_palpation(const World& world, const GlovePalpationDe
   const Vec3 p_stand = p_press + out_standoff;
   std::vector<DeviceInput> samples;
   const auto push = [&](double t, const Vec3& p) {
-    DeviceInput in;
-    in.time_s = t;
-    in.p_world = p;
-    in.q_world = Quat(R);
-    in.joint_count = kHandFingers * kGloveAnglesPerFinger;
-    for (int f = 0; f < kHandFingers; ++f) {
-      for (int k = 0; k < kGloveAnglesPerFinger; ++k) {
-        in.joint_rad[static_cast<std::size_t>(f * kGloveAnglesPerFinger + k)] =
-            angles[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)];
-      }
-    }
-    samples.push_back(in);
+    samples.push_back(glove_input(t, p, R, angles));
   };
   double t = 0.0;
   push(t, p_far);
@@ -463,18 +469,7 @@ Trajectory make_scene_glove_pick_and_place(const World& world,
   double t = 0.0;
   const auto push = [&](double time_s, const Vec3& p,
                         const std::array<GloveAngles, kHandFingers>& angles) {
-    DeviceInput in;
-    in.time_s = time_s;
-    in.p_world = p;
-    in.q_world = Quat(R_hand);
-    in.joint_count = kHandFingers * kGloveAnglesPerFinger;
-    for (int f = 0; f < kHandFingers; ++f) {
-      for (int k = 0; k < kGloveAnglesPerFinger; ++k) {
-        in.joint_rad[static_cast<std::size_t>(f * kGloveAnglesPerFinger + k)] =
-            angles[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)];
-      }
-    }
-    samples.push_back(in);
+    samples.push_back(glove_input(time_s, p, R_hand, angles));
   };
   Vec3 p_now = p_above_pick;
   auto angles_now = open;
