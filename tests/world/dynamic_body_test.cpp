@@ -111,6 +111,19 @@ TEST(DynamicBody, BallDroppedOnTheFloorRestsWhereTheSpringCarriesItsWeight) {
   EXPECT_NEAR(c.normal_world.z(), 1.0, 1e-9);
 }
 
+// Materials in series: an infinitely stiff side gives the other's stiffness, never NaN.
+TEST(DynamicBody, ARigidMaterialInSeriesGivesTheOther) {
+  ContactMaterial rigid = penalty("rigid", kInf, 50.0, 0.0).contact;
+  rigid.damping_n_s_per_m = kInf;
+  ContactMaterial soft = penalty("soft", 800.0, 5.0, 0.4).contact;
+  soft.damping_n_s_per_m = 3.0;
+  const ContactMaterial m = combine_materials(rigid, soft);
+  EXPECT_EQ(m.stiffness_n_per_m, 800.0);
+  EXPECT_EQ(m.damping_n_s_per_m, 3.0);
+  EXPECT_EQ(m.max_force_n, 5.0);
+  EXPECT_EQ(m.static_friction, 0.4);
+}
+
 TEST(DynamicBody, BallOnTheSheetIsCarriedAndImprintsIt) {
   WorldDescription d;
   d.materials = {penalty("ball", 4000.0, 50.0, 0.5), penalty("sheet", 4000.0, 50.0, 0.5)};

@@ -6,9 +6,10 @@
 // Two height fields are kept:
 //  * elastic  — the sum of the profile over this cycle's contacts (what the forces produce);
 //  * surface  — what is shown and collided with: min(elastic, every imprinted sphere's cap).
-// The split exists because an imprinting sphere lies exactly on its own imprint: queried against
-// the surface it would feel no penetration and sink, so the body that imprints is queried against
-// the elastic field, everything else against the surface (see SheetLayer).
+// The split exists because an imprinting sphere lies exactly on its own imprint: pressing the
+// surface it would feel no penetration and sink. So contacts press the elastic field (in the world
+// every contact does, tools and bodies alike: deform/sheet_query.h), and the surface, imprints
+// included, is what is shown.
 #pragma once
 
 #include "hapsim/core/types.h"

@@ -7,8 +7,9 @@ namespace hapsim {
 
 namespace {
 
+// 1/(1/x + 1/y): an infinitely stiff side gives the other, and nothing overflows.
 double in_series(double x, double y) noexcept {
-  return x > 0.0 && y > 0.0 ? x * y / (x + y) : 0.0;
+  return x > 0.0 && y > 0.0 ? 1.0 / (1.0 / x + 1.0 / y) : 0.0;
 }
 
 }  // namespace

@@ -29,8 +29,9 @@ bool sphere_segment_contact(const WorldState& state, const SegmentModel& seg, st
   if ((c_body - c_body.cwiseMax(bounds.min()).cwiseMin(bounds.max())).squaredNorm() > r * r) {
     return false;
   }
-  // A CSG solid answers from its exact signed distance, a sheet from its live field.
-  const bool tree = seg.body_tree && !seg.description->csg;
+  // A CSG solid or an exact sphere answers from its exact signed distance, a sheet from its live
+  // field.
+  const bool tree = seg.body_tree && !seg.description->csg && !seg.description->sphere;
   const ProximityQuery& query =
       tree ? static_cast<const ProximityQuery&>(*seg.body_tree) : state.contact_query(seg, flat);
   if (query.contact_within(c_body, r, &sp, &pair.hint)) {
@@ -84,6 +85,9 @@ void body_contacts(const WorldModel& model, WorldState& state, double /*dt_s*/) 
       const ContactMaterial material =
           combine_materials(state.body_materials[own.material], state.body_materials[seg.material]);
       const Vec3 f_normal = penalty_force(material, depth, n_world, -v_rel.dot(n_world));
+      // Friction: a stick spring from the ball's lowest point to where it stuck on the other body.
+      // That point follows the ball's centre, not its material: a ball held this way slides but
+      // cannot roll (see the note in docs/architecture.md#contact).
       StickPoint stick{pair.stick_body.active, other.X_world_body * pair.stick_body.p};
       const Vec3 f = f_normal + contact_friction_force(material, f_normal.norm(), n_world, v_rel,
                                                        p_ball, stick);

@@ -37,6 +37,13 @@ void integrate_body(const BodyModel& bm, const Vec3& gravity, BodyState& body,
     // Keep the rotation orthonormal over millions of steps.
     R_next = Quat(R_next).normalized().toRotationMatrix();
   }
+  if (!com.allFinite() || !R_next.allFinite() || !body.v_world.allFinite() ||
+      !body.w_world.allFinite()) {
+    // Overflowed (a mass or inertia too small for the forces): stay put rather than go NaN.
+    body.v_world.setZero();
+    body.w_world.setZero();
+    return;
+  }
   body.X_world_body.linear() = R_next;
   body.X_world_body.translation() = com - R_next * bm.com_body;
   body.X_body_world = body.X_world_body.inverse();

@@ -29,6 +29,13 @@ void place_pads(const TeleopRigDescription& d, RigState& rig, WorldState& state,
     width = std::max(width, 2.0 * (d.ball.radius_m - pen_max + std::abs(c.y())));
   }
   rig.result.gripper.width_m = width;
+  // The pads turn with the tool: ω from this step's rotation of it (none on the first step).
+  Vec3 w_world = Vec3::Zero();
+  if (rig.has_pad_previous && dt_s > 0.0) {
+    const Eigen::AngleAxisd turn(X_world_tool.linear() * rig.tool_previous_R.transpose());
+    w_world = turn.axis() * (turn.angle() / dt_s);
+  }
+  rig.tool_previous_R = X_world_tool.linear();
   for (std::size_t i = 0; i < 2; ++i) {
     const double side = i == 0 ? 1.0 : -1.0;
     BodyState& pad = state.bodies[d.pad_body[i]];
@@ -38,6 +45,7 @@ void place_pads(const TeleopRigDescription& d, RigState& rig, WorldState& state,
     const Vec3 p = pad.X_world_body.translation();
     pad.v_world = rig.has_pad_previous && dt_s > 0.0 ? Vec3((p - rig.pad_previous_world[i]) / dt_s)
                                                      : Vec3::Zero();
+    pad.w_world = w_world;
     rig.pad_previous_world[i] = p;
   }
   rig.has_pad_previous = true;
@@ -97,6 +105,7 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
         side = PenaltySide{};  // the tool may come back anywhere
       }
       std::fill(tool.pressing.begin(), tool.pressing.end(), std::uint8_t{0});
+      std::fill(tool.stick_body.begin(), tool.stick_body.end(), StickPoint{});
     }
     return;
   }

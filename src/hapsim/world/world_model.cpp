@@ -229,7 +229,8 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
   check_sheet_contacts();
   if (!dynamic_bodies_.empty()) {
     for (SegmentModel& seg : segments_) {
-      if (!seg.sheet) {
+      // Sheets, CSG solids and exact spheres answer body contacts exactly without a tree.
+      if (!seg.sheet && !seg.description->csg && !seg.description->sphere) {
         seg.body_tree = std::make_unique<SphereTree>(seg.description->mesh);
       }
     }

@@ -235,6 +235,7 @@ struct RigState {
   bool input_usable = false;
   /// Place stage: the pads' centres last step (their velocity), world frame.
   std::array<Vec3, 2> pad_previous_world{Vec3::Zero(), Vec3::Zero()};
+  Mat3 tool_previous_R = Mat3::Identity();
   bool has_pad_previous = false;
   /// Respond stage: the grasp holds (both pads press the ball from opposite sides hard enough
   /// that friction carries its weight). A report: the ball is held by friction, not attached.
