@@ -527,7 +527,7 @@ std::string format_session_summary(const SessionSummary& s) {
     out << line;
   }
   if (!s.segments.empty()) {
-    out << "segments touched (tool-steps in contact, peak force, largest deflection):\n";
+    out << "segments touched by tools (tool-steps in contact, peak force, largest deflection):\n";
   }
   std::size_t untouched = 0;
   for (const SegmentSummary& g : s.segments) {
@@ -541,7 +541,7 @@ std::string format_session_summary(const SessionSummary& s) {
     out << line;
   }
   if (untouched > 0) {
-    out << "  (" << untouched << " segment(s) never touched)\n";
+    out << "  (" << untouched << " segment(s) never touched by a tool)\n";
   }
   std::snprintf(line, sizeof line,
                 "pop-throughs: %zu (deepest proxy sphere reach %.3f mm); force-limit violations: "

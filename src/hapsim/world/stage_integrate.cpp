@@ -60,7 +60,6 @@ void integrate(const WorldModel& model, WorldState& state, double dt_s) noexcept
   if (!state.rig) {
     return;
   }
-  (void)dt_s;
   // The rig's report of where the ball is and what carries it (the sheet, the floor).
   RigState& rig = *state.rig;
   const TeleopRigDescription& d = *model.description().teleop;
