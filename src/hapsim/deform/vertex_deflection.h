@@ -152,7 +152,7 @@ class VertexDeflection {
   [[nodiscard]] double deflection_m(std::uint32_t v) const {
     return slots_[slot_of_vertex_[v]].offset_m;
   }
-  /// Vertices whose position changed in the last step()/reset(), each once.
+  /// Vertices whose offset (so position) changed in the last step()/reset(), each once.
   [[nodiscard]] std::span<const std::uint32_t> moved_vertices() const { return moved_vertices_; }
   /// Triangles with a moved corner in the last step()/reset(), each once (refit these).
   /// Gathered on the first call after a step, so a step that nobody refits does not pay for it.
@@ -244,9 +244,9 @@ class VertexDeflection {
   mutable std::vector<std::uint32_t> moved_triangles_;
   mutable std::vector<std::uint32_t> triangle_stamp_lazy_;
   mutable bool moved_triangles_ready_ = true;
-  /// Display bookkeeping, written by the lazy calls (mesh(), update_normals()): slots whose offset
-  /// changed since the positions were last written, each once per display epoch; then the
-  /// vertices written since the last update_normals(), whose one-ring's normals are stale.
+  /// Display bookkeeping: slots whose offset changed since the positions were last written
+  /// (listed by step(), each once per display epoch; written out by mesh()); then the vertices
+  /// written since the last update_normals(), whose one-ring's normals are stale.
   mutable std::vector<std::uint32_t> stale_;
   mutable std::uint32_t display_epoch_ = 1;
   mutable std::vector<std::uint32_t> moved_since_normals_;
