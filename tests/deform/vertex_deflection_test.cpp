@@ -430,9 +430,9 @@ TEST(VertexDeflection, ResetReturnsToRest) {
   }
 }
 
-// The automatic grid cell: twice the mean edge, or a quarter of a typical press's d0 when that
-// is larger, so a 25 mm dent on a 1 mm mesh looks up ~8^3 cells, not ~20^3. The deflection
-// itself does not depend on the cell (same vertices, same values).
+// The automatic grid cell: twice the mean edge, or half a typical press's d0 when that is
+// larger, so a 25 mm dent on a 1 mm mesh looks up ~5^3 cells, not ~20^3. The deflection itself
+// does not depend on the cell (same vertices, same values).
 TEST(VertexDeflection, GridCellFollowsTheTypicalDent) {
   const TriangleMesh patch = flat_patch();  // 1 mm grid: mean edge (1 + 1 + sqrt 2) / 3 mm
   const double mean_edge = (2.0 + std::sqrt(2.0)) / 3.0 * 1e-3;
@@ -444,7 +444,7 @@ TEST(VertexDeflection, GridCellFollowsTheTypicalDent) {
   muscle.segments = {{.elasticity_factor = 1.5, .max_deflection_m = 0.015}};
   muscle.typical_contact_radius_m = 0.007;
   VertexDeflection wide(patch, muscle);
-  EXPECT_NEAR(wide.grid().cell_m(), 0.25 * 1.5 * (0.010 + 0.007), 1e-12);
+  EXPECT_NEAR(wide.grid().cell_m(), 0.5 * 1.5 * (0.010 + 0.007), 1e-12);
   muscle.grid_cell_m = 0.001;  // given explicitly: used as is
   VertexDeflection fine(patch, muscle);
   EXPECT_EQ(fine.grid().cell_m(), 0.001);

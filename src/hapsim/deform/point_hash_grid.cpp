@@ -28,6 +28,9 @@ PointHashGrid::PointHashGrid(std::span<const Vec3> points, double cell_m) : cell
   }
   if (!points.empty()) {
     origin_m_ = box.min();
+    margin_m_ = 1e-9 * std::max(box.diagonal().maxCoeff(), cell_m_);
+    bounds_lo_ = Vec3(box.min().array() - margin_m_);
+    bounds_hi_ = Vec3(box.max().array() + margin_m_);
     for (int k = 0; k < 3; ++k) {
       const double cells = std::floor((box.max()[k] - origin_m_[k]) * inv_cell_);
       if (cells > 1e9) {
@@ -64,10 +67,15 @@ PointHashGrid::PointHashGrid(std::span<const Vec3> points, double cell_m) : cell
     }
     return a < b;
   });
-  slot_points_.resize(points.size());
+  slot_x_.resize(points.size());
+  slot_y_.resize(points.size());
+  slot_z_.resize(points.size());
   std::size_t cell_count = 0;
   for (std::size_t s = 0; s < points.size(); ++s) {
-    slot_points_[s] = points[slot_index_[s]];
+    const Vec3& p = points[slot_index_[s]];
+    slot_x_[s] = p.x();
+    slot_y_[s] = p.y();
+    slot_z_[s] = p.z();
     if (s == 0 || cell_of_point[slot_index_[s]] != cell_of_point[slot_index_[s - 1]]) {
       ++cell_count;
     }

@@ -30,22 +30,34 @@ class PointHashGrid {
   template <class Visit>
   void for_each_within(const Vec3& center, double radius_m, Visit&& visit) const;
 
-  /// Calls visit(first, last) for the slots [first, last) of every non-empty cell that overlaps
-  /// the box [lo, hi], each slot at most once (or once with every slot when the box spans more
-  /// cells than there are points). Candidates only: the caller tests the distances. haptic path
+  /// Calls visit(first, last, box_lo, box_hi) for the slots [first, last) of every non-empty
+  /// cell that overlaps the box [lo, hi], each slot at most once (or once with every slot when
+  /// the box spans more cells than there are points); [box_lo, box_hi] holds every point of the
+  /// run (the cell, grown by a rounding margin), so a caller can skip what cannot reach it.
+  /// Candidates only: the caller tests the distances. haptic path
   template <class Visit>
   void for_each_candidate_run(const Vec3& lo, const Vec3& hi, Visit&& visit) const;
   /// How many cells the box [lo, hi] spans inside the grid (0 when it misses the grid): what
   /// for_each_candidate_run() looks up for it.
   [[nodiscard]] double cells_spanned(const Vec3& lo, const Vec3& hi) const;
 
-  /// The points in slot order (sorted by cell).
-  [[nodiscard]] std::span<const Vec3> slot_points() const { return slot_points_; }
+  /// The points' coordinates in slot order (sorted by cell), one array per axis, so a caller
+  /// can compute many distances with packed instructions.
+  [[nodiscard]] std::span<const double> slot_x() const { return slot_x_; }
+  [[nodiscard]] std::span<const double> slot_y() const { return slot_y_; }
+  [[nodiscard]] std::span<const double> slot_z() const { return slot_z_; }
+  /// |slot s − p|², evaluated as (p − slot s).squaredNorm() is for a Vec3: (dx² + dy²) + dz².
+  [[nodiscard]] double squared_distance(std::uint32_t s, const Vec3& p) const {
+    const double dx = slot_x_[s] - p.x();
+    const double dy = slot_y_[s] - p.y();
+    const double dz = slot_z_[s] - p.z();
+    return dx * dx + dy * dy + dz * dz;
+  }
   /// Slot → the point's index in the constructor's span.
   [[nodiscard]] std::span<const std::uint32_t> slot_index() const { return slot_index_; }
 
   [[nodiscard]] double cell_m() const { return cell_m_; }
-  [[nodiscard]] std::size_t size() const { return slot_points_.size(); }
+  [[nodiscard]] std::size_t size() const { return slot_index_.size(); }
 
  private:
   struct CellRange {
@@ -77,11 +89,18 @@ class PointHashGrid {
   bool box_cells(const Vec3& lo, const Vec3& hi, std::int32_t (&first)[3], std::int32_t (&last)[3],
                  double& cells) const;
 
-  std::vector<Vec3> slot_points_;
+  std::vector<double> slot_x_;
+  std::vector<double> slot_y_;
+  std::vector<double> slot_z_;
   std::vector<std::uint32_t> slot_index_;
   /// Open addressing (linear probing) over the non-empty cells, at most half full.
   std::vector<CellRange> table_;
   Vec3 origin_m_ = Vec3::Zero();
+  /// The points' bounds, grown by margin_m_, and the margin that covers rounding in a point's
+  /// cell (1e-9 of the extent: far above the few ulps floor((p - origin)/cell) can be off).
+  Vec3 bounds_lo_ = Vec3::Zero();
+  Vec3 bounds_hi_ = Vec3::Zero();
+  double margin_m_ = 0.0;
   std::int32_t max_cell_[3] = {0, 0, 0};
   double cell_m_;
   double inv_cell_;
@@ -113,7 +132,7 @@ inline double PointHashGrid::cells_spanned(const Vec3& lo, const Vec3& hi) const
 
 template <class Visit>
 void PointHashGrid::for_each_candidate_run(const Vec3& lo, const Vec3& hi, Visit&& visit) const {
-  if (slot_points_.empty() || !lo.allFinite() || !hi.allFinite()) {
+  if (slot_index_.empty() || !lo.allFinite() || !hi.allFinite()) {
     return;
   }
   std::int32_t first[3], last[3];
@@ -121,15 +140,19 @@ void PointHashGrid::for_each_candidate_run(const Vec3& lo, const Vec3& hi, Visit
   if (!box_cells(lo, hi, first, last, cells)) {
     return;
   }
-  if (cells > static_cast<double>(slot_points_.size())) {
-    visit(std::uint32_t{0}, static_cast<std::uint32_t>(slot_points_.size()));
+  if (cells > static_cast<double>(slot_index_.size())) {
+    visit(std::uint32_t{0}, static_cast<std::uint32_t>(slot_index_.size()), bounds_lo_, bounds_hi_);
     return;
   }
   for (std::int32_t z = first[2]; z <= last[2]; ++z) {
     for (std::int32_t y = first[1]; y <= last[1]; ++y) {
       for (std::int32_t x = first[0]; x <= last[0]; ++x) {
         if (const CellRange* c = find(x, y, z)) {
-          visit(c->begin, c->end);
+          const Vec3 cell_lo =
+              origin_m_ + cell_m_ * Vec3(static_cast<double>(x), static_cast<double>(y),
+                                         static_cast<double>(z));
+          visit(c->begin, c->end, Vec3(cell_lo.array() - margin_m_),
+                Vec3(cell_lo.array() + (cell_m_ + margin_m_)));
         }
       }
     }
@@ -144,9 +167,9 @@ void PointHashGrid::for_each_within(const Vec3& center, double radius_m, Visit&&
   const double r2 = radius_m * radius_m;
   const Vec3 extent = Vec3::Constant(radius_m);
   for_each_candidate_run(center - extent, center + extent,
-                         [&](std::uint32_t first, std::uint32_t last) {
+                         [&](std::uint32_t first, std::uint32_t last, const Vec3&, const Vec3&) {
                            for (std::uint32_t s = first; s < last; ++s) {
-                             const double d2 = (slot_points_[s] - center).squaredNorm();
+                             const double d2 = squared_distance(s, center);
                              if (d2 < r2) {
                                visit(slot_index_[s], d2);
                              }

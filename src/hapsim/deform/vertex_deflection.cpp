@@ -189,13 +189,15 @@ VertexDeflection::VertexDeflection(TriangleMesh rest_mesh, VertexDeflectionOptio
       edge_sum_m += (c[1] - c[0]).norm() + (c[2] - c[1]).norm() + (c[0] - c[2]).norm();
     }
     cell_m = mesh.triangle_count() > 0 ? 2.0 * edge_sum_m / (3.0 * mesh.triangle_count()) : 0.0;
-    // A typical press: a query of radius d0 then spans about 8^3 cells instead of (d0/edge)^3.
+    // A typical press: a query of radius d0 then spans about 5^3 cells instead of (d0/edge)^3
+    // (fewer, fuller cells: per cell, step() tests which contacts reach it, then runs through
+    // its points without branches).
     const double r_m = std::isfinite(options.typical_contact_radius_m)
                            ? std::max(options.typical_contact_radius_m, 0.0)
                            : 0.0;
     for (const DeflectionParams& p : segments_) {
       const double x_m = std::min(p.max_deflection_m, 0.01);
-      cell_m = std::max(cell_m, 0.25 * zero_deflection_distance_m(x_m, r_m, p.elasticity_factor));
+      cell_m = std::max(cell_m, 0.5 * zero_deflection_distance_m(x_m, r_m, p.elasticity_factor));
     }
     if (!(cell_m > 0.0)) {
       const double diag_m = n > 0 ? mesh.bounds().diagonal().norm() : 0.0;
@@ -235,6 +237,7 @@ VertexDeflection::VertexDeflection(TriangleMesh rest_mesh, VertexDeflectionOptio
   moved_triangles_.reserve(mesh.triangle_count());
   last_contacts_.reserve(kMaxHeldContacts);
   prepared_.resize(kBatch);
+  deepest_scratch_.assign(n, 0.0);
 }
 
 double VertexDeflection::deflection_profile_m(double distance_m, double penetration_m,
@@ -307,51 +310,117 @@ bool VertexDeflection::same_contacts_as_last(std::span<const DeflectionContact> 
                     });
 }
 
+// haptic path: a touched slot moves to its target at once when pressed deeper, or recovers
+// towards a shallower one.
+inline void VertexDeflection::settle(std::uint32_t s, double dt_s) {
+  Slot& slot = slots_[s];
+  const double target_m = slot.target_m;
+  const double current_m = slot.offset_m;
+  const double next_m =
+      target_m >= current_m
+          ? target_m
+          : target_m + recovered_gap_m(segments_.size() == 1 ? 0 : segment_of_slot_[s],
+                                       current_m - target_m, dt_s);
+  settled_ = settled_ && next_m == target_m;
+  // Away from rest exactly while listed in active_ (offsets are never negative).
+  if (next_m > 0.0 && !(current_m > 0.0)) {
+    active_.push_back(s);
+  }
+  set_offset(s, next_m);
+}
+
 // haptic path: every slot within d0 of one of `count` contacts gets its target (deepest wins),
-// in one pass over the grid cells of the box [lo, hi] that holds all their reaches.
+// in one pass over the grid cells of the box [lo, hi] that holds all their reaches. Per cell, only
+// the contacts that can reach its box are tried, each over the cell's points in a loop without
+// branches, which the compiler packs two points at a time.
+// `settle_now`: no other pass reaches these slots this step, so each settles as soon as its cell
+// is done (else step() settles the touched list once every pass is done).
 void VertexDeflection::press_group(const PreparedContact* first, std::size_t count, const Vec3& lo,
-                                   const Vec3& hi) {
-  const std::span<const Vec3> points = grid_->slot_points();
-  const bool one_segment = segments_.size() == 1;
-  grid_->for_each_candidate_run(lo, hi, [&](std::uint32_t begin, std::uint32_t end) {
-    for (std::uint32_t s = begin; s < end; ++s) {
-      const Vec3& q = points[s];
-      bool reached = false;
-      double deepest_m = 0.0;
-      for (std::size_t k = 0; k < count; ++k) {
-        const PreparedContact& c = first[k];
-        // The same d² as PointHashGrid::for_each_within, so the same vertices and values.
-        const double d2 = (q - c.p_mesh).squaredNorm();
-        if (!(d2 < c.r2_m2) || (!one_segment && segment_of_slot_[s] != c.segment)) {
-          continue;
-        }
-        // A contact no deeper than what the vertex already gets cannot win (δ ≤ x).
-        if (!reached || c.x_m > deepest_m) {
-          // d2 < d0² here, so the profile needs no range checks.
-          const double delta_m = c.x_m * raised_cosine_of_squared(d2 * c.inv_d0_sq);
-          deepest_m = reached ? std::max(deepest_m, delta_m) : delta_m;
-        }
-        reached = true;
+                                   const Vec3& hi, bool settle_now, double dt_s) {
+  const double* const xs = grid_->slot_x().data();
+  const double* const ys = grid_->slot_y().data();
+  const double* const zs = grid_->slot_z().data();
+  double* const deepest = deepest_scratch_.data();
+  // The deepest δ each of the cell's points gets from contact c (eq. 1 from d² as
+  // deflection_profile_from_squared_m; d² as PointHashGrid::squared_distance, so the same
+  // vertices and values); < 0 stays "not reached". The profile is evaluated for every point (a
+  // finite number past d0 too) and kept only within d0.
+  const auto reach = [&]<bool kOneSegment>(const PreparedContact& c, std::uint32_t begin,
+                                           std::uint32_t n) {
+    const double* const x = xs + begin;
+    const double* const y = ys + begin;
+    const double* const z = zs + begin;
+    const double cx = c.p_mesh.x();
+    const double cy = c.p_mesh.y();
+    const double cz = c.p_mesh.z();
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const double dx = x[i] - cx;
+      const double dy = y[i] - cy;
+      const double dz = z[i] - cz;
+      const double d2 = dx * dx + dy * dy + dz * dz;
+      const double delta_m = c.x_m * raised_cosine_of_squared(d2 * c.inv_d0_sq);
+      const double so_far = deepest[i];
+      const double deeper = so_far < delta_m ? delta_m : so_far;  // std::max(so_far, delta_m)
+      bool within = d2 < c.r2_m2;
+      if constexpr (!kOneSegment) {
+        within = within && segment_of_slot_[begin + i] == c.segment;
       }
-      if (!reached) {
-        continue;
-      }
-      Slot& slot = slots_[s];
-      if (slot.stamp != stamp_) {
-        slot.stamp = stamp_;
-        slot.target_m = deepest_m;
-        touched_.push_back(s);
-      } else {
-        slot.target_m = std::max(slot.target_m, deepest_m);
-      }
+      deepest[i] = within ? deeper : so_far;
     }
-  });
+  };
+  const bool one_segment = segments_.size() == 1;
+  grid_->for_each_candidate_run(
+      lo, hi,
+      [&](std::uint32_t begin, std::uint32_t end, const Vec3& cell_lo, const Vec3& cell_hi) {
+        const std::uint32_t n = end - begin;
+        bool reached = false;
+        for (std::size_t k = 0; k < count; ++k) {
+          const PreparedContact& c = first[k];
+          // The box holds every point of the cell, so a contact whose d0 misses the box misses
+          // them all (the rounded distances are monotone too: never a reaching contact skipped).
+          const Vec3 nearest = c.p_mesh.cwiseMax(cell_lo).cwiseMin(cell_hi);
+          if (!((nearest - c.p_mesh).squaredNorm() < c.r2_m2)) {
+            continue;
+          }
+          if (!reached) {
+            std::fill_n(deepest, n, -1.0);  // δ itself is never negative
+            reached = true;
+          }
+          if (one_segment) {
+            reach.template operator()<true>(c, begin, n);
+          } else {
+            reach.template operator()<false>(c, begin, n);
+          }
+        }
+        if (!reached) {
+          return;
+        }
+        for (std::uint32_t i = 0; i < n; ++i) {
+          if (!(deepest[i] >= 0.0)) {
+            continue;
+          }
+          const std::uint32_t s = begin + i;
+          Slot& slot = slots_[s];
+          if (settle_now) {
+            // The only pass this step: a cell is visited once, so the slot is fresh.
+            slot.stamp = stamp_;
+            slot.target_m = deepest[i];
+            settle(s, dt_s);
+          } else if (slot.stamp != stamp_) {
+            slot.stamp = stamp_;
+            slot.target_m = deepest[i];
+            touched_.push_back(s);
+          } else {
+            slot.target_m = std::max(slot.target_m, deepest[i]);
+          }
+        }
+      });
 }
 
 // haptic path: targets of this step's contacts, a batch at a time. Contacts whose boxes overlap
 // (fingertips side by side on one muscle) share a pass over the grid, so a vertex several of them
 // reach is fetched once.
-void VertexDeflection::press(std::span<const DeflectionContact> contacts) {
+void VertexDeflection::press(std::span<const DeflectionContact> contacts, double dt_s) {
   std::size_t next = 0;
   while (next < contacts.size()) {
     std::size_t prepared = 0;
@@ -418,13 +487,15 @@ void VertexDeflection::press(std::span<const DeflectionContact> contacts) {
     // Each group's contacts side by side, then one pass per group.
     std::sort(prepared_.begin(), prepared_.begin() + static_cast<std::ptrdiff_t>(prepared),
               [](const PreparedContact& a, const PreparedContact& b) { return a.group < b.group; });
+    // One pass in all (one group, one batch: the usual case): slots settle as the pass goes.
+    const bool settle_now = groups == 1 && next == contacts.size() && touched_.empty();
     for (std::size_t k = 0; k < prepared;) {
       std::size_t e = k + 1;
       while (e < prepared && prepared_[e].group == prepared_[k].group) {
         ++e;
       }
       const Box3& box = group_box_[prepared_[k].group];
-      press_group(prepared_.data() + k, e - k, box.min(), box.max());
+      press_group(prepared_.data() + k, e - k, box.min(), box.max(), settle_now, dt_s);
       k = e;
     }
   }
@@ -450,27 +521,16 @@ void VertexDeflection::step(std::span<const DeflectionContact> contacts, double 
 
   if (!held) {
     const std::size_t rejected_before = rejected_;
-    // 1. Target deflection of every vertex near a contact (deepest wins).
-    press(contacts);
-
+    settled_ = true;
+    // 1. Target deflection of every vertex near a contact (deepest wins); with a single pass
+    // over the grid the touched vertices settle there, else:
+    press(contacts, dt_s);
     // 2. Touched vertices: press at once, or recover towards a shallower target.
-    bool settled = true;
     for (const std::uint32_t s : touched_) {
-      Slot& slot = slots_[s];
-      const double target_m = slot.target_m;
-      const double current_m = slot.offset_m;
-      const double next_m = target_m >= current_m
-                                ? target_m
-                                : target_m + recovered_gap_m(one_segment ? 0 : segment_of_slot_[s],
-                                                             current_m - target_m, dt_s);
-      settled = settled && next_m == target_m;
-      // Away from rest exactly while listed in active_ (offsets are never negative).
-      if (next_m > 0.0 && !(current_m > 0.0)) {
-        active_.push_back(s);
-      }
-      set_offset(s, next_m);
+      settle(s, dt_s);
     }
-    held_ = settled && rejected_ == rejected_before && contacts.size() <= last_contacts_.capacity();
+    held_ =
+        settled_ && rejected_ == rejected_before && contacts.size() <= last_contacts_.capacity();
     if (held_) {
       last_contacts_.assign(contacts.begin(), contacts.end());  // within capacity: no allocation
     }

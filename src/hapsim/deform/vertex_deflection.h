@@ -61,8 +61,8 @@ struct VertexDeflectionOptions {
   /// Parameters per segment. Empty → one segment with default parameters.
   std::vector<DeflectionParams> segments;
   /// Edge of the rest-position hash grid cells, metres. 0 → automatic: twice the mean edge
-  /// length, or a quarter of a typical contact's d0 when that is larger (a wide dent on a fine
-  /// mesh would otherwise look up thousands of empty cells).
+  /// length, or half a typical contact's d0 when that is larger (a wide dent on a fine mesh
+  /// would otherwise look up thousands of small cells).
   double grid_cell_m = 0.0;
   /// Radius of the tools expected to press the surface, metres (≥ 0); only sizes the automatic
   /// grid: a typical contact presses min(max_deflection_m, 10 mm) with this radius.
@@ -152,7 +152,7 @@ class VertexDeflection {
   [[nodiscard]] double deflection_m(std::uint32_t v) const {
     return slots_[slot_of_vertex_[v]].offset_m;
   }
-  /// Vertices whose position changed in the last step()/reset(), each once.
+  /// Vertices whose offset (so position) changed in the last step()/reset(), each once.
   [[nodiscard]] std::span<const std::uint32_t> moved_vertices() const { return moved_vertices_; }
   /// Triangles with a moved corner in the last step()/reset(), each once (refit these).
   /// Gathered on the first call after a step, so a step that nobody refits does not pay for it.
@@ -166,7 +166,7 @@ class VertexDeflection {
   [[nodiscard]] std::size_t segment_count() const { return segments_.size(); }
 
  private:
-  /// Per vertex, in the grid's slot order (PointHashGrid::slot_points), what step() reads and
+  /// Per vertex, in the grid's slot order (PointHashGrid::slot_x/y/z), what step() reads and
   /// writes: one cache line holds it for 2-3 vertices that lie side by side.
   struct Slot {
     double offset_m = 0.0;  ///< inward displacement now (≥ 0); > 0 exactly while in active_
@@ -193,8 +193,10 @@ class VertexDeflection {
   void set_offset(std::uint32_t slot, double offset_m);
   void next_stamp();
   void next_moved_stamp();
-  void press(std::span<const DeflectionContact> contacts);
-  void press_group(const PreparedContact* first, std::size_t count, const Vec3& lo, const Vec3& hi);
+  void press(std::span<const DeflectionContact> contacts, double dt_s);
+  void press_group(const PreparedContact* first, std::size_t count, const Vec3& lo, const Vec3& hi,
+                   bool settle_now, double dt_s);
+  void settle(std::uint32_t slot, double dt_s);
   void sync_positions() const;
   [[nodiscard]] bool same_contacts_as_last(std::span<const DeflectionContact> contacts) const;
   [[nodiscard]] double recovered_gap_m(std::uint32_t segment, double gap_m, double dt_s) const;
@@ -234,13 +236,17 @@ class VertexDeflection {
   std::vector<PreparedContact> prepared_;
   std::array<Box3, kBatch> group_box_;
   std::array<double, kBatch> group_cells_{};
+  /// Scratch of press_group(): per slot of a cell, the deepest δ so far (< 0: not reached).
+  std::vector<double> deepest_scratch_;
+  /// This step's touched vertices all reached their targets (a held press can skip the next).
+  bool settled_ = true;
   // Filled lazily by moved_triangles() (a cache of the last step's moved vertices).
   mutable std::vector<std::uint32_t> moved_triangles_;
   mutable std::vector<std::uint32_t> triangle_stamp_lazy_;
   mutable bool moved_triangles_ready_ = true;
-  /// Display bookkeeping, written by the lazy calls (mesh(), update_normals()): slots whose offset
-  /// changed since the positions were last written, each once per display epoch; then the
-  /// vertices written since the last update_normals(), whose one-ring's normals are stale.
+  /// Display bookkeeping: slots whose offset changed since the positions were last written
+  /// (listed by step(), each once per display epoch; written out by mesh()); then the vertices
+  /// written since the last update_normals(), whose one-ring's normals are stale.
   mutable std::vector<std::uint32_t> stale_;
   mutable std::uint32_t display_epoch_ = 1;
   mutable std::vector<std::uint32_t> moved_since_normals_;

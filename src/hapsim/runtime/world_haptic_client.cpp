@@ -7,6 +7,12 @@
 
 namespace hapsim {
 
+namespace {
+
+constexpr std::uint8_t kOwedToAll = 0x7;  // listed for each of the three snapshot slots
+
+}  // namespace
+
 WorldHapticClient::WorldHapticClient(World& world, WorldHapticClientOptions options)
     : world_(world), options_(options) {
   const WorldDescription& d = world_.description();
@@ -24,10 +30,11 @@ WorldHapticClient::WorldHapticClient(World& world, WorldHapticClientOptions opti
       seg.flat = world_.flat_segment(b, s);
       seg.deflection = deflection;
       const std::size_t n = deflection->mesh().vertices.size();
-      for (int k = 0; k < 3; ++k) {
-        seg.pending[static_cast<std::size_t>(k)].reserve(n);
-        seg.is_pending[static_cast<std::size_t>(k)].assign(n, 0);
+      for (std::vector<std::uint32_t>& pending : seg.pending) {
+        pending.assign(n, 0);  // capacity n, pages mapped now
+        pending.clear();
       }
+      seg.owed.assign(n, 0);
       deformable_.push_back(std::move(seg));
     }
   }
@@ -47,13 +54,13 @@ const DeviceCommand& WorldHapticClient::step(const DeviceInput& input, double dt
     soft_start_ = true;
     // Every vertex may have moved back to rest (a rare O(vertices) cycle, asked for by a user).
     for (DeformableSegment& seg : deformable_) {
-      for (std::size_t k = 0; k < 3; ++k) {
-        seg.pending[k].clear();
-        for (std::uint32_t v = 0; v < seg.is_pending[k].size(); ++v) {
-          seg.is_pending[k][v] = 1;
-          seg.pending[k].push_back(v);
+      for (std::vector<std::uint32_t>& pending : seg.pending) {
+        pending.clear();
+        for (std::uint32_t v = 0; v < seg.owed.size(); ++v) {
+          pending.push_back(v);
         }
       }
+      std::fill(seg.owed.begin(), seg.owed.end(), kOwedToAll);
       ++seg.changes;
     }
   }
@@ -92,15 +99,18 @@ void WorldHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
     const auto moved =
         stepped_ ? seg.deflection->moved_vertices() : std::span<const std::uint32_t>{};
     seg.changes += moved.empty() ? 0 : 1;
-    for (std::size_t k = 0; k < 3; ++k) {
-      std::vector<std::uint32_t>& pending = seg.pending[k];
-      std::vector<std::uint8_t>& flag = seg.is_pending[k];
-      for (const std::uint32_t v : moved) {
-        if (flag[v] == 0) {
-          flag[v] = 1;
-          pending.push_back(v);  // capacity = vertex count: never reallocates
+    for (const std::uint32_t v : moved) {
+      std::uint8_t& owed = seg.owed[v];
+      if (owed == kOwedToAll) {
+        continue;
+      }
+      // Listed once per slot (capacity = vertex count: never reallocates).
+      for (std::size_t k = 0; k < 3; ++k) {
+        if ((owed & (1u << k)) == 0) {
+          seg.pending[k].push_back(v);
         }
       }
+      owed = kOwedToAll;
     }
     double& peak = max_deflection_m_[seg.flat];
     peak = std::max(peak, seg.deflection->max_deflection_m());
@@ -156,7 +166,7 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
   }
   for (DeformableSegment& seg : deformable_) {
     std::vector<std::uint32_t>& pending = seg.pending[slot];
-    std::vector<std::uint8_t>& flag = seg.is_pending[slot];
+    const auto not_owed = static_cast<std::uint8_t>(~(1u << slot));
     s.deflection_m[seg.flat] = seg.deflection->max_deflection_m();
     if (pending.empty()) {
       continue;
@@ -170,7 +180,7 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
       xyz[3 * v + 0] = static_cast<float>(p.x());
       xyz[3 * v + 1] = static_cast<float>(p.y());
       xyz[3 * v + 2] = static_cast<float>(p.z());
-      flag[v] = 0;
+      seg.owed[v] &= not_owed;
     }
     pending.clear();
     s.positions_version[seg.flat] = seg.changes;

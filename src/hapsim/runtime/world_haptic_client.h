@@ -74,9 +74,10 @@ class WorldHapticClient final : public HapticClient {
   struct DeformableSegment {
     std::size_t flat = 0;
     const VertexDeflection* deflection = nullptr;
-    // Per triple-buffer slot: vertices moved since that slot was last written, and flags.
+    // Per triple-buffer slot: vertices moved since that slot was last written; per vertex, bit k
+    // set when it is listed for slot k (one byte to test for the three slots).
     std::array<std::vector<std::uint32_t>, 3> pending;
-    std::array<std::vector<std::uint8_t>, 3> is_pending;
+    std::vector<std::uint8_t> owed;
     std::uint64_t changes = 0;  // steps that moved a vertex: the published version
   };
 

@@ -78,7 +78,9 @@ class World {
 
   /// The rest-shape query of a segment (body frame): the one step() uses.
   [[nodiscard]] const ProximityQuery& rest_query(std::size_t body, std::size_t segment) const;
-  /// The segment's current (deformed) surface, body frame.
+  /// The segment's current (deformed) surface, body frame. For a deformable segment this writes
+  /// the positions the steps left pending (they are display data, written lazily: see
+  /// VertexDeflection::mesh()), so only on the thread that steps, or while nothing steps.
   [[nodiscard]] const TriangleMesh& surface(std::size_t body, std::size_t segment) const;
   /// Exact query on the current (deformed) surface, refitted if it moved since the last call.
   /// Not on the haptic path (the refit is O(segment size)); for display, picking and checks.
