@@ -3,8 +3,8 @@
 // loader. The schema is checked by a small JSON Schema (draft 2020-12) validator written here for
 // the keywords the file uses; it refuses any other keyword, so the schema cannot quietly grow
 // beyond what is checked. (Debian's python3-jsonschema agrees, but CI does not install it.)
-#include "hapsim/core/error.h"
 #include "hapsim/core/device_profile.h"
+#include "hapsim/core/error.h"
 #include "hapsim/scene/scene_file.h"
 
 #include <gtest/gtest.h>
