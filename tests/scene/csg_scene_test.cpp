@@ -8,6 +8,8 @@
 #include "hapsim/core/error.h"
 #include "hapsim/world/world.h"
 
+#include "support/temp_dir_test.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -48,24 +50,11 @@ Json dimple_scene() {
   })");
 }
 
-class CsgSceneTest : public ::testing::Test {
+class CsgSceneTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hapsim_csg_scene_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   fs::path write(const Json& scene) const {
-    const fs::path p = dir_ / "scene.json";
-    std::ofstream(p, std::ios::binary) << scene.dump(2);
-    return p;
+    return TempDirTest::write("scene.json", scene.dump(2));
   }
-
-  fs::path dir_;
 };
 
 DeviceInput at(const Vec3& p) {

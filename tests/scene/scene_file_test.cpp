@@ -7,6 +7,8 @@
 #include "hapsim/core/error.h"
 #include "hapsim/geometry/triangle_mesh.h"
 
+#include "support/temp_dir_test.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -26,24 +28,8 @@ namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
 // A folder of its own per test binary run, removed at the end.
-class SceneFileTest : public ::testing::Test {
+class SceneFileTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hapsim_scene_file_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
-
   // A small valid scene: a rigid block, a deformable ball beside it, one probe on a desktop
   // stylus, a one-press palpation of the block from above.
   static Json base() {
@@ -89,8 +75,6 @@ class SceneFileTest : public ::testing::Test {
       EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
     }
   }
-
-  fs::path dir_;
 };
 
 struct Mutation {

@@ -10,6 +10,8 @@
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 
+#include "support/temp_dir_test.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -30,24 +32,8 @@ bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
 
-class SceneWarningsTest : public ::testing::Test {
+class SceneWarningsTest : public test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hapsim_scene_warnings_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  fs::path write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-    return p;
-  }
-
   // A cube `edge_m` on a side written with `units_per_metre` file units per metre (1000: mm).
   fs::path write_cube(const std::string& name, double edge_m, double units_per_metre) const {
     const fs::path p = dir_ / name;
@@ -82,8 +68,6 @@ class SceneWarningsTest : public ::testing::Test {
   SceneDescription load(const Json& scene) const {
     return load_scene(write("scene.json", scene.dump(2)), {});
   }
-
-  fs::path dir_;
 };
 
 TEST_F(SceneWarningsTest, MeshInMillimetresReadAsMetresWarnsOnceWithTheScaleThatFixesIt) {

@@ -247,11 +247,8 @@ void read_device(const SceneReader& r, const Json& j, const std::string& ptr,
                     "' (a script)");
   }
   if (j.contains("trajectory")) {
-    d.trajectory_file =
-        r.path(j["trajectory"], JsonReader::at(ptr, "trajectory"), "a trajectory CSV path");
-    if (!std::filesystem::is_regular_file(d.trajectory_file)) {
-      r.fail(JsonReader::at(ptr, "trajectory"), "no such file: " + d.trajectory_file.string());
-    }
+    d.trajectory_file = r.existing_file(j["trajectory"], JsonReader::at(ptr, "trajectory"),
+                                        "a trajectory CSV path");
     return;
   }
   if (glove) {

@@ -18,6 +18,15 @@ std::filesystem::path SceneReader::path(const Json& j, const std::string& ptr,
   return p.is_absolute() ? p : file_.parent_path() / p;
 }
 
+std::filesystem::path SceneReader::existing_file(const Json& j, const std::string& ptr,
+                                                 const std::string& what) const {
+  std::filesystem::path p = path(j, ptr, what);
+  if (!std::filesystem::is_regular_file(p)) {
+    fail(ptr, "no such file: " + p.string());
+  }
+  return p;
+}
+
 std::filesystem::path SceneReader::data_dir(const std::string& ptr) const {
   if (!options_.data_dir.empty()) {
     if (!std::filesystem::is_directory(options_.data_dir)) {

@@ -28,6 +28,9 @@ class SceneReader : public JsonReader {
   /// absolute as written, else relative to the scene file's folder. Existence is not checked.
   [[nodiscard]] std::filesystem::path path(const Json& j, const std::string& ptr,
                                            const std::string& what) const;
+  /// path(), and the file must exist (else an error at `ptr` naming it).
+  [[nodiscard]] std::filesystem::path existing_file(const Json& j, const std::string& ptr,
+                                                    const std::string& what) const;
 
   /// The data folder "data:REL" paths resolve against: options().data_dir, else the scene's
   /// default folder under the data root. An error at `ptr` when it does not exist.

@@ -85,11 +85,8 @@ void read_teleop_device(const SceneReader& r, const Json& j, const std::string& 
            "f0, f1) or 'pick_and_place' (a script)");
   }
   if (j.contains("trajectory")) {
-    d.trajectory_file =
-        r.path(j["trajectory"], JsonReader::at(ptr, "trajectory"), "a trajectory CSV path");
-    if (!std::filesystem::is_regular_file(d.trajectory_file)) {
-      r.fail(JsonReader::at(ptr, "trajectory"), "no such file: " + d.trajectory_file.string());
-    }
+    d.trajectory_file = r.existing_file(j["trajectory"], JsonReader::at(ptr, "trajectory"),
+                                        "a trajectory CSV path");
     return;
   }
   const std::string pp = JsonReader::at(ptr, "pick_and_place");
