@@ -465,6 +465,51 @@ TEST(SphereTree, TreeVsTreeEqualsAllPairsWithFewerTests) {
   EXPECT_EQ(counters_none.sphere_tests, 1U);
 }
 
+// With a margin, the pairs cover every vertex of one mesh that lies within the margin of the other
+// surface (inside or out): what body contact relies on to find vertices that touch or sink in.
+TEST(SphereTree, TreeVsTreeMarginCoversEveryVertexNearTheOtherSurface) {
+  const TriangleMesh ball = make_bumpy_sphere(3000, 0.03);
+  const TriangleMesh sheet = make_sheet(41, 0.2);
+  const SphereTree tree_ball(ball);
+  const SphereTree tree_sheet(sheet);
+  Iso3 X_sheet_ball = Iso3::Identity();
+  X_sheet_ball.rotate(Eigen::AngleAxisd(0.4, Vec3(2, -1, 1).normalized()));
+  X_sheet_ball.translation() = Vec3(-0.01, 0.015, 0.028);  // sunk 2 mm
+  const double margin_m = 0.004;
+
+  std::vector<LeafPair> out;
+  TreeTraversalCounters counters;
+  EXPECT_TRUE(tree_sheet.overlapping_leaves(tree_ball, X_sheet_ball, out, &counters, margin_m));
+  std::set<std::uint32_t> covered;  // ball vertices in some pair's ball leaf
+  for (const LeafPair& lp : out) {
+    for (const std::uint32_t t : tree_ball.leaf_triangles(lp.leaf_b)) {
+      for (const std::uint32_t v : ball.triangles[t]) {
+        covered.insert(v);
+      }
+    }
+  }
+  std::size_t near = 0;
+  for (std::uint32_t v = 0; v < ball.vertices.size(); ++v) {
+    const SurfacePoint sp = tree_sheet.closest_point(X_sheet_ball * ball.vertices[v]);
+    if (std::abs(sp.signed_distance) <= margin_m) {
+      ++near;
+      EXPECT_TRUE(covered.count(v) == 1) << "vertex " << v << " at " << sp.signed_distance;
+    }
+  }
+  EXPECT_GT(near, 20U);
+  // Far fewer tests than all leaf pairs, and the margin only adds pairs.
+  EXPECT_LT(counters.sphere_tests, tree_sheet.leaf_count() * tree_ball.leaf_count() / 20);
+  std::vector<LeafPair> tight;
+  tree_sheet.overlapping_leaves(tree_ball, X_sheet_ball, tight);
+  EXPECT_LT(tight.size(), out.size());
+
+  // A cap stops the descent and says so.
+  std::vector<LeafPair> capped;
+  EXPECT_FALSE(
+      tree_sheet.overlapping_leaves(tree_ball, X_sheet_ball, capped, nullptr, margin_m, 10));
+  EXPECT_EQ(capped.size(), 10U);
+}
+
 TEST(SphereTree, TreeVsTreeTwoBodiesAfterRefit) {
   TriangleMesh a = make_bumpy_sphere(2000, 0.04);
   const TriangleMesh b = make_uv_sphere(0.02, 20, 10);

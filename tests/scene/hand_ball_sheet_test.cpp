@@ -89,6 +89,45 @@ TEST(HandBallSheet, AReplayRunsTheRecordingsLengthNotTheScenes) {
   fs::remove(recording);
 }
 
+// A dynamic body of any closed shape from a scene file: its inertia is the solid's at uniform
+// density (a box's m·(b² + c²)/3 about x for half extents a, b, c), and dropped on the table it
+// comes to rest on its four bottom corners, each a spring of both materials in series carrying a
+// quarter of its weight, while the hand works beside it.
+TEST(HandBallSheet, ADynamicBoxFromTheSceneFileRestsOnTheTable) {
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(kScene));
+  const double a = 0.02;
+  const double b = 0.015;
+  const double c = 0.01;
+  const double mass = 0.2;
+  j["bodies"].push_back({{"name", "block"},
+                         {"type", "dynamic"},
+                         {"mass_kg", mass},
+                         {"pose", {{"position_m", {0.0, 0.12, c + 0.01}}}},
+                         {"geometry", {{"box", {{"half_extents_m", {a, b, c}}}}}},
+                         {"materials", {{"default", "ball"}}}});
+  j["run"]["duration_s"] = 2.0;
+  const SceneDescription scene = parse_scene(j.dump(), kScene);
+  const BodyDescription& block = scene.world.bodies.back();
+  EXPECT_NEAR(block.rigid.inertia_kg_m2(0, 0), mass * (b * b + c * c) / 3.0, 1e-12);
+  EXPECT_NEAR(block.rigid.inertia_kg_m2(2, 2), mass * (a * a + b * b) / 3.0, 1e-12);
+  EXPECT_NEAR(block.rigid.inertia_kg_m2(0, 1), 0.0, 1e-12);
+  RunSetup setup = make_run_setup(scene, DeviceChoice::scene_script());
+  SessionOptions options;
+  options.duration_s = setup.duration_s;
+  options.dt_s = setup.scene.run.dt_s;
+  const SessionSummary s = run_session(*setup.world, *setup.device, options);
+  ASSERT_EQ(s.bodies.size(), 2U);
+  const BodySummary& box = s.bodies.back();
+  EXPECT_EQ(box.name, "block");
+  EXPECT_EQ(box.nonfinite_steps, 0U);
+  EXPECT_EQ(box.touching_at_end, std::vector<std::string>{"table"});
+  EXPECT_LT(box.final_speed_m_per_s, 1e-4);
+  const double k = 2000.0 * 20000.0 / 22000.0;  // ball and table materials in series
+  EXPECT_NEAR(box.final_world.z(), c - mass * 9.81 / (4.0 * k), 2e-6);
+  EXPECT_NEAR(box.final_world.x(), 0.0, 1e-6);
+  EXPECT_NEAR(box.final_world.y(), 0.12, 1e-6);
+}
+
 // Bad dynamic and sheet bodies are refused by the loader, each naming its place.
 TEST(HandBallSheet, BadBodiesAreRefusedByPointer) {
   const nlohmann::json base = nlohmann::json::parse(std::ifstream(kScene));

@@ -271,9 +271,6 @@ TEST(DynamicBody, UnusableBodiesAreRefusedByName) {
   d.bodies[0].rigid.inertia_kg_m2 = Mat3::Identity() * 1e-4;
   d.materials[0].response = ContactResponse::kProxy;
   EXPECT_THROW(World w(d), Error);
-  d.materials[0].response = ContactResponse::kPenalty;
-  d.bodies[0].segments[0].sphere.reset();  // a mesh-shaped dynamic body: not supported yet
-  EXPECT_THROW(World w(d), Error);
 }
 
 }  // namespace

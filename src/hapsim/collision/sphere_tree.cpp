@@ -482,13 +482,13 @@ void SphereTree::refit() {
 // Simultaneous descent: a pair is expanded only when its two spheres overlap; the larger sphere
 // (or the non-leaf) is split, which keeps the pairs' sizes balanced. haptic path: no allocation
 // as long as `out` has capacity.
-void SphereTree::overlapping_leaves(const SphereTree& other, const Iso3& X_this_other,
-                                    std::vector<LeafPair>& out,
-                                    TreeTraversalCounters* counters) const {
+bool SphereTree::overlapping_leaves(const SphereTree& other, const Iso3& X_this_other,
+                                    std::vector<LeafPair>& out, TreeTraversalCounters* counters,
+                                    double margin_m, std::size_t max_pairs) const {
   const Impl& a = *impl_;
   const Impl& b = *other.impl_;
   if (a.nodes.empty() || b.nodes.empty()) {
-    return;
+    return true;
   }
   // Each step pops one pair and pushes at most `children` pairs, along at most
   // depth_a + depth_b steps.
@@ -512,7 +512,7 @@ void SphereTree::overlapping_leaves(const SphereTree& other, const Iso3& X_this_
     const double dx = a.cx[na] - cb.x();
     const double dy = a.cy[na] - cb.y();
     const double dz = a.cz[na] - cb.z();
-    const double reach = a.radius[na] + rb;
+    const double reach = a.radius[na] + rb + margin_m;
     return dx * dx + dy * dy + dz * dz <= reach * reach;
   };
 
@@ -522,6 +522,7 @@ void SphereTree::overlapping_leaves(const SphereTree& other, const Iso3& X_this_
   };
   std::array<Pair, kMaxPairStack> stack;
   std::size_t top = 0;
+  bool complete = true;
   if (overlap(0, center_b(0), b.radius[0])) {
     stack[top++] = {0, 0};
   }
@@ -532,6 +533,10 @@ void SphereTree::overlapping_leaves(const SphereTree& other, const Iso3& X_this_
     const bool leaf_a = na.child_count == 0;
     const bool leaf_b = nb.child_count == 0;
     if (leaf_a && leaf_b) {
+      if (out.size() >= max_pairs) {
+        complete = false;
+        break;
+      }
       out.push_back({a.node_leaf[pair.a], b.node_leaf[pair.b]});
       continue;
     }
@@ -555,6 +560,7 @@ void SphereTree::overlapping_leaves(const SphereTree& other, const Iso3& X_this_
   if (counters != nullptr) {
     counters->sphere_tests += tests;
   }
+  return complete;
 }
 
 std::size_t SphereTree::memory_bytes() const {

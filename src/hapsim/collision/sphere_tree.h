@@ -81,11 +81,15 @@ class SphereTree final : public ProximityQuery {
                               SphereQueryCounters* counters) const;
 
   /// Pairs of leaves whose spheres overlap, with `other` placed by X_this_other (other's frame
-  /// into this tree's frame). Descends only where parent spheres overlap. Appends to `out`
-  /// (reserve it to stay allocation-free on the haptic path).
-  void overlapping_leaves(const SphereTree& other, const Iso3& X_this_other,
-                          std::vector<LeafPair>& out,
-                          TreeTraversalCounters* counters = nullptr) const;
+  /// into this tree's frame). Descends only where parent spheres overlap. Spheres less than
+  /// `margin_m` apart count as overlapping, so every point of either surface within margin_m of
+  /// the other surface lies in a returned pair's leaves. Appends to `out` (reserve it to stay
+  /// allocation-free on the haptic path) until it holds `max_pairs`; returns false when it stopped
+  /// there with pairs left unvisited.
+  bool overlapping_leaves(const SphereTree& other, const Iso3& X_this_other,
+                          std::vector<LeafPair>& out, TreeTraversalCounters* counters = nullptr,
+                          double margin_m = 0.0,
+                          std::size_t max_pairs = static_cast<std::size_t>(-1)) const;
 
   // Structure access (viewer's sphere display, tests of invariants).
   [[nodiscard]] std::size_t node_count() const;

@@ -19,8 +19,12 @@ void deform_sheet(const WorldModel& model, WorldState& state, const SegmentModel
     if (c.other_body != static_cast<std::int32_t>(seg.body)) {
       continue;
     }
-    // A sphere resting on the sheet transcribes its lower cap (paper 000 §3.2.2, Fig. 2).
+    // A sphere resting on the sheet transcribes its lower cap (paper 000 §3.2.2, Fig. 2); a
+    // mesh presses it through its pushes only.
     const auto b = static_cast<std::size_t>(c.body);
+    if (!model.bodies()[b].sphere) {
+      continue;
+    }
     const ExactSphere& sphere = *model.bodies()[b].sphere;
     sheet.sheet->imprint_sphere(X_sheet_world * (state.bodies[b].X_world_body * sphere.center_body),
                                 sphere.radius_m);

@@ -149,12 +149,18 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
       // the other (the closest point on the segment slides over it as the geometry changes).
       StickPoint stick{tool.stick_body[c.segment].active,
                        body.X_world_body * tool.stick_body[c.segment].p};
-      const Vec3 f = f_normal + contact_friction_force(material, f_normal.norm(), c.n_world, v_rel,
-                                                       tool.p_world - radius * c.n_world, stick);
+      const Vec3 f_friction = contact_friction_force(material, f_normal.norm(), c.n_world, v_rel,
+                                                     tool.p_world - radius * c.n_world, stick);
+      const Vec3 f = f_normal + f_friction;
       tool.stick_body[c.segment] = {stick.active, body.X_body_world * stick.p};
       if (seg.dynamic) {
         body.force_world_n -= f;
         body.torque_world_nm -= (c.point_world - body.com_world(body_model.com_body)).cross(f);
+        // The tool is where the device puts it: to the body, a spring to a fixed point.
+        linearise_penalty(body, body_model, c.point_world, c.n_world, material, c.depth_m,
+                          f_normal.norm(), tool.v_world);
+        linearise_friction(body, body_model, c.point_world, c.n_world, material, f_normal.norm(),
+                           f_friction, tool.v_world);
       }
       if (seg.sheet) {
         add_sheet_push(state.segments[c.segment], body.X_body_world, c.point_world, f);

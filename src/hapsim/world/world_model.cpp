@@ -213,24 +213,26 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
       bm.com_body = body.rigid.com_body;
       bm.inertia_body_kg_m2 = body.rigid.inertia_kg_m2;
       bm.inverse_inertia_body = body.rigid.inertia_kg_m2.inverse();
-      if (body.segments.size() != 1 || !body.segments.front().sphere) {
-        // Mesh-against-mesh contact of a moving body (both trees' leaves, vertices refined
-        // against the other's exact surface) is not written yet; say so instead of letting the
-        // body fall through everything.
-        throw Error("body '" + body.name + "'",
-                    "a dynamic body must be one sphere (geometry \"sphere\"): dynamic bodies of "
-                    "other shapes do not collide with other bodies yet");
+      if (body.segments.size() == 1 && body.segments.front().sphere) {
+        bm.sphere = body.segments.front().sphere;
+      } else {
+        has_dynamic_meshes_ = true;
       }
-      bm.sphere = body.segments.front().sphere;
       dynamic_bodies_.push_back(b);
+      for (std::size_t s = 0; s < bm.segment_count; ++s) {
+        dynamic_segments_.push_back(bm.first_segment + s);
+      }
     }
     bodies_.push_back(bm);
   }
   check_sheet_contacts();
   if (!dynamic_bodies_.empty()) {
     for (SegmentModel& seg : segments_) {
-      // Sheets, CSG solids and exact spheres answer body contacts exactly without a tree.
-      if (!seg.sheet && !seg.description->csg && !seg.description->sphere) {
+      // A sheet answers body contacts from its field. A CSG solid or exact sphere answers a
+      // dynamic sphere exactly without a tree; a dynamic mesh finds the vertices that may touch
+      // it through the tree of its polygonised mesh.
+      const bool exact = seg.description->csg || seg.description->sphere;
+      if (!seg.sheet && (!exact || has_dynamic_meshes_)) {
         seg.body_tree = std::make_unique<SphereTree>(seg.description->mesh);
       }
     }

@@ -40,7 +40,7 @@ struct BodyModel {
   Mat3 inertia_body_kg_m2 = Mat3::Identity();
   Mat3 inverse_inertia_body = Mat3::Identity();
   /// A dynamic body of one exactly spherical segment meets other bodies through its centre and
-  /// radius (exact); otherwise through its mesh vertices.
+  /// radius (exact); otherwise through its meshes' vertices (stage_body_contacts.cpp).
   std::optional<ExactSphere> sphere;
 };
 
@@ -64,7 +64,9 @@ struct SegmentModel {
   std::unique_ptr<ProximityQuery> rest_query;
   /// Sphere tree of the rest surface for body-against-body contact (paper 000 §3.1: both bodies'
   /// trees descended where parent spheres overlap, then refined exactly); built only when the
-  /// world has dynamic bodies, and not for sheets (their field answers directly).
+  /// world has dynamic bodies, and not for sheets (their field answers directly). A CSG solid's
+  /// or exact sphere's tree is over its polygonised mesh: it finds candidate vertices, the exact
+  /// solid refines.
   std::unique_ptr<SphereTree> body_tree;
 };
 
@@ -87,6 +89,12 @@ class WorldModel {
   [[nodiscard]] const std::vector<BodyModel>& bodies() const { return bodies_; }
   /// Indices of the dynamic bodies, in body order.
   [[nodiscard]] const std::vector<std::size_t>& dynamic_bodies() const { return dynamic_bodies_; }
+  /// Flat indices of the dynamic bodies' segments, in flat order.
+  [[nodiscard]] const std::vector<std::size_t>& dynamic_segments() const {
+    return dynamic_segments_;
+  }
+  /// Whether some dynamic body is not an exact sphere (it meets others through its vertices).
+  [[nodiscard]] bool has_dynamic_meshes() const { return has_dynamic_meshes_; }
   [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const {
     return body_first_segment_.at(body) + segment;
   }
@@ -111,6 +119,8 @@ class WorldModel {
   std::vector<SegmentModel> segments_;
   std::vector<BodyModel> bodies_;
   std::vector<std::size_t> dynamic_bodies_;
+  std::vector<std::size_t> dynamic_segments_;
+  bool has_dynamic_meshes_ = false;
   std::vector<std::size_t> body_first_segment_;
   std::size_t proxy_segments_ = 0;
   std::size_t penalty_segments_ = 0;

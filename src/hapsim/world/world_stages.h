@@ -9,14 +9,16 @@
 //   detect_contacts  penalty segments: each tool against each segment's rest surface (a sheet: its
 //                    live field), which side it presses from (never pulled through a thin
 //                    segment), less the dent others left under it
-//   body_contacts    each dynamic body (a sphere) against every other body's segments through their
-//                    sphere trees, refined exactly: one spring of both materials in series, with
-//                    friction, equal and opposite on both; pushes on sheets
+//   body_contacts    each dynamic body against every other body's segments through both bodies'
+//                    sphere trees, refined exactly (a sphere's centre, a mesh's vertices): springs
+//                    of both materials in series, with friction, equal and opposite on both;
+//                    pushes on sheets
 //   respond          proxy segments: the god-object moves its proxy and the spring gives the force;
 //                    penalty segments: F = k·x with damping and friction, the reaction on a dynamic
 //                    body, the push on a sheet; contacts reported, deformation fed; a rig's grasp
 //                    read off its pads' contacts with the ball
-//   integrate        dynamic bodies move under gravity and this step's forces (semi-implicit Euler)
+//   integrate        dynamic bodies move under gravity and this step's forces (semi-implicit Euler,
+//                    the contacts' springs and dampers taken implicitly)
 //   deform           deformable segments deflect under this step's contacts (eq. 1), the rest
 //                    recover; sheets take this step's pushes and the imprint of resting spheres
 //   safety           what leaves the world is finite: per-tool forces, then the device command
@@ -32,6 +34,9 @@ namespace hapsim {
 class WorldModel;
 struct WorldState;
 struct SegmentState;
+struct BodyState;
+struct BodyModel;
+struct ContactMaterial;
 
 namespace stage {
 
@@ -45,6 +50,18 @@ void respond(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void integrate(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void deform(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void safety(const WorldModel& model, WorldState& state) noexcept;
+
+/// The contact spring of a penalty contact (normal n_world, force magnitude force_n, at
+/// p_world; its other end moving at v_anchor_world) on a dynamic body, for the integrate stage
+/// to take implicitly; nothing where the force is clamped (zero, the force or depth cap).
+/// haptic path
+void linearise_penalty(BodyState& body, const BodyModel& bm, const Vec3& p_world,
+                       const Vec3& n_world, const ContactMaterial& material, double depth_m,
+                       double force_n, const Vec3& v_anchor_world) noexcept;
+/// The same for a friction stick spring (tangential), only while it sticks. haptic path
+void linearise_friction(BodyState& body, const BodyModel& bm, const Vec3& p_world,
+                        const Vec3& n_world, const ContactMaterial& material, double normal_force_n,
+                        const Vec3& f_friction_n, const Vec3& v_anchor_world) noexcept;
 
 /// A push on a sheet segment this step: the force that pushes the presser out, at `p_world`;
 /// the deform stage displaces the sheet by it.

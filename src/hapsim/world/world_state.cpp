@@ -34,6 +34,23 @@ void RigState::reset() {
 
 RigState::~RigState() = default;
 
+// haptic path
+void BodyState::add_contact_spring(const Vec3& p_world, const Vec3& com_body, const Mat3& S,
+                                   const Mat3& D, const Vec3& v_anchor_world) noexcept {
+  if (!dynamic) {
+    return;
+  }
+  // The point's velocity is J·[v; ω] with J = [I, −[r]×]; a force f there is Jᵀ·f on the body.
+  const Vec3 r = p_world - com_world(com_body);
+  Mat3 r_cross;
+  r_cross << 0.0, -r.z(), r.y(), r.z(), 0.0, -r.x(), -r.y(), r.x(), 0.0;
+  Eigen::Matrix<double, 3, 6> J;
+  J << Mat3::Identity(), -r_cross;
+  stiffness_6.noalias() += J.transpose() * S * J;
+  damping_6.noalias() += J.transpose() * D * J;
+  anchor_6.noalias() += J.transpose() * (S * v_anchor_world);
+}
+
 namespace {
 
 // Every body at its start pose and velocity.
@@ -60,7 +77,13 @@ WorldState::WorldState(const WorldModel& model) {
   const std::vector<SegmentModel>& segs = model.segments();
   segments.resize(segs.size());
   place_bodies(model, bodies);
-  body_pairs.resize(model.dynamic_bodies().size() * segs.size());
+  body_pairs.resize(model.dynamic_segments().size() * segs.size());
+  if (model.has_dynamic_meshes()) {
+    leaf_pairs.reserve(kMaxBodyLeafPairs);
+    for (std::size_t i = 0; i < segs.size(); ++i) {
+      segments[i].vertex_pass.assign(segs[i].description->mesh.vertex_count(), 0);
+    }
+  }
   body_contacts.resize(std::max<std::size_t>(body_pairs.size(), 1));
   sheet_depth_m.assign(
       static_cast<std::size_t>(
@@ -77,7 +100,7 @@ WorldState::WorldState(const WorldModel& model) {
         throw Error("body '" + body.name + "'", e.what());
       }
       segments[i].sheet_query = std::make_unique<SheetQuery>(*segments[i].sheet);
-      segments[i].sheet_pushes.resize(tool_count + model.dynamic_bodies().size() + 1);
+      segments[i].sheet_pushes.resize(tool_count + model.dynamic_segments().size() + 1);
       continue;
     }
     if (!seg.deformable) {
@@ -190,6 +213,10 @@ void WorldState::reset() {
   }
   place_bodies(*model_, bodies);
   std::fill(body_pairs.begin(), body_pairs.end(), BodyPairState{});
+  for (SegmentState& seg : segments) {
+    std::fill(seg.vertex_pass.begin(), seg.vertex_pass.end(), 0);
+  }
+  vertex_pass = 0;
   std::fill(sheet_depth_m.begin(), sheet_depth_m.end(), 0.0);
   body_contact_count = 0;
   for (ToolState& state : tool_states) {

@@ -3,6 +3,7 @@
 // (world_stages.h) fills it. The model (world_model.h) is never written by a step.
 #pragma once
 
+#include "hapsim/collision/sphere_tree.h"
 #include "hapsim/core/device_io.h"
 #include "hapsim/core/types.h"
 #include "hapsim/deform/vertex_deflection.h"
@@ -63,18 +64,38 @@ struct BodyState {
   /// (respond and body-contact stages), world frame.
   Vec3 force_world_n = Vec3::Zero();
   Vec3 torque_world_nm = Vec3::Zero();
+  /// This step's contact springs and dampers on the body, linearised about its centre of mass in
+  /// its generalised velocity [v_world; ω_world] (dynamic bodies only): what lets the integrate
+  /// stage treat them implicitly, so that stiff contacts on a light or small body stay stable.
+  Eigen::Matrix<double, 6, 6> stiffness_6 = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> damping_6 = Eigen::Matrix<double, 6, 6>::Zero();
+  /// Σ Jᵀ·S·v_anchor: the springs' other ends move (a tool, a pad, another body), so a spring
+  /// stretches by dt·(v_point − v_anchor), not dt·v_point.
+  Eigen::Matrix<double, 6, 1> anchor_6 = Eigen::Matrix<double, 6, 1>::Zero();
   /// The centre of mass, world frame.
   [[nodiscard]] Vec3 com_world(const Vec3& com_body) const { return X_world_body * com_body; }
+  /// Adds a spring of stiffness matrix S and damper D (world frame, N/m and N·s/m) acting at
+  /// `p_world`, whose other end moves at `v_anchor_world`, to stiffness_6 / damping_6 / anchor_6
+  /// (no-op for a body that does not move). haptic path
+  void add_contact_spring(const Vec3& p_world, const Vec3& com_body, const Mat3& S, const Mat3& D,
+                          const Vec3& v_anchor_world) noexcept;
   /// Velocity of the body's material point at `p_world`.
   [[nodiscard]] Vec3 velocity_at(const Vec3& p_world, const Vec3& com_body) const {
     return v_world + w_world.cross(p_world - com_world(com_body));
   }
 };
 
-/// Per (dynamic body, flat segment) pair: what the body-contact stage remembers between steps.
+/// Overlapping leaf pairs one dynamic mesh and one other segment may have in one step; beyond it
+/// the pair's contacts are partial and WorldState::dropped_body_contacts counts it.
+inline constexpr std::size_t kMaxBodyLeafPairs = 16384;
+
+/// Per (dynamic segment, flat segment) pair: what the body-contact stage remembers between steps.
 struct BodyPairState {
-  QueryHint hint;
+  QueryHint hint;         ///< the other segment's query
+  QueryHint hint_own;     ///< the dynamic segment's own query (a mesh's: the other's vertices)
   StickPoint stick_body;  ///< friction stick point, in the other segment's body frame
+  /// A dynamic mesh: its material point that friction holds there, in its own body frame.
+  Vec3 stick_own_body = Vec3::Zero();
   bool touching = false;
 };
 
@@ -181,6 +202,9 @@ struct SegmentState {
   std::size_t sheet_push_count = 0;
   /// The sheet's mesh changed this step (deform stage).
   bool sheet_dirty = false;
+  /// Body-contact stage, worlds with dynamic meshes: per rest-mesh vertex, the pass that last
+  /// tried it (each vertex is tried once per pair however many leaf pairs hold it).
+  std::vector<std::uint32_t> vertex_pass;
 };
 
 /// Per-step state of one tool.
@@ -266,8 +290,13 @@ struct WorldState {
   std::vector<SegmentState> segments;  ///< per flat segment
   std::vector<ToolRuntime> tools;
   std::vector<BodyState> bodies;  ///< per body
-  /// Per (dynamic body i of model.dynamic_bodies(), flat segment s): [i · segments + s].
+  /// Per (dynamic segment i of model.dynamic_segments(), flat segment s): [i · segments + s].
   std::vector<BodyPairState> body_pairs;
+  /// Body-contact stage scratch for dynamic meshes: overlapping leaves (capacity fixed at
+  /// construction; a pair with more counts in dropped_body_contacts, its contacts partial) and
+  /// the pass number behind SegmentState::vertex_pass.
+  std::vector<LeafPair> leaf_pairs;
+  std::uint32_t vertex_pass = 0;
   /// Body contacts stage: this step's contacts of dynamic bodies, capacity fixed at construction.
   std::vector<BodyContact> body_contacts;
   std::size_t body_contact_count = 0;

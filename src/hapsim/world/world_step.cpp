@@ -55,6 +55,11 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   for (BodyState& body : state.bodies) {
     body.force_world_n.setZero();
     body.torque_world_nm.setZero();
+    if (body.dynamic) {
+      body.stiffness_6.setZero();
+      body.damping_6.setZero();
+      body.anchor_6.setZero();
+    }
   }
 
   stage::place_tools(model, state, input, dt);

@@ -1,0 +1,255 @@
+// Dynamic bodies of any closed mesh in the one world, against analytic answers: a cube dropped on
+// a floor rests on its four bottom corners, each a vertex spring carrying a quarter of its weight
+// (k·x = m·g / 4, the two materials in series); a cube dropped tilted lands on a face; a small
+// cube stacked on a dynamic cube is carried by it and both by the floor; a probe pushing a cube
+// along the floor feels the dynamic friction μ·m·g; a cube rests on the Gaussian sheet, which
+// carries its weight; the step stays allocation-free and replays to the same bits.
+#include "hapsim/geometry/mass_properties.h"
+#include "hapsim/geometry/procedural.h"
+#include "hapsim/world/world.h"
+
+#include "support/allocation_counter.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace hapsim {
+namespace {
+
+constexpr double kG = 9.81;
+
+MaterialDescription penalty(const char* name, double k, double friction) {
+  MaterialDescription m;
+  m.name = name;
+  m.response = ContactResponse::kPenalty;
+  m.contact.stiffness_n_per_m = k;
+  m.contact.max_penetration_m = 0.01;
+  m.contact.max_force_n = 50.0;
+  m.contact.static_friction = friction;
+  m.contact.dynamic_friction = friction;
+  return m;
+}
+
+// A dynamic cube of half side `half_m` (a 12-triangle mesh) whose mass properties come from its
+// mesh, as a scene file's would.
+BodyDescription cube_body(const char* name, double half_m, double mass_kg, const Iso3& X_world,
+                          std::uint32_t material) {
+  BodyDescription b;
+  b.name = name;
+  b.kind = BodyKind::kDynamic;
+  b.X_world_body = X_world;
+  SegmentDescription s;
+  s.name = name;
+  s.material = material;
+  s.mesh = make_box(Vec3::Constant(half_m));
+  const MassProperties mp = mass_properties(s.mesh);
+  b.rigid.mass_kg = mass_kg;
+  b.rigid.com_body = mp.com;
+  b.rigid.inertia_kg_m2 = mp.inertia_per_density * (mass_kg / mp.volume_m3);
+  b.segments.push_back(std::move(s));
+  return b;
+}
+
+// A static floor box whose top face is z = 0.
+BodyDescription floor_body(std::uint32_t material) {
+  BodyDescription b;
+  b.name = "floor";
+  b.X_world_body = Iso3(Eigen::Translation3d(0.0, 0.0, -0.05));
+  SegmentDescription s;
+  s.name = "floor";
+  s.material = material;
+  s.mesh = make_box(Vec3(0.3, 0.3, 0.05));
+  b.segments.push_back(std::move(s));
+  return b;
+}
+
+Iso3 at(const Vec3& p) {
+  return Iso3(Eigen::Translation3d(p));
+}
+
+DeviceInput probe_at(const Vec3& p) {
+  DeviceInput in;
+  in.p_world = p;
+  return in;
+}
+
+const DeviceInput kAway = probe_at(Vec3(0.0, 0.0, 1.0));
+
+TEST(DynamicMesh, CubeDroppedOnTheFloorRestsOnItsFourCorners) {
+  const double half = 0.02;
+  const double mass = 0.2;
+  WorldDescription d;
+  d.materials = {penalty("cube", 20000.0, 0.5), penalty("floor", 20000.0, 0.5)};
+  d.bodies = {floor_body(1), cube_body("cube", half, mass, at(Vec3(0.0, 0.0, half + 0.01)), 0)};
+  d.tools.push_back(ToolDescription{"probe", 0.005, Vec3::Zero(), -1});
+  World world(std::move(d));
+  for (int i = 0; i < 2000; ++i) {
+    world.step(kAway, 1e-3);
+    ASSERT_TRUE(world.body_pose(1).matrix().allFinite());
+  }
+  // Four corner springs of 10 kN/m (both materials in series) carry m·g.
+  const double x = mass * kG / (4.0 * 10000.0);
+  const Iso3 X = world.body_pose(1);
+  EXPECT_NEAR(X.translation().z(), half - x, 1e-6);
+  EXPECT_NEAR(X.translation().x(), 0.0, 1e-9);
+  EXPECT_NEAR(X.translation().y(), 0.0, 1e-9);
+  EXPECT_LT((X.linear() - Mat3::Identity()).norm(), 1e-6) << "lands flat, does not turn";
+  EXPECT_LT(world.state().bodies[1].v_world.norm(), 1e-4);
+  ASSERT_EQ(world.last_result().body_contacts.size(), 1U) << "one contact per pair of segments";
+  const BodyContact& c = world.last_result().body_contacts.front();
+  EXPECT_EQ(c.other_body, 0);
+  EXPECT_NEAR(c.force_world_n.z(), mass * kG, 1e-4);
+  EXPECT_NEAR(c.normal_world.z(), 1.0, 1e-9);
+  EXPECT_NEAR(c.depth_m, x, 1e-6);
+}
+
+TEST(DynamicMesh, CubeDroppedTiltedLandsOnAFace) {
+  const double half = 0.02;
+  const double mass = 0.2;
+  Iso3 X0 = at(Vec3(0.01, -0.02, 0.06));
+  X0.rotate(Eigen::AngleAxisd(0.5, Vec3(1.0, 0.4, 0.0).normalized()));
+  WorldDescription d;
+  d.materials = {penalty("cube", 20000.0, 0.6), penalty("floor", 20000.0, 0.6)};
+  d.bodies = {floor_body(1), cube_body("cube", half, mass, X0, 0)};
+  d.tools.push_back(ToolDescription{"probe", 0.005, Vec3::Zero(), -1});
+  World world(std::move(d));
+  double highest_speed = 0.0;
+  for (int i = 0; i < 4000; ++i) {
+    world.step(kAway, 1e-3);
+    ASSERT_TRUE(world.body_pose(1).matrix().allFinite());
+    highest_speed = std::max(highest_speed, world.state().bodies[1].v_world.norm());
+  }
+  // Free fall from 6 cm bounds every speed (nothing adds energy).
+  EXPECT_LT(highest_speed, std::sqrt(2.0 * kG * 0.06) * 1.05);
+  const Iso3 X = world.body_pose(1);
+  // One of the cube's axes is vertical: it lies on a face...
+  const Vec3 up_body = X.linear().transpose() * Vec3::UnitZ();
+  EXPECT_GT(up_body.cwiseAbs().maxCoeff(), std::cos(0.5 * M_PI / 180.0)) << up_body.transpose();
+  // ...at the height four corner springs carry it, at rest.
+  EXPECT_NEAR(X.translation().z(), half - mass * kG / (4.0 * 10000.0), 1e-5);
+  EXPECT_LT(world.state().bodies[1].v_world.norm(), 1e-3);
+  EXPECT_LT(world.state().bodies[1].w_world.norm(), 1e-2);
+}
+
+TEST(DynamicMesh, SmallCubeStackedOnACubeIsCarriedAndBothByTheFloor) {
+  const double big = 0.02;
+  const double small = 0.01;
+  const double m_big = 0.2;
+  const double m_small = 0.05;
+  const auto make = [&] {
+    WorldDescription d;
+    d.materials = {penalty("cube", 20000.0, 0.5), penalty("floor", 20000.0, 0.5)};
+    d.bodies = {
+        floor_body(1), cube_body("big", big, m_big, at(Vec3(0.0, 0.0, big + 0.002)), 0),
+        cube_body("small", small, m_small, at(Vec3(0.003, -0.002, 2.0 * big + small + 0.006)), 0)};
+    d.tools.push_back(ToolDescription{"probe", 0.005, Vec3::Zero(), -1});
+    return std::make_unique<World>(std::move(d));
+  };
+  auto world = make();
+  for (int i = 0; i < 200; ++i) {
+    world->step(kAway, 1e-3);
+  }
+  const long before = test::allocation_count();
+  for (int i = 200; i < 3000; ++i) {
+    world->step(kAway, 1e-3);
+  }
+  EXPECT_EQ(test::allocation_count() - before, 0) << "the step allocates nothing";
+  // Floor under the big cube: 4 corners carry both weights; the small cube's 4 bottom corners
+  // press into the big cube's top face and carry its own.
+  const double k = 10000.0;
+  const double z_big = big - (m_big + m_small) * kG / (4.0 * k);
+  const double z_small = z_big + big + small - m_small * kG / (4.0 * k);
+  EXPECT_NEAR(world->body_pose(1).translation().z(), z_big, 1e-6);
+  EXPECT_NEAR(world->body_pose(2).translation().z(), z_small, 1e-6);
+  EXPECT_NEAR(world->body_pose(2).translation().x(), 0.003, 1e-4) << "stays where it landed";
+  EXPECT_LT(world->state().bodies[2].v_world.norm(), 1e-4);
+  ASSERT_EQ(world->last_result().body_contacts.size(), 2U);
+  for (const BodyContact& c : world->last_result().body_contacts) {
+    const double carried = c.other_body == 0 ? (m_big + m_small) * kG : m_small * kG;
+    // The lower-numbered body answers for a pair: the big cube, pushed down by the small one.
+    const double sign = c.other_body == 0 ? 1.0 : -1.0;
+    EXPECT_NEAR(sign * c.force_world_n.z(), carried, 1e-4) << "contact with " << c.other_body;
+  }
+  // The same run again gives the same bits.
+  auto again = make();
+  for (int i = 0; i < 3000; ++i) {
+    again->step(kAway, 1e-3);
+  }
+  EXPECT_EQ(again->body_pose(2).matrix(), world->body_pose(2).matrix());
+  EXPECT_EQ(again->body_pose(1).matrix(), world->body_pose(1).matrix());
+}
+
+TEST(DynamicMesh, ProbePushingACubeAlongTheFloorFeelsDynamicFriction) {
+  const double half = 0.02;
+  const double mass = 0.2;
+  const double mu = 0.4;
+  WorldDescription d;
+  d.materials = {penalty("cube", 20000.0, mu), penalty("floor", 20000.0, mu),
+                 penalty("probe side", 2000.0, 0.0)};
+  d.bodies = {floor_body(1), cube_body("cube", half, mass, at(Vec3(0.0, 0.0, half)), 0)};
+  d.tools.push_back(ToolDescription{"probe", 0.005, Vec3::Zero(), -1});
+  World world(std::move(d));
+  for (int i = 0; i < 300; ++i) {
+    world.step(kAway, 1e-3);  // settle
+  }
+  // The probe comes from −x at the cube's mid-height and pushes at 2 cm/s for 1.5 s.
+  const double x0 = -half - 0.005 - 0.002;
+  double push_sum_n = 0.0;
+  double load_sum_n = 0.0;  // what the probe adds to the weight (its own friction on the face)
+  int samples = 0;
+  for (int i = 0; i <= 1500; ++i) {
+    const double x = x0 + 0.02 * i / 1000.0;
+    const StepResult& r = world.step(probe_at(Vec3(x, 0.0, half)), 1e-3);
+    if (i > 800) {  // sliding steadily
+      push_sum_n -= r.tools[0].force_world_n.x();
+      load_sum_n += r.tools[0].force_world_n.z();
+      ++samples;
+      EXPECT_NEAR(world.state().bodies[1].v_world.x(), 0.02, 1e-4) << "at the probe's speed";
+    }
+  }
+  const double moved = world.body_pose(1).translation().x();
+  EXPECT_GT(moved, 0.02);
+  EXPECT_LT(moved, 0.03);
+  // While it slides at constant speed, the probe holds the cube against the floor's dynamic
+  // friction μ·N, N the weight and what the probe's own friction on the face presses down.
+  const double normal_n = mass * kG + load_sum_n / samples;
+  EXPECT_NEAR(push_sum_n / samples, mu * normal_n, 1e-3 * mu * normal_n);
+  // Pushed at mid-height from the side, it slides upright.
+  EXPECT_LT((world.body_pose(1).linear() - Mat3::Identity()).norm(), 0.02);
+}
+
+TEST(DynamicMesh, CubeOnTheSheetIsCarried) {
+  const double half = 0.015;
+  const double mass = 0.05;
+  WorldDescription d;
+  d.materials = {penalty("cube", 3000.0, 0.5), penalty("sheet", 3000.0, 0.5)};
+  BodyDescription sheet;
+  sheet.name = "sheet";
+  sheet.kind = BodyKind::kDeformable;
+  sheet.deformation = BodyDeformation::kGaussianSheet;
+  SegmentDescription s;
+  s.name = "sheet";
+  s.material = 1;
+  s.mesh = make_sheet(sheet.sheet.nodes_per_side, sheet.sheet.side_m);
+  s.two_sided = true;
+  sheet.segments.push_back(std::move(s));
+  d.bodies.push_back(std::move(sheet));
+  d.bodies.push_back(cube_body("cube", half, mass, at(Vec3(0.01, 0.0, half + 0.005)), 0));
+  d.tools.push_back(ToolDescription{"probe", 0.005, Vec3::Zero(), -1});
+  World world(std::move(d));
+  for (int i = 0; i < 4000; ++i) {
+    world.step(kAway, 1e-3);
+    ASSERT_TRUE(world.body_pose(1).matrix().allFinite());
+  }
+  EXPECT_LT(world.state().bodies[1].v_world.norm(), 1e-3);
+  ASSERT_EQ(world.last_result().body_contacts.size(), 1U);
+  EXPECT_NEAR(world.last_result().body_contacts.front().force_world_n.z(), mass * kG, 1e-3);
+  // The sheet sank under it (its elastic field is below rest where the cube sits).
+  const Vec3 p = world.body_pose(1).translation();
+  EXPECT_LT(world.sheet(0)->height_at(p.x(), p.y(), SheetLayer::kElastic), -1e-4);
+  EXPECT_LT(p.z(), half);
+}
+
+}  // namespace
+}  // namespace hapsim
