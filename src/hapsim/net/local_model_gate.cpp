@@ -23,26 +23,6 @@ bool within(const double (&values)[N], double limit) noexcept {
 
 }  // namespace
 
-const char* verdict_name(SampleVerdict verdict) noexcept {
-  switch (verdict) {
-    case SampleVerdict::kAccepted:
-      return "accepted";
-    case SampleVerdict::kMalformed:
-      return "malformed";
-    case SampleVerdict::kOutOfRange:
-      return "out of range";
-    case SampleVerdict::kOtherScene:
-      return "other scene";
-    case SampleVerdict::kOtherDevice:
-      return "other device";
-    case SampleVerdict::kOutOfOrder:
-      return "out of order";
-    case SampleVerdict::kStale:
-      return "stale";
-  }
-  return "?";
-}
-
 LocalModelGate::LocalModelGate(std::uint16_t device_id, std::uint64_t scene_hash, int finger_count,
                                LocalModelLimits limits) noexcept
     : device_id_(device_id),

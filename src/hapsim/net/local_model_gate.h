@@ -6,6 +6,7 @@
 
 #include "hapsim/core/device_io.h"
 #include "hapsim/force/local_contact_model.h"
+#include "hapsim/net/sample_verdict.h"
 #include "hapsim_messages.h"
 
 #include <array>
@@ -13,19 +14,6 @@
 #include <cstdint>
 
 namespace hapsim::net {
-
-enum class SampleVerdict : std::uint8_t {
-  kAccepted,
-  kMalformed,   ///< a non-finite number, or a key outside the device's fingers
-  kOutOfRange,  ///< finite but beyond what any contact can mean (limits below)
-  kOtherScene,  ///< made for another scene than the one this device is in
-  kOtherDevice,
-  kOutOfOrder,  ///< not newer than the newest accepted for its key (late, duplicated, reordered)
-  kStale,       ///< answers a device state older than max_age_cycles of the device's own cycles
-};
-inline constexpr std::size_t kSampleVerdicts = 7;
-
-[[nodiscard]] const char* verdict_name(SampleVerdict verdict) noexcept;
 
 /// Bounds of a believable model (a wild but finite sample is refused, not clamped: it says the
 /// sender is wrong, and its f0 or K would be applied at full weight by the renderer).
