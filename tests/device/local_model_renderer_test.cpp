@@ -2,6 +2,8 @@
 
 #include "hapsim/core/error.h"
 
+#include "support/allocation_counter.h"
+
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -96,6 +98,19 @@ TEST(LocalModelRenderer, BlendsANewModelInOverTheBlendTime) {
   EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.05).z(), 1.0, 1e-12);
   EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.06).z(), 2.0, 1e-12);
   EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.07).z(), 3.0, 1e-12);
+}
+
+TEST(LocalModelRenderer, ReceivingAndRenderingAllocateNothing) {
+  LocalModelRenderer r;
+  const long before = test::allocation_count();
+  Vec3 sum = Vec3::Zero();
+  for (int k = 0; k < 1000; ++k) {  // haptic path
+    const double t_s = 1e-3 * k;
+    r.receive(wall_model(static_cast<std::uint64_t>(k) + 1), t_s);
+    sum += r.render(Vec3(0.0, 0.0, -0.002), Vec3::Zero(), t_s);
+  }
+  EXPECT_EQ(test::allocation_count() - before, 0);
+  EXPECT_TRUE(sum.allFinite());
 }
 
 TEST(LocalModelRenderer, RefusesBrokenModelsAndNeverReturnsNaN) {

@@ -1,6 +1,7 @@
 #include "hapsim/net/local_model_gate.h"
 
 #include "net/net_test_support.h"
+#include "support/allocation_counter.h"
 
 #include <limits>
 
@@ -77,6 +78,20 @@ TEST(LocalModelGate, AcceptsInOrderAndCountsEachReason) {
   EXPECT_EQ(gate.count(SampleVerdict::kStale), 1u);
   EXPECT_EQ(gate.rejected(), 12u);
   EXPECT_STREQ(verdict_name(SampleVerdict::kStale), "stale");
+}
+
+TEST(LocalModelGate, AdmittingAndCodingAllocateNothing) {
+  LocalModelGate gate(kDeviceId, kSceneHash, 1);
+  LocalContactModel out;
+  std::uint64_t accepted = 0;
+  const long before = hapsim::test::allocation_count();
+  for (std::uint64_t s = 1; s <= 1000; ++s) {  // haptic path
+    const hapsim_msg_LocalModel m =
+        encode_local_model(test::model_for(s), {kDeviceId, 0}, kSceneHash);
+    accepted += gate.admit(m, s, out) == SampleVerdict::kAccepted ? 1 : 0;
+  }
+  EXPECT_EQ(hapsim::test::allocation_count() - before, 0);
+  EXPECT_EQ(accepted, 1000u);
 }
 
 TEST(LocalModelGate, OrdersEachFingerOnItsOwn) {

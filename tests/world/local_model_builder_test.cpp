@@ -6,6 +6,8 @@
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/world/world.h"
 
+#include "support/allocation_counter.h"
+
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -66,6 +68,18 @@ TEST(LocalModelBuilder, RigidFaceModelPredictsTheStepOneMillimetreDeeper) {
   World other(box_world());
   const double stepped_n = other.step(at(deeper), 1e-3).tools[0].force_world_n.z();
   EXPECT_NEAR(local_model_force(m, deeper, Vec3::Zero()).z(), stepped_n, 1e-9);
+}
+
+TEST(LocalModelBuilder, BuildingAllocatesNothing) {
+  World world(box_world());
+  const LocalModelBuilder builder(world.model());
+  std::array<LocalContactModel, 1> models;
+  world.step(at(Vec3(0.0, 0.0, -0.002)), 1e-3);
+  const long before = test::allocation_count();
+  for (std::uint64_t k = 1; k <= 100; ++k) {
+    builder.build(world.state(), k, k, models);  // haptic path
+  }
+  EXPECT_EQ(test::allocation_count() - before, 0);
 }
 
 TEST(LocalModelBuilder, ASaturatedSpringHasNoStiffness) {
