@@ -9,10 +9,10 @@
 // rms about its mean over the last second.
 #include "hapsim/device/local_model_renderer.h"
 #include "hapsim/force/local_contact_model.h"
+#include "hapsim/net/link_shim.h"
 
 #include <cmath>
 #include <cstdint>
-#include <deque>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -79,38 +79,6 @@ double quasi_static_force_n(double x_m) {
 
 enum class Mode { kRaw, kLocalSeries, kLocalContact };
 
-// One direction of the link: seeded i.i.d. loss, fixed one-way delay in cycles.
-template <typename T>
-class Link {
- public:
-  Link(int delay_cycles, double loss, std::uint32_t seed)
-      : delay_(delay_cycles), loss_(loss), rng_(seed) {}
-  void send(std::int64_t now, const T& payload) {
-    if (uniform_(rng_) >= loss_) {
-      queue_.push_back({now + delay_, payload});
-    }
-  }
-  // The payloads due by `now`, oldest first.
-  template <typename F>
-  void deliver(std::int64_t now, F&& on_payload) {
-    while (!queue_.empty() && queue_.front().due <= now) {
-      on_payload(queue_.front().payload);
-      queue_.pop_front();
-    }
-  }
-
- private:
-  struct Entry {
-    std::int64_t due;
-    T payload;
-  };
-  int delay_;
-  double loss_;
-  std::mt19937 rng_;
-  std::uniform_real_distribution<double> uniform_{0.0, 1.0};
-  std::deque<Entry> queue_;
-};
-
 struct DeviceState {
   double x_m = 0.0;
   double v_m_per_s = 0.0;
@@ -152,9 +120,15 @@ LocalContactModel local_model(const DeviceState& s, double k_n_per_m, std::uint6
 }
 
 RunResult simulate(Mode mode, int delay_ms, double loss, double duration_s) {
-  const int delay_cycles = delay_ms;  // 1 kHz
-  Link<DeviceState> up(delay_cycles, loss, 12345u);
-  Link<Downlink> down(delay_cycles, loss, 67890u);
+  // The link's clock is the cycle count (1 kHz: one cycle per millisecond), so a delay is a
+  // whole number of cycles exactly.
+  net::LinkShimOptions link;
+  link.delay_s = delay_ms;
+  link.loss = loss;
+  link.seed = 12345u;
+  net::LinkShim<DeviceState, 512> up(link);
+  link.seed = 67890u;
+  net::LinkShim<Downlink, 512> down(link);
   LocalModelRenderer renderer(LocalModelRenderOptions{kMaxForce_n, 0.02, 0.1, 0.05});
   DeviceState device{kStart_m, 0.0, 0.0, 0};
   double raw_force_n = 0.0;  // raw mode: the newest force received, held
@@ -167,7 +141,8 @@ RunResult simulate(Mode mode, int delay_ms, double loss, double duration_s) {
   for (std::int64_t k = 0; k < steps; ++k) {
     const double now_s = static_cast<double>(k) * kDt_s;
     // Device side: take what arrived, render from its own fresh state.
-    down.deliver(k, [&](const Downlink& d) {
+    const auto now_cycles = static_cast<double>(k);
+    down.deliver(now_cycles, [&](const Downlink& d) {
       if (mode == Mode::kRaw) {
         raw_force_n = d.raw_force_n;
       } else {
@@ -186,7 +161,7 @@ RunResult simulate(Mode mode, int delay_ms, double loss, double duration_s) {
       sum_sq += force_n * force_n;
     }
     result.peak_force_n = std::max(result.peak_force_n, force_n);
-    up.send(k, device);
+    up.send(device, now_cycles);
     // The device moves under the hand and the rendered force (semi-implicit Euler).
     const double hand_n = kHandStiffness_n_per_m * (kHandTarget_m - device.x_m) -
                           kHandDamping_n_s_per_m * device.v_m_per_s;
@@ -195,7 +170,7 @@ RunResult simulate(Mode mode, int delay_ms, double loss, double duration_s) {
     ++device.sequence;
 
     // Simulation side: answer every device state that arrived.
-    up.deliver(k, [&](const DeviceState& s) {
+    up.deliver(now_cycles, [&](const DeviceState& s) {
       Downlink d;
       if (mode == Mode::kRaw) {
         const double f_n = quasi_static_force_n(s.x_m);
@@ -208,7 +183,7 @@ RunResult simulate(Mode mode, int delay_ms, double loss, double duration_s) {
                 : kContactStiffness_n_per_m;
         d.model = local_model(s, k_n_per_m, ++model_sequence);
       }
-      down.send(k, d);
+      down.send(d, now_cycles);
     });
   }
   const double n = static_cast<double>(steps - tail_from);
@@ -245,7 +220,7 @@ RunResult run_and_print(const Case& c) {
   const RunResult r = simulate(c.mode, c.delay_ms, c.loss, duration_s);
   const double f_star = analytic_steady_force_n();
   std::printf(
-      "1dof %-16s delay %3d ms loss %2.0f %%: mean %.4f N (error %+.2f %%), ripple %.4f N rms, "
+      "1dof %-16s delay %3d ms loss %2.0f %%: mean %.4f N (error %+.2e %%), ripple %.2e N rms, "
       "peak %.2f N\n",
       name(c.mode), c.delay_ms, c.loss * 100.0, r.mean_force_n,
       (r.mean_force_n - f_star) / f_star * 100.0, r.ripple_rms_n, r.peak_force_n);
