@@ -40,7 +40,7 @@ TEST(ServeProcess, PublishesGatedModelsFollowsADeviceHostAndCountsBadStates) {
   hapsim::test::RunResult served;
   std::thread server([&] {
     served = hapsim::test::run_hapsim("serve " + kScene +
-                                      " --duration 5 --session serve-test --domain " +
+                                      " --duration 6 --session serve-test --domain " +
                                       std::to_string(kDomain));
   });
 
@@ -88,8 +88,8 @@ TEST(ServeProcess, PublishesGatedModelsFollowsADeviceHostAndCountsBadStates) {
     });
   };
 
-  // The scene's script drives for a second (the palpation touches the knee within it).
-  for (auto until = Clock::now() + std::chrono::milliseconds(1200); Clock::now() < until;) {
+  // The scene's script drives for two seconds (the palpation touches the knee from 0.9 s).
+  for (auto until = Clock::now() + std::chrono::milliseconds(2000); Clock::now() < until;) {
     drain();
     std::this_thread::sleep_for(std::chrono::microseconds(500));
   }
