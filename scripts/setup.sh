@@ -27,6 +27,9 @@ HAPSIM_PACKAGES=(
   libglfw3-dev libimgui-dev libstb-dev libspnav-dev
   # the viewer's smoke test: xvfb-run (xvfb, which needs xauth) and xdotool for the real X pointer
   xvfb xauth xdotool
+  # the network layer (net/): find_package(CycloneDDS) for libddsc and its headers, and idlc
+  # (cyclonedds-tools) that idlc_generate runs at build time on the topics' IDL
+  cyclonedds-dev cyclonedds-tools
   # tests and benchmarks: find_package(GTest) with GMock, find_package(benchmark), and
   # find_package(ZLIB) for the golden run traces (tests/golden/*.trace.gz)
   libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev

@@ -24,5 +24,6 @@ void add_bench_command(CLI::App& app);
 void add_run_command(CLI::App& app);
 void add_view_command(CLI::App& app);
 void add_kinematics_commands(CLI::App& app);
+void add_serve_command(CLI::App& app);
 
 }  // namespace hapsim::app

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   add_run_command(app);
   add_view_command(app);
   add_kinematics_commands(app);
+  add_serve_command(app);
 #ifdef HAPSIM_WITH_BENCH
   add_bench_command(app);
 #endif

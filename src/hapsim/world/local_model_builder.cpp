@@ -1,0 +1,76 @@
+#include "hapsim/world/local_model_builder.h"
+
+#include "hapsim/deform/sheet_profile.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hapsim {
+
+LocalModelBuilder::LocalModelBuilder(const WorldModel& model, LocalModelBuildOptions options)
+    : model_(&model), options_(options) {
+  const WorldDescription& d = model.description();
+  tissue_stiffness_n_per_m_.reserve(model.segments().size());
+  for (const SegmentModel& seg : model.segments()) {
+    double k = kInf;
+    if (seg.sheet) {
+      const double compliance_m_per_n =
+          GaussianSheetProfile(d.bodies[seg.body].sheet_profile).depth_m(0.0, 1.0);
+      k = compliance_m_per_n > 0.0 ? 1.0 / compliance_m_per_n : kInf;
+    }
+    tissue_stiffness_n_per_m_.push_back(k);
+  }
+}
+
+// haptic path
+void LocalModelBuilder::build(const WorldState& state, std::uint64_t sequence,
+                              std::uint64_t device_sequence,
+                              std::span<LocalContactModel> out) const noexcept {
+  const std::size_t tools = std::min(out.size(), state.tool_states.size());
+  for (std::size_t t = 0; t < tools; ++t) {
+    LocalContactModel& m = out[t];
+    const ToolState& tool = state.tool_states[t];
+    m = LocalContactModel{};
+    m.x0_world_m = state.tools[t].p_world;
+    m.v0_world_m_per_s = state.tools[t].v_world;
+    m.f0_world_n = tool.force_world_n.allFinite() ? tool.force_world_n : Vec3::Zero();
+    m.validity_radius_m = options_.validity_radius_m;
+    m.sim_time_s = state.time_s;
+    m.sequence = sequence;
+    m.device_sequence = device_sequence;
+    m.valid = state.input_usable && m.x0_world_m.allFinite() && m.v0_world_m_per_s.allFinite();
+  }
+  for (std::size_t i = 0; i < state.contact_count; ++i) {
+    const WorldContact& c = state.contacts[i];
+    const auto t = static_cast<std::size_t>(c.tool);
+    if (c.tool < 0 || t >= tools || !c.normal_world.allFinite()) {
+      continue;
+    }
+    const std::size_t flat =
+        model_->flat_segment(static_cast<std::size_t>(c.body), static_cast<std::size_t>(c.segment));
+    const ContactMaterial& material = state.materials[model_->segments()[flat].material];
+    LocalContactModel& m = out[t];
+    const Mat3 nn = c.normal_world * c.normal_world.transpose();
+    // A saturated spring (at its maximum penetration or force) pushes no harder deeper in.
+    const bool saturated =
+        c.depth_m >= material.max_penetration_m || c.force_n >= material.max_force_n * (1.0 - 1e-9);
+    if (!saturated) {
+      m.stiffness_n_per_m +=
+          series_stiffness_n_per_m(material.stiffness_n_per_m, tissue_stiffness_n_per_m_[flat]) *
+          nn;
+    }
+    m.damping_n_s_per_m += std::max(material.damping_n_s_per_m, 0.0) * nn;
+    if (m.normal_world.isZero()) {
+      m.normal_world = c.normal_world;
+    }
+  }
+  // The push-only rule follows the force the step rendered where there is one.
+  for (std::size_t t = 0; t < tools; ++t) {
+    const double f_n = out[t].f0_world_n.norm();
+    if (f_n > 0.0) {
+      out[t].normal_world = out[t].f0_world_n / f_n;
+    }
+  }
+}
+
+}  // namespace hapsim

@@ -1,0 +1,135 @@
+#include "hapsim/device/local_model_renderer.h"
+
+#include "hapsim/core/error.h"
+
+#include "support/allocation_counter.h"
+
+#include <limits>
+
+#include <gtest/gtest.h>
+
+namespace hapsim {
+namespace {
+
+// A wall along +z at z = 0 pressed to 1 mm: f0 = 1 N up, K = 1000 N/m along z.
+LocalContactModel wall_model(std::uint64_t sequence = 1) {
+  LocalContactModel m;
+  m.x0_world_m = Vec3(0.0, 0.0, -0.001);
+  m.f0_world_n = Vec3(0.0, 0.0, 1.0);
+  m.stiffness_n_per_m = Vec3(0.0, 0.0, 1000.0).asDiagonal();
+  m.damping_n_s_per_m = Vec3(0.0, 0.0, 2.0).asDiagonal();
+  m.normal_world = Vec3::UnitZ();
+  m.validity_radius_m = 0.01;
+  m.sequence = sequence;
+  m.valid = true;
+  return m;
+}
+
+LocalModelRenderOptions no_blend() {
+  return {10.0, 0.0, 0.1, 0.05};
+}
+
+TEST(LocalContactModel, SeriesStiffness) {
+  EXPECT_DOUBLE_EQ(series_stiffness_n_per_m(2000.0, 2000.0), 1000.0);
+  EXPECT_DOUBLE_EQ(series_stiffness_n_per_m(2000.0, kInf), 2000.0);  // rigid body
+  EXPECT_EQ(series_stiffness_n_per_m(2000.0, -1.0), 0.0);
+  EXPECT_EQ(series_stiffness_n_per_m(std::numeric_limits<double>::quiet_NaN(), 1.0), 0.0);
+}
+
+TEST(LocalContactModel, TissueCoupledForceIsTheQuasiStaticForceForSeriesStiffness) {
+  // Linear tissue k_t = 500 under a contact k_c = 2000: series 400 N/m. At x0 = 10 mm with the
+  // tissue settled under a rendered 3 N (y = 6 mm, compression 4 mm), the quasi-static force at
+  // x0 is 400 · 0.01 = 4 N whatever was rendered.
+  const double k_s = series_stiffness_n_per_m(2000.0, 500.0);
+  const double y_m = 3.0 / 500.0;
+  EXPECT_NEAR(tissue_coupled_force_n(3.0, 0.01 - y_m, 2000.0, k_s), 4.0, 1e-12);
+  // With the contact stiffness alone it is the contact spring's own force, k_c · compression.
+  EXPECT_NEAR(tissue_coupled_force_n(3.0, 0.01 - y_m, 2000.0, 2000.0), 2000.0 * (0.01 - y_m),
+              1e-12);
+}
+
+TEST(LocalModelRenderer, RendersTheLinearModelAtTheDevicesOwnPosition) {
+  LocalModelRenderer r(no_blend());
+  r.receive(wall_model(), 0.0);
+  // 1 mm deeper than x0: 1 N + 1000 N/m · 1 mm = 2 N up; moving down at 0.1 m/s adds 0.2 N.
+  const Vec3 f = r.render(Vec3(0.0, 0.0, -0.002), Vec3(0.0, 0.0, -0.1), 0.001);
+  EXPECT_NEAR(f.z(), 2.2, 1e-12);
+  EXPECT_NEAR(f.x(), 0.0, 1e-12);
+}
+
+TEST(LocalModelRenderer, PushOnlyRadiusAndClamp) {
+  LocalModelRenderer r(no_blend());
+  r.receive(wall_model(), 0.0);
+  EXPECT_EQ(r.render(Vec3(0.0, 0.0, 0.001), Vec3::Zero(), 0.0), Vec3::Zero());    // would pull
+  EXPECT_EQ(r.render(Vec3(0.0, 0.02, -0.001), Vec3::Zero(), 0.0), Vec3::Zero());  // outside
+  const Vec3 f = r.render(Vec3(0.0, 0.0, -0.009), Vec3::Zero(), 0.0);             // 9 N
+  EXPECT_NEAR(f.z(), 9.0, 1e-9);
+  LocalModelRenderer tight({5.0, 0.0, 0.1, 0.05});
+  tight.receive(wall_model(), 0.0);
+  EXPECT_NEAR(tight.render(Vec3(0.0, 0.0, -0.009), Vec3::Zero(), 0.0).norm(), 5.0, 1e-12);
+  EXPECT_EQ(r.counts().pull_zeroed, 1u);
+  EXPECT_EQ(r.counts().outside_radius, 1u);
+  EXPECT_EQ(tight.counts().clamped, 1u);
+}
+
+TEST(LocalModelRenderer, FadesToZeroWhenTheNewestModelGoesStale) {
+  LocalModelRenderer r(no_blend());  // stale after 100 ms, faded out 50 ms later
+  r.receive(wall_model(), 1.0);
+  const Vec3 x0(0.0, 0.0, -0.001);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 1.1).z(), 1.0, 1e-12);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 1.125).z(), 0.5, 1e-9);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 1.15).z(), 0.0, 1e-9);
+  EXPECT_EQ(r.render(x0, Vec3::Zero(), 1.151).z(), 0.0);
+  EXPECT_EQ(r.render(x0, Vec3::Zero(), 5.0).z(), 0.0);
+  // A fresh model brings the force back.
+  r.receive(wall_model(2), 5.0);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 5.001).z(), 1.0, 1e-12);
+}
+
+TEST(LocalModelRenderer, BlendsANewModelInOverTheBlendTime) {
+  LocalModelRenderer r({10.0, 0.02, 0.1, 0.05});
+  r.receive(wall_model(1), 0.0);
+  const Vec3 x0(0.0, 0.0, -0.001);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.0).z(), 0.0, 1e-12);  // from nothing
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.02).z(), 1.0, 1e-12);
+  LocalContactModel harder = wall_model(2);
+  harder.f0_world_n.z() = 3.0;
+  r.receive(harder, 0.05);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.05).z(), 1.0, 1e-12);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.06).z(), 2.0, 1e-12);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.07).z(), 3.0, 1e-12);
+}
+
+TEST(LocalModelRenderer, ReceivingAndRenderingAllocateNothing) {
+  LocalModelRenderer r;
+  const long before = test::allocation_count();
+  Vec3 sum = Vec3::Zero();
+  for (int k = 0; k < 1000; ++k) {  // haptic path
+    const double t_s = 1e-3 * k;
+    r.receive(wall_model(static_cast<std::uint64_t>(k) + 1), t_s);
+    sum += r.render(Vec3(0.0, 0.0, -0.002), Vec3::Zero(), t_s);
+  }
+  EXPECT_EQ(test::allocation_count() - before, 0);
+  EXPECT_TRUE(sum.allFinite());
+}
+
+TEST(LocalModelRenderer, RefusesBrokenModelsAndNeverReturnsNaN) {
+  LocalModelRenderer r(no_blend());
+  r.receive(wall_model(), 0.0);
+  LocalContactModel broken = wall_model(2);
+  broken.f0_world_n.x() = std::numeric_limits<double>::quiet_NaN();
+  r.receive(broken, 0.001);
+  LocalContactModel negative = wall_model(3);
+  negative.stiffness_n_per_m(2, 2) = -5.0;
+  r.receive(negative, 0.001);
+  EXPECT_EQ(r.counts().models_refused, 2u);
+  EXPECT_EQ(r.newest().sequence, 1u);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(r.render(Vec3(nan, 0.0, 0.0), Vec3::Zero(), 0.002), Vec3::Zero());
+  EXPECT_TRUE(r.render(Vec3(0.0, 0.0, -0.002), Vec3::Zero(), 0.002).allFinite());
+  EXPECT_THROW(LocalModelRenderer({0.0, 0.0, 0.1, 0.05}), Error);
+  EXPECT_THROW(LocalModelRenderer({1.0, -1.0, 0.1, 0.05}), Error);
+}
+
+}  // namespace
+}  // namespace hapsim

@@ -1,0 +1,107 @@
+#include "hapsim/net/local_model_gate.h"
+
+#include "net/net_test_support.h"
+#include "support/allocation_counter.h"
+
+#include <limits>
+
+#include <gtest/gtest.h>
+
+namespace hapsim::net {
+namespace {
+
+using test::kDeviceId;
+using test::kSceneHash;
+using test::message_for;
+
+constexpr std::uint64_t kNow = 100;
+
+TEST(LocalModelCodec, RoundTripsEveryFieldBitForBit) {
+  const hapsim_msg_LocalModel m = message_for(42);
+  const hapsim_msg_LocalModel again =
+      encode_local_model(decode_local_model(m), {kDeviceId, 0}, kSceneHash);
+  EXPECT_TRUE(test::same_bits(m, again));
+  EXPECT_EQ(decode_local_model(m).stiffness_n_per_m(0, 2), 2.0);  // row-major
+}
+
+TEST(LocalModelGate, AcceptsInOrderAndCountsEachReason) {
+  LocalModelGate gate(kDeviceId, kSceneHash, 1);
+  LocalContactModel out;
+  EXPECT_EQ(gate.admit(message_for(10), kNow, out), SampleVerdict::kAccepted);
+  EXPECT_EQ(out.sequence, 10u);
+
+  hapsim_msg_LocalModel nan_force = message_for(11);
+  nan_force.f0_n[1] = std::numeric_limits<double>::quiet_NaN();
+  hapsim_msg_LocalModel inf_k = message_for(11);
+  inf_k.stiffness_n_per_m[4] = std::numeric_limits<double>::infinity();
+  hapsim_msg_LocalModel bad_finger = message_for(11);
+  bad_finger.finger = 1;  // the device has one
+  hapsim_msg_LocalModel huge_force = message_for(11);
+  huge_force.f0_n[2] = 1e6;
+  hapsim_msg_LocalModel negative_k = message_for(11);
+  negative_k.stiffness_n_per_m[0] = -1.0;
+  hapsim_msg_LocalModel long_normal = message_for(11);
+  long_normal.normal[2] = 2.0;
+  hapsim_msg_LocalModel future = message_for(11);
+  future.device_sequence = kNow + 1;
+  hapsim_msg_LocalModel other_scene = message_for(11);
+  other_scene.scene_hash ^= 1u;
+  hapsim_msg_LocalModel other_device = message_for(11);
+  other_device.device_id = kDeviceId + 1;
+  hapsim_msg_LocalModel stale = message_for(11);
+  // answers device state 11: stale once the device is 500 cycles past it
+
+  LocalContactModel untouched = out;
+  EXPECT_EQ(gate.admit(nan_force, kNow, out), SampleVerdict::kMalformed);
+  EXPECT_EQ(gate.admit(inf_k, kNow, out), SampleVerdict::kMalformed);
+  EXPECT_EQ(gate.admit(bad_finger, kNow, out), SampleVerdict::kMalformed);
+  EXPECT_EQ(gate.admit(huge_force, kNow, out), SampleVerdict::kOutOfRange);
+  EXPECT_EQ(gate.admit(negative_k, kNow, out), SampleVerdict::kOutOfRange);
+  EXPECT_EQ(gate.admit(long_normal, kNow, out), SampleVerdict::kOutOfRange);
+  EXPECT_EQ(gate.admit(future, kNow, out), SampleVerdict::kOutOfRange);
+  EXPECT_EQ(gate.admit(other_scene, kNow, out), SampleVerdict::kOtherScene);
+  EXPECT_EQ(gate.admit(other_device, kNow, out), SampleVerdict::kOtherDevice);
+  EXPECT_EQ(gate.admit(message_for(10), kNow, out), SampleVerdict::kOutOfOrder);  // duplicate
+  EXPECT_EQ(gate.admit(message_for(9), kNow, out), SampleVerdict::kOutOfOrder);   // late
+  EXPECT_EQ(gate.admit(stale, 11 + 501, out), SampleVerdict::kStale);
+  // Nothing rejected reached the output.
+  EXPECT_EQ(out.sequence, untouched.sequence);
+  EXPECT_EQ(out.f0_world_n, untouched.f0_world_n);
+
+  EXPECT_EQ(gate.admit(message_for(11), kNow, out), SampleVerdict::kAccepted);
+  EXPECT_EQ(gate.count(SampleVerdict::kAccepted), 2u);
+  EXPECT_EQ(gate.count(SampleVerdict::kMalformed), 3u);
+  EXPECT_EQ(gate.count(SampleVerdict::kOutOfRange), 4u);
+  EXPECT_EQ(gate.count(SampleVerdict::kOtherScene), 1u);
+  EXPECT_EQ(gate.count(SampleVerdict::kOtherDevice), 1u);
+  EXPECT_EQ(gate.count(SampleVerdict::kOutOfOrder), 2u);
+  EXPECT_EQ(gate.count(SampleVerdict::kStale), 1u);
+  EXPECT_EQ(gate.rejected(), 12u);
+  EXPECT_STREQ(verdict_name(SampleVerdict::kStale), "stale");
+}
+
+TEST(LocalModelGate, AdmittingAndCodingAllocateNothing) {
+  LocalModelGate gate(kDeviceId, kSceneHash, 1);
+  LocalContactModel out;
+  std::uint64_t accepted = 0;
+  const long before = hapsim::test::allocation_count();
+  for (std::uint64_t s = 1; s <= 1000; ++s) {  // haptic path
+    const hapsim_msg_LocalModel m =
+        encode_local_model(test::model_for(s), {kDeviceId, 0}, kSceneHash);
+    accepted += gate.admit(m, s, out) == SampleVerdict::kAccepted ? 1 : 0;
+  }
+  EXPECT_EQ(hapsim::test::allocation_count() - before, 0);
+  EXPECT_EQ(accepted, 1000u);
+}
+
+TEST(LocalModelGate, OrdersEachFingerOnItsOwn) {
+  LocalModelGate gate(kDeviceId, kSceneHash, 2);
+  LocalContactModel out;
+  hapsim_msg_LocalModel finger1 = message_for(5);
+  finger1.finger = 1;
+  EXPECT_EQ(gate.admit(message_for(7), kNow, out), SampleVerdict::kAccepted);
+  EXPECT_EQ(gate.admit(finger1, kNow, out), SampleVerdict::kAccepted);  // its own sequence
+}
+
+}  // namespace
+}  // namespace hapsim::net

@@ -1,0 +1,64 @@
+// Shared by the network tests: the loopback guard and a deterministic local-model message.
+#pragma once
+
+#include "hapsim/net/local_model_codec.h"
+
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace hapsim::net::test {
+
+/// Every DDS test runs on the shipped loopback config (ctest sets CYCLONEDDS_URI): refuse to
+/// start otherwise, so a test never multicasts on the machine's real interface.
+inline ::testing::AssertionResult on_loopback_config() {
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  const std::string expected = std::string("file://") + HAPSIM_DDS_CONFIG;
+  if (uri == nullptr || expected != uri) {
+    return ::testing::AssertionFailure() << "CYCLONEDDS_URI must be " << expected
+                                         << " (run through ctest), is " << (uri ? uri : "unset");
+  }
+  return ::testing::AssertionSuccess();
+}
+
+inline constexpr std::uint64_t kSceneHash = 0x68617073696d2121ULL;
+inline constexpr std::uint16_t kDeviceId = 3;
+
+/// A model whose every field is a distinct function of `sequence` (so a swapped, truncated or
+/// stale field shows up), valid for the gate's default limits.
+inline LocalContactModel model_for(std::uint64_t sequence) {
+  const double s = static_cast<double>(sequence);
+  LocalContactModel m;
+  m.x0_world_m = Vec3(0.001 * s, -0.002 * s, 0.1 + 1e-7 * s) / 1000.0;
+  m.v0_world_m_per_s = Vec3(0.01, -0.02 + 1e-6 * s, 0.03);
+  m.f0_world_n = Vec3(0.0, 0.0, 1.0 + 1e-3 * s);
+  m.stiffness_n_per_m << 500.0 + s * 1e-3, 1.0, 2.0, 1.0, 600.0, 3.0, 2.0, 3.0, 700.0;
+  m.damping_n_s_per_m = Mat3::Identity() * (0.5 + 1e-9 * s);
+  m.normal_world = Vec3(0.0, 0.0, 1.0);
+  m.validity_radius_m = 0.01;
+  m.sim_time_s = 1e-3 * s;
+  m.sequence = sequence;
+  m.device_sequence = sequence;
+  m.valid = true;
+  return m;
+}
+
+inline hapsim_msg_LocalModel message_for(std::uint64_t sequence) {
+  return encode_local_model(model_for(sequence), {kDeviceId, 0}, kSceneHash);
+}
+
+/// Field by field, bit for bit (the struct's padding bytes are not part of the sample).
+inline bool same_bits(const hapsim_msg_LocalModel& a, const hapsim_msg_LocalModel& b) {
+  const auto eq = [](const auto& x, const auto& y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+  return a.device_id == b.device_id && a.finger == b.finger &&
+         a.model_sequence == b.model_sequence && a.device_sequence == b.device_sequence &&
+         a.scene_hash == b.scene_hash && eq(a.sim_time_s, b.sim_time_s) && eq(a.x0_m, b.x0_m) &&
+         eq(a.v0_m_per_s, b.v0_m_per_s) && eq(a.f0_n, b.f0_n) &&
+         eq(a.stiffness_n_per_m, b.stiffness_n_per_m) &&
+         eq(a.damping_n_s_per_m, b.damping_n_s_per_m) && eq(a.normal, b.normal) &&
+         eq(a.validity_radius_m, b.validity_radius_m) && a.valid == b.valid;
+}
+
+}  // namespace hapsim::net::test
