@@ -1,9 +1,12 @@
 // A teleoperation rig inside the one World: the step's stages move the slave, the ball and the
-// sheet; reset() puts all three back where the description starts them; an unusable master input
-// holds the slave and sends no torque.
+// sheet; reset() puts all three back where the description starts them, without allocating (a
+// viewer's reset runs on the haptic thread), and the run after it is the fresh run's to the bit; an
+// unusable master input holds the slave and sends no torque.
 #include "hapsim/world/world.h"
 
 #include "hapsim/kinematics/procedural_motoman.h"
+
+#include "support/allocation_counter.h"
 
 #include <gtest/gtest.h>
 
@@ -54,6 +57,26 @@ TEST(WorldRig, BallFallsOnTheSheetAndResetPutsEverythingBack) {
   const auto q = world.rig()->slave->q();
   EXPECT_TRUE(std::equal(q.begin(), q.end(), q0.begin()));
   EXPECT_EQ(world.last_result().teleop, &world.rig()->result);
+}
+
+TEST(WorldRig, ResetAllocatesNothingAndTheRunAfterItIsAFreshRun) {
+  World fresh(rig());
+  World world(rig());
+  for (int k = 0; k < 800; ++k) {
+    (void)world.step(master(0.1 + 1e-4 * k), 1e-3);
+  }
+  const long before = test::allocation_count();
+  world.reset();
+  EXPECT_EQ(test::allocation_count() - before, 0);
+  for (int k = 0; k < 800; ++k) {
+    (void)world.step(master(0.3 - 2e-4 * k), 1e-3);
+    (void)fresh.step(master(0.3 - 2e-4 * k), 1e-3);
+  }
+  const std::size_t ball = world.description().teleop->ball_body;
+  EXPECT_EQ(world.body_pose(ball).matrix(), fresh.body_pose(ball).matrix());
+  EXPECT_EQ(world.rig()->slave->tip_pose().matrix(), fresh.rig()->slave->tip_pose().matrix());
+  EXPECT_EQ(world.last_result().command.joint_torque_nm,
+            fresh.last_result().command.joint_torque_nm);
 }
 
 TEST(WorldRig, UnusableMasterInputHoldsTheSlaveAndSendsNoTorque) {

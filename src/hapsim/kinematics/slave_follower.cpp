@@ -30,9 +30,18 @@ SlaveFollower::SlaveFollower(const SerialChain& chain, std::span<const double> q
       !std::isfinite(options_.gripper_speed_m_per_s)) {
     throw Error("slave gripper", "width and speed must be finite and > 0");
   }
+  reset(q_start);
+}
+
+// haptic path
+void SlaveFollower::reset(std::span<const double> q_start) noexcept {
+  const auto n = static_cast<std::size_t>(chain_->dof());
+  q_.fill(0.0);
+  goal_.fill(0.0);
+  std::copy(q_start.begin(),
+            q_start.begin() + static_cast<std::ptrdiff_t>(std::min(n, q_start.size())), q_.begin());
+  chain_->clamp_to_limits({q_.data(), n});
   gripper_width_m_ = options_.gripper_max_width_m;  // starts open
-  std::copy(q_start.begin(), q_start.begin() + chain.dof(), q_.begin());
-  chain.clamp_to_limits({q_.data(), static_cast<std::size_t>(chain.dof())});
 }
 
 SlaveStep SlaveFollower::step(const Iso3& target, double gripper_width_target_m,

@@ -59,6 +59,10 @@ class SlaveFollower {
   SlaveFollower(const SerialChain& chain, std::span<const double> q_start,
                 SlaveFollowerOptions options = {});
 
+  /// Back to `q_start` (dof() values, clamped into the limits) with the gripper open, as the
+  /// constructor leaves it. haptic path (no allocation)
+  void reset(std::span<const double> q_start) noexcept;
+
   /// One cycle towards `target` and `gripper_width_target_m`. A non-finite target leaves the
   /// joints where they are. haptic path (no allocation)
   SlaveStep step(const Iso3& target, double gripper_width_target_m, double dt_s) noexcept;

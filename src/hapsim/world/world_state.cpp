@@ -21,11 +21,12 @@ std::vector<double> start_joints(const TeleopRigDescription& d) {
 
 RigState::RigState(const TeleopRigDescription& rig)
     : description(&rig),
-      slave(std::make_unique<SlaveFollower>(*rig.slave, start_joints(rig), rig.follower)) {}
+      slave_start_rad(start_joints(rig)),
+      slave(std::make_unique<SlaveFollower>(*rig.slave, slave_start_rad, rig.follower)) {}
 
-void RigState::reset() {
-  const TeleopRigDescription& d = *description;
-  slave = std::make_unique<SlaveFollower>(*d.slave, start_joints(d), d.follower);
+// haptic path
+void RigState::reset() noexcept {
+  slave->reset(slave_start_rad);
   input_usable = false;
   has_pad_previous = false;
   held = false;

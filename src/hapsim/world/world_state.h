@@ -248,11 +248,12 @@ struct RigState {
   ~RigState();
   RigState(const RigState&) = delete;
   RigState& operator=(const RigState&) = delete;
-  /// Back to the start: slave at its start joints with the gripper open. Rebuilds the slave
-  /// (allocates): a user's reset, not a cycle's work.
-  void reset();
+  /// Back to the start: slave at its start joints with the gripper open. haptic path (no
+  /// allocation: a reset asked for from the viewer runs on the haptic thread)
+  void reset() noexcept;
 
   const TeleopRigDescription* description = nullptr;  ///< the model's; outlives this state
+  std::vector<double> slave_start_rad;                ///< the slave's start joints, dof() values
 
   std::unique_ptr<SlaveFollower> slave;
   /// Place stage: the master's input was usable (healthy, finite joints).
