@@ -5,6 +5,7 @@
 // it by friction alone; a probe pressing the sheet feels k·x and the sheet moves under it; the
 // step stays allocation-free and replays to the same bits; unusable bodies are refused by name.
 #include "hapsim/core/error.h"
+#include "hapsim/deform/sheet_profile.h"
 #include "hapsim/deform/virtual_sheet.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/world/world.h"
@@ -220,6 +221,37 @@ TEST(DynamicBody, ProbePressingTheSheetFeelsTheSpringAndMovesIt) {
   const SheetContact push{Vec3::Zero(), f};
   reference.apply_contacts({&push, 1});
   EXPECT_NEAR(sink, -reference.height_at(0.0, 0.0, SheetLayer::kElastic), 1e-6);
+}
+
+// A live material edit that would make a press on the sheet overshoot every step (a contact
+// spring stiffer than the sheet gives way under a push, k·compliance ≥ 1) is refused as the loader
+// refuses it; a softer one is taken.
+TEST(DynamicBody, LiveMaterialEditsThatAPressOnTheSheetCannotSettleAreRefused) {
+  WorldDescription d;
+  d.materials = {penalty("ball", 4000.0, 50.0, 0.5), penalty("sheet", 4000.0, 50.0, 0.5)};
+  d.bodies = {sheet_body(1), ball_body(Vec3(0.0, 0.0, 0.1), 0)};
+  const double compliance_m_per_n =
+      GaussianSheetProfile(d.bodies[0].sheet_profile).depth_m(0.0, 1.0);
+  d.tools.push_back(ToolDescription{"probe", 0.005, Vec3::Zero(), -1});
+  const double limit_n_per_m = 1.0 / compliance_m_per_n;
+  // A device rated at half the limit: the tool's press is clamped to it, the ball's is not.
+  WorldOptions options;
+  options.max_stiffness_n_per_m = 0.5 * limit_n_per_m;
+  World world(std::move(d), options);
+  ContactMaterial stiff = world.material_contact(1);
+  stiff.stiffness_n_per_m = 1e9;
+  ContactMaterial stiff_ball = world.material_contact(0);
+  stiff_ball.stiffness_n_per_m = 1e9;
+  EXPECT_TRUE(world.set_material_contact(1, stiff)) << "the tool's press is clamped; 4 kN/m ball";
+  EXPECT_FALSE(world.set_material_contact(0, stiff_ball)) << "ball and sheet in series: 0.5 GN/m";
+  EXPECT_EQ(world.material_contact(0).stiffness_n_per_m, 4000.0) << "nothing changed";
+  stiff_ball.stiffness_n_per_m = 0.9 * limit_n_per_m;  // in series with the stiff sheet: 0.9 L
+  EXPECT_TRUE(world.set_material_contact(0, stiff_ball));
+  // Without the clamp the tool's own press decides.
+  World unclamped(world.description());
+  EXPECT_FALSE(unclamped.set_material_contact(1, stiff));
+  stiff.stiffness_n_per_m = 0.9 * limit_n_per_m;
+  EXPECT_TRUE(unclamped.set_material_contact(1, stiff));
 }
 
 TEST(DynamicBody, StepAllocatesNothingAndReplaysBitForBit) {

@@ -109,7 +109,13 @@ bool World::set_material_contact(std::uint32_t material, const ContactMaterial& 
       !non_negative(c.dynamic_friction) || c.dynamic_friction > c.static_friction) {
     return false;
   }
+  // A sheet that a press would not settle on is refused as the loader refuses it.
+  const ContactMaterial before = state_.material_contact[material];
   state_.material_contact[material] = c;
+  if (!model_.sheet_presses_settle(state_.material_contact)) {
+    state_.material_contact[material] = before;
+    return false;
+  }
   state_.materials_dt_s = -1.0;  // the next step recomputes the effective materials
   return true;
 }

@@ -43,7 +43,8 @@ class World {
   /// haptic path. New contact parameters for material `material` from the next step on (a user
   /// tuning stiffness and limits live). Only on the thread that steps. Returns false, changing
   /// nothing, for a bad index or values a step cannot use (non-finite, stiffness, limits ≤ 0,
-  /// negative damping or friction, dynamic above static friction).
+  /// negative damping or friction, dynamic above static friction) or that a press on a sheet
+  /// would not settle with (WorldModel::sheet_presses_settle).
   bool set_material_contact(std::uint32_t material, const ContactMaterial& contact) noexcept;
   /// haptic path. The next step takes the tools' positions as new, with no velocity from where
   /// they were (after a pause, the device may have moved far: no damping spike).

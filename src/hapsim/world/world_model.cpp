@@ -208,6 +208,9 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
     bm.first_segment = body_first_segment_[b];
     bm.segment_count = body.segments.size();
     bm.sheet = segments_[bm.first_segment].sheet;
+    if (bm.sheet) {
+      bm.sheet_compliance_m_per_n = GaussianSheetProfile(body.sheet_profile).depth_m(0.0, 1.0);
+    }
     if (body.kind == BodyKind::kDynamic) {
       bm.mass_kg = body.rigid.mass_kg;
       bm.com_body = body.rigid.com_body;
@@ -263,33 +266,61 @@ WorldModel::~WorldModel() = default;
 // A sheet answers contacts from its elastic field, which takes this step's push one step later:
 // the push and the field's give settle only while the contact spring is softer than the sheet
 // under a contact, k · compliance < 1 (else the press grows from step to step).
-void WorldModel::check_sheet_contacts() const {
+// haptic path
+bool WorldModel::sheet_presses_settle(std::span<const ContactMaterial> materials,
+                                      SheetPress* unsettled) const noexcept {
   const WorldDescription& d = description_;
-  for (const BodyModel& sheet : bodies_) {
-    if (!sheet.sheet) {
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    if (!bodies_[b].sheet) {
       continue;
     }
-    const BodyDescription& body = d.bodies[static_cast<std::size_t>(&sheet - bodies_.data())];
-    const double compliance_m_per_n = GaussianSheetProfile(body.sheet_profile).depth_m(0.0, 1.0);
-    const ContactMaterial& own = d.materials[body.segments.front().material].contact;
-    const auto check = [&](double k, const std::string& what) {
-      if (!(k * compliance_m_per_n < 1.0)) {
-        throw Error("body '" + body.name + "'",
-                    what + " presses the sheet with " + std::to_string(k) +
-                        " N/m, not softer than the sheet under a contact (" +
-                        std::to_string(1.0 / compliance_m_per_n) +
-                        " N/m): the press would not settle; soften the material or stiffen the "
-                        "sheet (sensitivity_n_per_mm)");
+    const double compliance_m_per_n = bodies_[b].sheet_compliance_m_per_n;
+    const ContactMaterial& own = materials[segments_[bodies_[b].first_segment].material];
+    // Each spring that presses the sheet must be softer than the sheet gives way under it, or the
+    // press overshoots further each step.
+    const auto settles = [&](double k, std::ptrdiff_t presser) {
+      if (k * compliance_m_per_n < 1.0) {
+        return true;
       }
+      if (unsettled != nullptr) {
+        *unsettled = SheetPress{b, presser, k, 1.0 / compliance_m_per_n};
+      }
+      return false;
     };
-    if (!d.tools.empty()) {
-      check(std::min(own.stiffness_n_per_m, options_.max_stiffness_n_per_m), "a tool");
+    if (!d.tools.empty() &&
+        !settles(std::min(own.stiffness_n_per_m, options_.max_stiffness_n_per_m), -1)) {
+      return false;
     }
-    for (const std::size_t b : dynamic_bodies_) {
-      const ContactMaterial& ball = d.materials[d.bodies[b].segments.front().material].contact;
-      check(combine_materials(ball, own).stiffness_n_per_m, "body '" + d.bodies[b].name + "'");
+    for (const std::size_t dyn : dynamic_segments_) {
+      const ContactMaterial& presser = materials[segments_[dyn].material];
+      if (!settles(combine_materials(presser, own).stiffness_n_per_m,
+                   static_cast<std::ptrdiff_t>(segments_[dyn].body))) {
+        return false;
+      }
     }
   }
+  return true;
+}
+
+void WorldModel::check_sheet_contacts() const {
+  std::vector<ContactMaterial> materials;
+  for (const MaterialDescription& m : description_.materials) {
+    materials.push_back(m.contact);
+  }
+  SheetPress press;
+  if (sheet_presses_settle(materials, &press)) {
+    return;
+  }
+  const std::string what =
+      press.presser < 0
+          ? std::string("a tool")
+          : "body '" + description_.bodies[static_cast<std::size_t>(press.presser)].name + "'";
+  throw Error("body '" + description_.bodies[press.sheet_body].name + "'",
+              what + " presses the sheet with " + std::to_string(press.stiffness_n_per_m) +
+                  " N/m, not softer than the sheet under a contact (" +
+                  std::to_string(press.sheet_stiffness_n_per_m) +
+                  " N/m): the press would not settle; soften the material or stiffen the "
+                  "sheet (sensitivity_n_per_mm)");
 }
 
 double WorldModel::slave_width_for(double master_opening_m) const noexcept {

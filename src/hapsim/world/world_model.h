@@ -11,6 +11,7 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,8 @@ struct BodyModel {
   std::size_t first_segment = 0;
   std::size_t segment_count = 0;
   bool sheet = false;  ///< a Gaussian sheet (one segment)
+  /// A sheet: how deep its elastic field sinks under a 1 N push, metres (its profile at d = 0).
+  double sheet_compliance_m_per_n = 0.0;
   // Dynamic bodies only.
   double mass_kg = 0.0;
   Vec3 com_body = Vec3::Zero();
@@ -68,6 +71,15 @@ struct SegmentModel {
   /// or exact sphere's tree is over its polygonised mesh: it finds candidate vertices, the exact
   /// solid refines.
   std::unique_ptr<SphereTree> body_tree;
+};
+
+/// A press on a sheet that would not settle: which sheet (body index), who presses (a body's
+/// index, −1 for the tools) and the two stiffnesses.
+struct SheetPress {
+  std::size_t sheet_body = 0;
+  std::ptrdiff_t presser = -1;
+  double stiffness_n_per_m = 0.0;
+  double sheet_stiffness_n_per_m = 0.0;
 };
 
 class WorldModel {
@@ -105,6 +117,13 @@ class WorldModel {
   /// The rig's slave gripper opening for a master grip opening: the master's range mapped
   /// linearly onto the slave's. 0 without a rig.
   [[nodiscard]] double slave_width_for(double master_opening_m) const noexcept;
+  /// Whether every press on a sheet settles with these contact materials (indexed like the
+  /// description's): each spring that presses a sheet — a tool's (clamped to the device's
+  /// rating), a dynamic body's (both materials in series) — is softer than the sheet gives way
+  /// under it. Otherwise false, with the first that does not in `unsettled`. The model checks
+  /// its own materials at build; a live edit is checked before it is taken. haptic path
+  [[nodiscard]] bool sheet_presses_settle(std::span<const ContactMaterial> materials,
+                                          SheetPress* unsettled = nullptr) const noexcept;
   /// Bytes of all rest-shape query structures (meshes excluded).
   [[nodiscard]] std::size_t query_memory_bytes() const;
   [[nodiscard]] double build_ms() const { return build_ms_; }
