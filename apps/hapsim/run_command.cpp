@@ -421,6 +421,12 @@ void run(const RunArgs& args) {
     j["peak_grasp_force_n"] = t.peak_grasp_force_n;
     j["max_sheet_deflection_m"] = t.max_sheet_deflection_m;
     j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
+    j["slave_collisions"] = {
+        {"steps", t.slave_collision_steps},
+        {"pairs", t.slave_collisions},
+        {"first_s", t.slave_collision_steps > 0 ? nlohmann::json(t.first_slave_collision_s)
+                                                : nlohmann::json(nullptr)},
+        {"bodies", t.slave_collision_bodies}};
     // A scripted pick-and-place must end with the ball within 5 mm of its target (a replay of one
     // is judged by its bit-for-bit comparison instead).
     if (t.target_error_m && !replayed && !t.placed()) {
