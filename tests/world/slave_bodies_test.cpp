@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -232,6 +234,50 @@ TEST(SlaveBodies, ALinkInsideTheFloorIsASlaveCollision) {
           EXPECT_FALSE((r.teleop->slave_collision_bodies >> s.body) & 1U);
         }
       }
+    }
+  }
+}
+
+TEST(SlaveBodies, TheBallPressingThePalmIsFeltAtTheMaster) {
+  // A weightless ball placed against the palm's underside, between the open pads: only the palm
+  // touches it; the master feels that push (the palm is past the wrist, as the pads are). The
+  // same ball beside the arm: nothing felt.
+  const DeviceInput input = master(0.2);
+  TeleopRigDescription d = procedural_rig();
+  d.ball.gravity_m_per_s2 = Vec3::Zero();
+  std::array<double, 3> felt{};
+  for (const bool under_palm : {false, true}) {
+    Iso3 tool = Iso3::Identity();
+    {
+      World dry(rig_world(d));
+      for (int k = 0; k < 2; ++k) {
+        static_cast<void>(dry.step(input, 1e-3));
+      }
+      tool = dry.rig()->result.slave_tool;
+    }
+    const ParallelGripperParams& g = d.gripper;
+    // 2 mm into the palm, whose underside is the pads' top.
+    const double depth_m = g.pad_depth_m - g.pad_half_m.z() + d.ball.radius_m - 0.002;
+    d.ball_start_world = under_palm ? Vec3(tool * Vec3(0.0, 0.0, depth_m)) : Vec3(3.0, 3.0, 3.0);
+    World world(rig_world(d));
+    static_cast<void>(world.step(input, 1e-3));
+    const StepResult& r = world.step(input, 1e-3);
+    std::size_t palm_contacts = 0;
+    for (const BodyContact& c : r.body_contacts) {
+      EXPECT_EQ(world.description().bodies[static_cast<std::size_t>(c.other_body)].name,
+                "slave_gripper_palm");
+      ++palm_contacts;
+    }
+    EXPECT_EQ(palm_contacts, under_palm ? 1U : 0U);
+    ASSERT_EQ(r.command.joint_count, 5);
+    for (std::size_t j = 0; j < 3; ++j) {
+      felt[j] = r.command.joint_torque_nm[j];
+    }
+    const double felt_nm = std::abs(felt[0]) + std::abs(felt[1]) + std::abs(felt[2]);
+    if (under_palm) {
+      EXPECT_GT(felt_nm, 1e-3);
+    } else {
+      EXPECT_EQ(felt_nm, 0.0);
     }
   }
 }
