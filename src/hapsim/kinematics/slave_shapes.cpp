@@ -28,8 +28,9 @@ double link_half_width_m(const SerialChain& chain, int k) {
   return scale * (0.035 - 0.015 * u);
 }
 
-// No edge of a slave box is longer than this: slave collisions test a shape's vertices (a long
-// link crossing a thin table with its corners on both sides still has vertices inside it).
+// No edge of a slave box is longer than this: slave collisions test points spread over a shape's
+// surface (its sphere tree's leaves), so a long link crossing a thin table with its corners on
+// both sides still has some inside it.
 constexpr double kMaxBoxEdgeM = 0.02;
 
 // A closed box with half extents `half`, each face a grid of squares no wider than kMaxBoxEdgeM.

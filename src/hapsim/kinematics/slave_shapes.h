@@ -3,7 +3,7 @@
 // frame, or — for a chain without meshes, like the procedural Motoman — one box per link between
 // consecutive joint origins, tapering towards the tip; the gripper's palm (across the pads'
 // travel, just above them) and the stem from the flange down to it, in the tool frame. Boxes are
-// tessellated (no edge longer than 2 cm): slave collisions test a shape's vertices.
+// tessellated (no edge longer than 2 cm): slave collisions test points spread over a shape.
 #pragma once
 
 #include "hapsim/core/types.h"

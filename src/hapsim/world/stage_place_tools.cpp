@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 namespace hapsim::stage {
 
@@ -98,42 +99,61 @@ Box3 world_bounds(const Box3& box_body, const Iso3& X_world_body) noexcept {
   return Box3(c - h, c + h);
 }
 
-// Whether a vertex of `tree`'s mesh, placed in `other`'s frame by X_other_mine, is deeper than
-// RigState::kCollisionDepthM inside `other`: the tree descended only where its spheres reach
-// other's surface, the leaves' vertices tested. (A link wholly inside a body, without a sphere
-// reaching its surface, is not seen: it went in through the surface, and was counted then.)
-bool penetrates(const SphereTree& tree, const std::vector<std::uint32_t>& node_leaf,
-                const Iso3& X_other_mine, const ProximityQuery& other) noexcept {
-  const TriangleMesh& mesh = tree.mesh();
+// Whether `tree`'s mesh, placed in `other`'s frame by X_other_mine, is deeper than
+// RigState::kCollisionDepthM inside `other`. The tree is descended only where its spheres reach
+// other's surface, the sphere most inside first, so a link through a table finds a leaf inside it
+// (a few triangles, its sphere's centre on them) in about (levels × branching) queries; a leaf
+// counts when its centre is that deep inside. A link hugging the surface without entering it
+// would have every leaf along it tested: after kMaxQueries it is counted as touching (it is
+// within a leaf's size of the surface all along). A link wholly inside a body, with no sphere
+// reaching its surface, is not seen: it went in through the surface, and was counted then.
+bool penetrates(const SphereTree& tree, const Iso3& X_other_mine,
+                const ProximityQuery& other) noexcept {
+  constexpr int kMaxQueries = 64;
+  constexpr std::size_t kMaxSorted = 16;  // children ordered by depth (a tree has 4)
+  const auto is_leaf = [&](std::uint32_t n) { return tree.node_children(n).empty(); };
+  if (tree.node_count() == 0) {
+    return false;
+  }
+  SurfacePoint sp;
+  const Sphere root = tree.node_sphere(0);
+  if (!other.contact_within(X_other_mine * root.center, root.radius, &sp)) {
+    return false;
+  }
+  if (is_leaf(0)) {
+    return sp.signed_distance < -RigState::kCollisionDepthM;
+  }
   std::array<std::uint32_t, 128> stack{};
   std::size_t top = 0;
-  if (tree.node_count() > 0) {
-    stack[top++] = 0;  // the root
-  }
+  stack[top++] = 0;
+  int queries = 1;
   while (top > 0) {
     const std::uint32_t n = stack[--top];
-    const Sphere sphere = tree.node_sphere(n);
-    SurfacePoint sp;
-    if (!other.contact_within(X_other_mine * sphere.center, sphere.radius, &sp)) {
-      continue;
-    }
-    if (node_leaf[n] != RigState::Collider::kNoLeaf) {
-      // Each vertex is within 2 r of other's surface (its sphere reaches the surface).
-      const double reach_m = 2.0 * sphere.radius + RigState::kCollisionDepthM;
-      for (const std::uint32_t t : tree.leaf_triangles(node_leaf[n])) {
-        for (const std::uint32_t v : mesh.triangles[t]) {
-          if (other.contact_within(X_other_mine * mesh.vertices[v], reach_m, &sp) &&
-              sp.signed_distance < -RigState::kCollisionDepthM) {
-            return true;
-          }
-        }
-      }
-      continue;
-    }
+    std::array<std::pair<double, std::uint32_t>, kMaxSorted> reaching{};
+    std::size_t m = 0;
     for (const std::uint32_t child : tree.node_children(n)) {
-      if (top < stack.size()) {
+      if (++queries > kMaxQueries) {
+        return true;
+      }
+      const Sphere sphere = tree.node_sphere(child);
+      if (!other.contact_within(X_other_mine * sphere.center, sphere.radius, &sp)) {
+        continue;
+      }
+      if (is_leaf(child)) {
+        if (sp.signed_distance < -RigState::kCollisionDepthM) {
+          return true;
+        }
+      } else if (m < reaching.size()) {
+        reaching[m++] = {sp.signed_distance, child};
+      } else if (top < stack.size()) {
         stack[top++] = child;
       }
+    }
+    // The most inside last on the stack: visited next.
+    std::sort(reaching.begin(), reaching.begin() + static_cast<std::ptrdiff_t>(m),
+              [](const auto& a, const auto& b) { return a.first > b.first; });
+    for (std::size_t i = 0; i < m && top < stack.size(); ++i) {
+      stack[top++] = reaching[i].second;
     }
   }
   return false;
@@ -155,8 +175,7 @@ void count_slave_collisions(const WorldModel& model, RigState& rig,
         continue;
       }
       const SegmentModel& other = segs[o.flat];
-      if (penetrates(*segs[c.flat].body_tree, c.node_leaf,
-                     state.bodies[o.body].X_body_world * body.X_world_body,
+      if (penetrates(*segs[c.flat].body_tree, state.bodies[o.body].X_body_world * body.X_world_body,
                      state.contact_query(other, o.flat))) {
         ++r.slave_collisions;
         for (const std::size_t b : {c.body, o.body}) {

@@ -66,12 +66,7 @@ void find_slave_collision_pairs(const WorldModel& model, RigState& rig) {
       if (tree == nullptr) {
         continue;  // no body trees: the world has no dynamic body (cannot be a rig's)
       }
-      RigState::Collider c{
-          b, flat, std::vector<std::uint32_t>(tree->node_count(), RigState::Collider::kNoLeaf)};
-      for (std::size_t leaf = 0; leaf < tree->leaf_count(); ++leaf) {
-        c.node_leaf[tree->leaf_node(leaf)] = static_cast<std::uint32_t>(leaf);
-      }
-      rig.colliders.push_back(std::move(c));
+      rig.colliders.push_back({b, flat});
     }
   };
   // The base and the link the first joint turns (the waist) stand on the robot's mount: only the

@@ -249,19 +249,17 @@ struct RigState {
   /// for its velocity.
   std::vector<Iso3> slave_body_previous;
 
-  /// A slave collision is counted when a slave body's vertex is deeper than this inside another
+  /// A slave collision is counted when a slave body's surface is deeper than this inside another
   /// body (a graze is not a hit).
   static constexpr double kCollisionDepthM = 1e-3;
   /// What the place stage checks for slave collisions (built with the world state): the slave's
   /// bodies (not its base and waist — the links on the base frame and joint 0's frame — which
-  /// stand on the robot's mount) with each one's sphere tree's leaf per node, and the bodies they
-  /// cannot push back (static and deformable) with their segments' world bounds (those bodies never
-  /// move).
+  /// stand on the robot's mount; their sphere trees are the body-contact stage's), and the bodies
+  /// they cannot push back (static and deformable) with their segments' world bounds (those
+  /// bodies never move).
   struct Collider {
-    static constexpr std::uint32_t kNoLeaf = 0xffffffffU;
     std::size_t body = 0;
-    std::size_t flat = 0;                  ///< its segment
-    std::vector<std::uint32_t> node_leaf;  ///< kNoLeaf for inner nodes
+    std::size_t flat = 0;  ///< its segment
   };
   struct Obstacle {
     std::size_t body = 0;
