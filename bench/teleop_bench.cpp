@@ -22,7 +22,7 @@ std::shared_ptr<const SerialChain> slave(bool gp7) {
     return std::make_shared<const SerialChain>(make_procedural_motoman());
   }
   UrdfChainOptions o;
-  o.load_collision_meshes = false;
+  o.load_collision_meshes = true;  // its links' bodies, as hapsim run builds them
   return std::make_shared<const SerialChain>(load_urdf_chain(
       std::filesystem::path(HAPSIM_BENCH_DEFAULT_DATA_DIR) / "motoman_gp7" / "gp7.urdf", o));
 }
@@ -45,6 +45,8 @@ void BM_TeleopStep(benchmark::State& state) {
   d.environment.X_world_sheet = Iso3(Eigen::Translation3d(0.5, 0.25, 0.05));
   PickAndPlaceScript script;
   script.pick_world = d.ball_start_world;
+  script.grasp_depth_m =
+      grasp_depth_m(d.gripper.pad_depth_m, d.gripper.pad_half_m.z(), d.ball.radius_m);
   const MasterArm master(d.master);
   const PickAndPlacePlan plan =
       make_pick_and_place_plan(script, master, d.mapping, d.follower.gripper_max_width_m);

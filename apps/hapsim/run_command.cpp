@@ -9,7 +9,6 @@
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/render/snapshot_writer.h"
-#include "hapsim/render/teleop_scene.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/run_setup.h"
@@ -87,12 +86,11 @@ class SnapshotSink {
   virtual void final(const World& world) = 0;
 };
 
-// The same scene the viewer shows (WorldScene, or TeleopScene for a rig), drawn offscreen. The
-// scene is built on first use with `make_scene`.
-template <class SceneT>
+// The same scene the viewer shows (WorldScene), drawn offscreen. The scene is built on first use
+// with `make_scene`.
 class RunSnapshots final : public SnapshotSink {
  public:
-  using MakeScene = std::function<std::unique_ptr<SceneT>(const World&)>;
+  using MakeScene = std::function<std::unique_ptr<WorldScene>(const World&)>;
 
   RunSnapshots(const RunArgs& args, MakeScene make_scene, double yaw_rad, double pitch_rad)
       : args_(args), make_scene_(std::move(make_scene)), yaw_rad_(yaw_rad), pitch_rad_(pitch_rad) {
@@ -134,7 +132,7 @@ class RunSnapshots final : public SnapshotSink {
   double yaw_rad_;
   double pitch_rad_;
   std::unique_ptr<SnapshotWriter> writer_;
-  std::unique_ptr<SceneT> scene_;
+  std::unique_ptr<WorldScene> scene_;
   OrbitCamera camera_;
   std::size_t written_ = 0;
 };
@@ -367,21 +365,15 @@ void run(const RunArgs& args) {
 
   std::unique_ptr<SnapshotSink> snapshots;
   if (!args.snapshot_path.empty()) {
-    if (teleop) {
-      snapshots = std::make_unique<RunSnapshots<TeleopScene>>(
-          args, [](const World& w) { return std::make_unique<TeleopScene>(w); }, kTeleopYaw,
-          kTeleopPitch);
-    } else {
-      snapshots = std::make_unique<RunSnapshots<WorldScene>>(
-          args,
-          [&args](const World& w) {
-            WorldSceneOptions o;
-            o.colouring = parse_colouring(args.colours);
-            o.sphere_tree_level = args.sphere_tree_level;
-            return std::make_unique<WorldScene>(w, o);
-          },
-          kKneeYaw, kKneePitch);
-    }
+    snapshots = std::make_unique<RunSnapshots>(
+        args,
+        [&args](const World& w) {
+          WorldSceneOptions o;
+          o.colouring = parse_colouring(args.colours);
+          o.sphere_tree_level = args.sphere_tree_level;
+          return std::make_unique<WorldScene>(w, o);
+        },
+        teleop ? kTeleopYaw : kKneeYaw, teleop ? kTeleopPitch : kKneePitch);
   }
 
   SessionOptions options;
@@ -421,6 +413,12 @@ void run(const RunArgs& args) {
     j["peak_grasp_force_n"] = t.peak_grasp_force_n;
     j["max_sheet_deflection_m"] = t.max_sheet_deflection_m;
     j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
+    j["slave_collisions"] = {
+        {"steps", t.slave_collision_steps},
+        {"pairs", t.slave_collisions},
+        {"first_s", t.slave_collision_steps > 0 ? nlohmann::json(t.first_slave_collision_s)
+                                                : nlohmann::json(nullptr)},
+        {"bodies", t.slave_collision_bodies}};
     // A scripted pick-and-place must end with the ball within 5 mm of its target (a replay of one
     // is judged by its bit-for-bit comparison instead).
     if (t.target_error_m && !replayed && !t.placed()) {

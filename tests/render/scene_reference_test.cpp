@@ -8,7 +8,6 @@
 #include "hapsim/render/image_compare.h"
 #include "hapsim/render/png_image.h"
 #include "hapsim/render/snapshot_writer.h"
-#include "hapsim/render/teleop_scene.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
@@ -134,7 +133,7 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
     world.step(setup.trajectory.sample_at(setup.trajectory.start_time_s() + k * dt), dt);
   }
   ASSERT_TRUE(world.rig()->held);
-  TeleopScene view(world);
+  WorldScene view(world);
   view.update_from_world(world);
   const OrbitCamera camera =
       framed_camera(view.rest_bounds_world(), static_cast<double>(kWidth) / kHeight, -0.9, 0.45);

@@ -41,9 +41,12 @@ TEST(WorldHapticClientRig, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   TripleBuffer<WorldSnapshot>& buffer = *client.snapshots();
   ASSERT_TRUE(buffer.update());
   ASSERT_TRUE(buffer.read_slot().teleop.has_value());
-  const TeleopSnapshot& s = *buffer.read_slot().teleop;
+  const WorldSnapshot& ws = buffer.read_slot();
+  const TeleopSnapshot& s = *ws.teleop;
   EXPECT_EQ(s.cycle, 299u);
-  EXPECT_EQ(s.ball_p_world, world.body_pose(world.description().teleop->ball_body).translation());
+  // The ball and the sheet are bodies: the world snapshot's poses and surfaces carry them.
+  const std::size_t ball = world.description().teleop->ball_body;
+  EXPECT_TRUE(ws.body_poses_world[ball].isApprox(world.body_pose(ball), 0.0));
   const auto q = world.rig()->slave->q();
   ASSERT_EQ(s.slave_q.size(), q.size());
   for (std::size_t i = 0; i < q.size(); ++i) {
@@ -53,9 +56,11 @@ TEST(WorldHapticClientRig, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   EXPECT_EQ(s.gripper_width_m, world.rig()->result.gripper.width_m);
   EXPECT_EQ(s.held, world.rig()->result.held);
   const auto heights = world.sheet(world.description().teleop->sheet_body)->surface_heights();
-  ASSERT_EQ(s.sheet_heights_m.size(), heights.size());
+  const std::vector<float>& sheet_xyz =
+      ws.positions_body[world.flat_segment(world.description().teleop->sheet_body, 0)];
+  ASSERT_EQ(sheet_xyz.size(), 3 * heights.size());
   for (std::size_t k = 0; k < heights.size(); ++k) {
-    ASSERT_EQ(s.sheet_heights_m[k], heights[k]) << "node " << k;
+    ASSERT_EQ(sheet_xyz[3 * k + 2], static_cast<float>(heights[k])) << "node " << k;
   }
   // The snapshot is one cycle's: the master joints the world followed are that cycle's input.
   for (std::size_t j = 0; j < 3; ++j) {
@@ -97,11 +102,12 @@ TEST(WorldHapticClientRig, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAl
     std::uint64_t last_cycle = 0;
     while (loop.running()) {
       if (client.snapshots()->update()) {
-        const TeleopSnapshot& s = *client.snapshots()->read_slot().teleop;
+        const WorldSnapshot& ws = client.snapshots()->read_slot();
+        const TeleopSnapshot& s = *ws.teleop;
         // One cycle's data: the master joints the world followed are that cycle's input.
         if (s.master_joint_rad[0] != s.input.joint_rad[0] ||
             s.master_joint_rad[2] != s.input.joint_rad[2] || s.cycle < last_cycle ||
-            !s.ball_p_world.allFinite()) {
+            !ws.body_poses_world[world.description().teleop->ball_body].translation().allFinite()) {
           inconsistent.fetch_add(1);
         }
         last_cycle = s.cycle;
@@ -134,7 +140,11 @@ TEST(WorldHapticClientRig, PausedClientHoldsTheWorldAndSendsNoTorque) {
   ASSERT_TRUE(client.snapshots()->update());
   const TeleopSnapshot& s = *client.snapshots()->read_slot().teleop;
   EXPECT_EQ(s.cycle, 49u);
-  EXPECT_EQ(s.ball_p_world, setup.description.teleop->ball_start_world);
+  EXPECT_EQ(client.snapshots()
+                ->read_slot()
+                .body_poses_world[setup.description.teleop->ball_body]
+                .translation(),
+            setup.description.teleop->ball_start_world);
   for (int j = 0; j < kMaxDeviceJoints; ++j) {
     EXPECT_EQ(s.output.joint_torque_nm[static_cast<std::size_t>(j)], 0.0);
   }

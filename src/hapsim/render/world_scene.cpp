@@ -3,9 +3,12 @@
 #include "hapsim/collision/knee_groups.h"
 #include "hapsim/collision/sphere_tree.h"
 #include "hapsim/core/error.h"
+#include "hapsim/kinematics/slave_shapes.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
+#include <cmath>
 #include <string>
 
 namespace hapsim {
@@ -17,15 +20,73 @@ struct WorldScene::Segment {
   std::string label;
   Vec3f tissue_colour = Vec3f::Ones();
   bool deformable = false;
-  std::uint64_t version = 0;
-  std::unique_ptr<SphereTree> tree;  // built when a sphere-tree level is first shown
-  std::vector<Vec3f> group_colours;  // built when group colouring is first asked for
+  bool sheet = false;    // a Gaussian sheet: shaded by its dent (tissue colouring)
+  bool faceted = false;  // drawn with a vertex per triangle corner (no vertex groups)
+  int pad = -1;          // a rig's gripper pad (0, 1): green while it holds
+  std::uint64_t version = ~std::uint64_t{0};  // none from a snapshot yet
+  std::unique_ptr<SphereTree> tree;           // built when a sphere-tree level is first shown
+  std::vector<Vec3f> group_colours;           // built when group colouring is first asked for
 };
 
 namespace {
 
 bool contains(const std::string& haystack, std::string_view needle) {
   return haystack.find(needle) != std::string::npos;
+}
+
+/// The mesh with a vertex per triangle corner, so its vertex normals are the face normals: a box
+/// drawn with flat faces and sharp edges, not smoothed round its corners.
+TriangleMesh faceted(const TriangleMesh& mesh) {
+  TriangleMesh m;
+  for (const TriangleIndices& t : mesh.triangles) {
+    const auto base = static_cast<std::uint32_t>(m.vertices.size());
+    for (const std::uint32_t v : t) {
+      m.vertices.push_back(mesh.vertices[v]);
+    }
+    m.triangles.push_back({base, base + 1, base + 2});
+  }
+  m.compute_vertex_normals();
+  return m;
+}
+
+/// How a rig draws a body, when it is one of the rig's: its colour, whether it is a box drawn
+/// with flat faces, which pad it is, whether it is the floor (drawn as the checked floor).
+struct RigRole {
+  std::optional<Vec3f> colour;
+  bool box = false;
+  int pad = -1;
+  bool floor = false;
+};
+
+RigRole rig_role(const WorldDescription& d, std::size_t b, const RigColours& c) {
+  RigRole role;
+  if (!d.teleop) {
+    return role;
+  }
+  const TeleopRigDescription& rig = *d.teleop;
+  // Boxes: the pads, the palm and stem, and the links of a chain without meshes.
+  const bool box_links =
+      std::all_of(rig.slave->link_geometry().begin(), rig.slave->link_geometry().end(),
+                  [](const ChainLinkGeometry& g) { return g.mesh.empty(); });
+  if (b == rig.ball_body) {
+    role.colour = c.ball;
+  } else if (b == rig.sheet_body) {
+    role.colour = c.sheet;
+  } else if (b == rig.floor_body) {
+    role.floor = true;
+  }
+  for (int i = 0; i < 2; ++i) {
+    if (b == rig.pad_body[static_cast<std::size_t>(i)]) {
+      role = {c.pad, true, i, false};
+    }
+  }
+  for (const TeleopRigDescription::SlaveBody& s : rig.slave_bodies) {
+    if (b == s.body) {
+      role = {s.frame == kToolFrame ? c.gripper : c.robot, s.frame == kToolFrame || box_links, -1,
+              false};
+    }
+  }
+  return role;
 }
 
 }  // namespace
@@ -67,6 +128,7 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
   segments_.resize(world.flat_segment_count());
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
     const BodyDescription& body = d.bodies[b];
+    const RigRole role = rig_role(d, b, rig_colours_);
     for (std::size_t s = 0; s < body.segments.size(); ++s) {
       const SegmentDescription& sd = body.segments[s];
       auto seg = std::make_unique<Segment>();
@@ -74,16 +136,33 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
       seg->index_in_body = s;
       seg->label = body.name + "/" + sd.name;
       seg->deformable = body.kind == BodyKind::kDeformable;
+      seg->sheet = seg->deformable && body.deformation == BodyDeformation::kGaussianSheet;
+      seg->faceted = role.box;
+      seg->pad = role.pad;
       const MaterialDescription& m = d.materials.at(sd.material);
-      seg->tissue_colour = tissue_colour(m.name, static_cast<int>(sd.material));
-      seg->mesh = scene_.add_mesh(sd.mesh, seg->tissue_colour, body.X_world_body);
+      seg->tissue_colour =
+          role.colour.value_or(tissue_colour(m.name, static_cast<int>(sd.material)));
+      seg->mesh = scene_.add_mesh(role.box ? faceted(sd.mesh) : sd.mesh, seg->tissue_colour,
+                                  world.body_pose(b));
       scene_.mesh(seg->mesh).name = seg->label;
+      // A rig's floor is a slab much wider than the scene: the checked floor stands for it.
+      scene_.mesh(seg->mesh).visible = !role.floor;
       for (const Vec3& v : sd.mesh.vertices) {
-        rest_bounds_world_.extend(body.X_world_body * v);
+        if (!role.floor) {
+          rest_bounds_world_.extend(body.X_world_body * v);
+        }
       }
       segments_[world.flat_segment(b, s)] = std::move(seg);
     }
-    body_poses_.push_back(body.X_world_body);
+    body_poses_.push_back(world.body_pose(b));
+  }
+  tools_.resize(d.tools.size());
+  tool_force_n_.assign(d.tools.size(), 0.0);
+  if (d.teleop) {
+    build_rig();
+    apply_colouring();
+    rebuild_overlays(tools_, tool_force_n_);
+    return;
   }
   // A floor just under the bodies, a little wider than them, with 1 cm checks for scale.
   if (!rest_bounds_world_.isEmpty()) {
@@ -95,12 +174,64 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
     scene_.floor.half_extent_m = half;
     scene_.floor.cell_m = half > 0.3 ? 0.05 : 0.01;
   }
-  tools_.resize(d.tools.size());
-  tool_force_n_.assign(d.tools.size(), 0.0);
   apply_colouring();
 }
 
 WorldScene::~WorldScene() = default;
+
+// The rig's part: its state at the start, the joint spheres of a slave drawn as boxes, the master
+// beside the slave's −y side (clear of the ball), on the floor, and a floor under everything.
+void WorldScene::build_rig() {
+  const TeleopRigDescription& rig = *world_.description().teleop;
+  rig_ = make_teleop_snapshot(world_);
+  joint_radius_m_ = slave_joint_radii_m(*rig.slave);
+  frames_.resize(static_cast<std::size_t>(rig.slave->dof()));
+  scene_.style.line_width_px = 2.0f;
+  Box3 bounds = rest_bounds_world_;
+  const BallEnvironmentOptions& env = rig.environment;
+  const double floor_z = env.has_floor ? env.floor_z_m : bounds.min().z();
+  bounds.extend(Vec3(bounds.min().x(), bounds.min().y(), floor_z));
+  const MasterArmGeometry& g = world_.model().master()->geometry();
+  const double master_reach =
+      options_.master_display_scale * (g.upper_arm_m + g.forearm_m + g.finger_m);
+  master_origin_world_ = Vec3(bounds.center().x(), bounds.min().y() - 0.6 * master_reach, floor_z);
+  if (options_.show_master) {
+    add_master_lines(*rig_);
+    for (const RenderSegment& seg : scene_.segments) {
+      bounds.extend(seg.a_world);
+      bounds.extend(seg.b_world);
+    }
+    scene_.segments.clear();
+    scene_.spheres.clear();
+  }
+  rest_bounds_world_ = bounds;
+  // A floor under everything, a little wider, 5 cm checks.
+  scene_.floor.visible = env.has_floor;
+  scene_.floor.height_m = floor_z;
+  scene_.floor.centre_x_m = bounds.center().x();
+  scene_.floor.centre_y_m = bounds.center().y();
+  scene_.floor.half_extent_m = 0.6 * bounds.sizes().head<2>().maxCoeff() + 0.1;
+  scene_.floor.cell_m = 0.05;
+}
+
+// A sheet's dent is a fraction of a millimetre under a resting ball (its grid is centimetres
+// apart): too shallow to change the shading, so the sheet is coloured by how deep each node is
+// below rest, darker blue down to kDentFullScaleM.
+void WorldScene::shade_dent(Segment& seg) {
+  constexpr double kDentFullScaleM = 5e-4;
+  const Vec3f deep(0.10f, 0.22f, 0.55f);
+  const std::vector<Vec3>& vertices = scene_.mesh(seg.mesh).geometry().vertices;
+  scratch_colours_.resize(vertices.size());
+  for (std::size_t v = 0; v < vertices.size(); ++v) {
+    const auto u = static_cast<float>(std::clamp(-vertices[v].z() / kDentFullScaleM, 0.0, 1.0));
+    scratch_colours_[v] = (1.0f - u) * seg.tissue_colour + u * deep;
+  }
+  scene_.set_vertex_colours(seg.mesh, scratch_colours_);
+}
+
+MeshId WorldScene::segment_mesh(std::size_t flat_segment) const {
+  return segments_.at(flat_segment)->mesh;
+}
 
 void WorldScene::set_options(const WorldSceneOptions& options) {
   const bool recolour = options.colouring != options_.colouring;
@@ -133,12 +264,20 @@ void WorldScene::apply_colouring() {
       case SegmentColouring::kTissue:
         mesh.colour = seg.tissue_colour;
         scene_.set_vertex_colours(seg.mesh, {});
+        if (seg.sheet) {
+          shade_dent(seg);
+        }
         break;
       case SegmentColouring::kSegments:
         mesh.colour = palette_colour(static_cast<int>(i));
         scene_.set_vertex_colours(seg.mesh, {});
         break;
       case SegmentColouring::kGroups: {
+        if (seg.faceted) {
+          mesh.colour = seg.tissue_colour;  // a box: no vertex groups to show
+          scene_.set_vertex_colours(seg.mesh, {});
+          break;
+        }
         if (seg.group_colours.empty()) {
           const TriangleMesh& rest = d.bodies[seg.body].segments[seg.index_in_body].mesh;
           const KneeGrouping grouping = build_knee_groups(rest);
@@ -174,6 +313,12 @@ void WorldScene::update(const WorldSnapshot& snapshot) {
     }
     scene_.update_positions(seg.mesh, scratch_positions_);
     seg.version = snapshot.positions_version[i];
+    if (seg.sheet && options_.colouring == SegmentColouring::kTissue) {
+      shade_dent(seg);
+    }
+  }
+  if (rig_ && snapshot.teleop) {
+    *rig_ = *snapshot.teleop;  // sized alike: no allocation after the first
   }
   rebuild_overlays(snapshot.tools, snapshot.tool_force_n);
 }
@@ -186,7 +331,14 @@ void WorldScene::update_from_world(const World& world) {
     scene_.mesh(seg->mesh).X_world_mesh = body_poses_[seg->body];
     if (seg->deformable) {
       scene_.update_positions(seg->mesh, world.surface(seg->body, seg->index_in_body).vertices);
+      if (seg->sheet && options_.colouring == SegmentColouring::kTissue) {
+        shade_dent(*seg);
+      }
     }
+  }
+  if (rig_) {
+    rig_->time_s = world.rig()->result.time_s;
+    fill_teleop_snapshot(*rig_, world);
   }
   const StepResult& r = world.last_result();
   std::vector<double> force_n(r.tools.size());
@@ -251,6 +403,70 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
         }
       }
     }
+  }
+  if (rig_) {
+    add_rig_overlays();
+  }
+}
+
+// What only a rig has, from its snapshot: the pads' colour while they hold, the joint spheres,
+// the shadow mark under the gripper's tool point (between the pads), the master.
+void WorldScene::add_rig_overlays() {
+  const TeleopSnapshot& s = *rig_;
+  const TeleopRigDescription& rig = *world_.description().teleop;
+  if (options_.colouring == SegmentColouring::kTissue) {
+    for (const auto& seg : segments_) {
+      if (seg->pad >= 0) {
+        scene_.mesh(seg->mesh).colour = s.held ? rig_colours_.pad_holding : rig_colours_.pad;
+      }
+    }
+  }
+  if (options_.show_joints && !joint_radius_m_.empty() && s.slave_q.size() == frames_.size()) {
+    static_cast<void>(rig.slave->frames(s.slave_q, frames_));
+    for (std::size_t k = 0; k < joint_radius_m_.size() && k < frames_.size(); ++k) {
+      scene_.spheres.push_back(
+          {frames_[k].translation(), joint_radius_m_[k], rig_colours_.joint, false});
+    }
+  }
+  const Vec3 tool_point_world = s.X_world_tool * Vec3(0.0, 0.0, rig.gripper.pad_depth_m);
+  scene_.shadow_marks.push_back({tool_point_world, 0.03, 0.005, rig_colours_.shadow});
+  if (options_.show_master) {
+    add_master_lines(s);
+  }
+}
+
+void WorldScene::add_master_lines(const TeleopSnapshot& s) {
+  const MasterArm& master = *world_.model().master();
+  const MasterArmGeometry& g = master.geometry();
+  std::array<Iso3, 3> f;
+  const Iso3 hand = master.arm().frames(s.master_joint_rad, f);
+  const double scale = options_.master_display_scale;
+  const Vec3f c = rig_colours_.master;
+  const auto at = [&](const Vec3& p_master) {
+    return Vec3(master_origin_world_ + scale * p_master);
+  };
+  const Vec3 base = at(Vec3::Zero());
+  const Vec3 shoulder = at(f[1].translation());
+  const Vec3 elbow = at(f[2].translation());
+  const Vec3 wrist = at(hand.translation());
+  scene_.segments.push_back({base, shoulder, c});
+  scene_.segments.push_back({shoulder, elbow, c});
+  scene_.segments.push_back({elbow, wrist, c});
+  // Fingers: pivots ± gap/2 across the hand (its y), each swung out by its angle from the
+  // hand's axis (its z).
+  const Vec3 y = hand.linear().col(1);
+  const Vec3 z = hand.linear().col(2);
+  for (int i = 0; i < 2; ++i) {
+    const double side = i == 0 ? 1.0 : -1.0;
+    const double a =
+        std::clamp(s.master_finger_rad[static_cast<std::size_t>(i)], 0.0, g.finger_open_limit_rad);
+    const Vec3 pivot = hand.translation() + side * 0.5 * g.finger_gap_m * y;
+    const Vec3 tip = pivot + g.finger_m * (std::cos(a) * z + side * std::sin(a) * y);
+    scene_.segments.push_back({at(pivot), at(tip), Vec3f(0.95f, 0.95f, 0.95f)});
+  }
+  const double r = 0.01 * scale;
+  for (const Vec3& p : {base, shoulder, elbow, wrist}) {
+    scene_.spheres.push_back({p, r, c, false});
   }
 }
 

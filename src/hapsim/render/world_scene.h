@@ -1,15 +1,22 @@
-// A World as the renderer sees it (architecture.md#viewer): one mesh per segment, coloured by
-// tissue (bone, cartilage, ligament, muscle, skin) or per segment / per vertex group (the knee
-// paper's Fig. 3), the tools as spheres with their god-object proxies and force arrows, an 'x'
-// shadow mark on the floor under each tool, and optionally the sphere tree's spheres at one level.
-// Updated each frame from a WorldSnapshot (the viewer, off the haptic thread) or straight from the
-// World (a headless run, on the thread that steps it).
+// A World as the renderer sees it (architecture.md#viewer), the one render adapter: one mesh per
+// segment where its body is now, coloured by tissue (bone, cartilage, ligament, muscle, skin) or
+// per segment / per vertex group (the knee paper's Fig. 3), deformed surfaces and sheets (their
+// live dent) re-uploaded when they change, the tools as spheres with their god-object proxies and
+// force arrows, an 'x' shadow mark on the floor under each tool, and optionally the sphere tree's
+// spheres at one level. A teleoperation rig's bodies are drawn as bodies too (the slave's links
+// robot orange, the palm and stem grey, the pads grey or green while they hold, the ball red, the
+// sheet light blue, darker where it is dented; its floor as the checked floor); what only a rig has
+// is drawn from the snapshot's teleop part: the master arm small as lines beside the scene, spheres
+// at the joints of a slave drawn as boxes, the shadow mark under the gripper. Updated each frame
+// from a WorldSnapshot (the viewer, off the haptic thread) or straight from the World (a headless
+// run, on the thread that steps it).
 #pragma once
 
 #include "hapsim/render/render_scene.h"
 #include "hapsim/runtime/world_snapshot.h"
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace hapsim {
@@ -28,12 +35,32 @@ struct WorldSceneOptions {
   bool show_force_arrows = true;
   /// Force arrow length per newton, metres.
   double arrow_m_per_n = 0.005;
+  /// A rig's master arm drawn as lines beside the scene (its base on the floor, off the slave's
+  /// −y side), at this fraction of its real size.
+  bool show_master = true;
+  double master_display_scale = 0.5;
+  /// Spheres at a rig slave's joints (only for a chain drawn as boxes).
+  bool show_joints = true;
+};
+
+/// Colours of a rig's parts (RGB in [0, 1]): a Motoman-like orange robot, a red ball.
+struct RigColours {
+  Vec3f robot = Vec3f(0.96f, 0.60f, 0.10f);
+  Vec3f joint = Vec3f(0.22f, 0.22f, 0.25f);
+  Vec3f gripper = Vec3f(0.55f, 0.57f, 0.60f);
+  Vec3f pad = Vec3f(0.30f, 0.32f, 0.35f);
+  /// The pads while they hold the ball.
+  Vec3f pad_holding = Vec3f(0.25f, 0.70f, 0.30f);
+  Vec3f ball = Vec3f(0.86f, 0.12f, 0.10f);
+  Vec3f sheet = Vec3f(0.55f, 0.75f, 0.95f);
+  Vec3f master = Vec3f(0.35f, 0.85f, 0.95f);
+  Vec3f shadow = Vec3f(0.10f, 0.10f, 0.12f);
 };
 
 class WorldScene {
  public:
-  /// Builds the render meshes from the world's description (rest shapes; call update_* to show
-  /// the current state).
+  /// Builds the render meshes from the world's description (rest shapes, at the bodies' current
+  /// poses; call update_* to show the current state).
   explicit WorldScene(const World& world, WorldSceneOptions options = {});
   ~WorldScene();
   WorldScene(const WorldScene&) = delete;
@@ -57,26 +84,43 @@ class WorldScene {
 
   [[nodiscard]] RenderScene& scene() { return scene_; }
   [[nodiscard]] const RenderScene& scene() const { return scene_; }
-  /// Bounds of the bodies at rest (for framing the camera).
+  /// Bounds of the bodies where the description starts them (for framing the camera); with a
+  /// rig, its master drawn beside.
   [[nodiscard]] const Box3& rest_bounds_world() const { return rest_bounds_world_; }
+  /// The render mesh of a segment (flat index).
+  [[nodiscard]] MeshId segment_mesh(std::size_t flat_segment) const;
+  /// With a rig: where its master's base is drawn (p_world = origin + scale · p_master).
+  [[nodiscard]] const Vec3& master_display_origin_world() const { return master_origin_world_; }
 
   /// The colour of a material by its name (what kTissue uses), for legends.
   [[nodiscard]] static Vec3f tissue_colour(std::string_view material_name, int material_index);
 
  private:
   struct Segment;
+  void build_rig();
   void apply_colouring();
+  void shade_dent(Segment& seg);
   void rebuild_overlays(const std::vector<ToolState>& tools, const std::vector<double>& force_n);
+  void add_rig_overlays();
+  void add_master_lines(const TeleopSnapshot& s);
 
   const World& world_;
   WorldSceneOptions options_;
+  RigColours rig_colours_;
   RenderScene scene_;
   std::vector<std::unique_ptr<Segment>> segments_;  // flat
   std::vector<Vec3> scratch_positions_;
+  std::vector<Vec3f> scratch_colours_;
   std::vector<ToolState> tools_;
   std::vector<double> tool_force_n_;
   std::vector<Iso3> body_poses_;  // where each body is drawn (dynamic bodies move)
   Box3 rest_bounds_world_;
+  // A rig's part: its latest state, the joint spheres' radii (a slave drawn as boxes), the
+  // slave's joint frames (scratch), where the master is drawn.
+  std::optional<TeleopSnapshot> rig_;
+  std::vector<double> joint_radius_m_;
+  std::vector<Iso3> frames_;
+  Vec3 master_origin_world_ = Vec3::Zero();
 };
 
 }  // namespace hapsim

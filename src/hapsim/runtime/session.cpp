@@ -227,6 +227,14 @@ class SessionAccountant {
     t.max_sheet_deflection_m = std::max(t.max_sheet_deflection_m, r.sheet_depth_m);
     t.max_slave_tracking_error_m = std::max(t.max_slave_tracking_error_m, r.slave.position_error_m);
     t.nonfinite_ball_steps += r.ball_p_world.allFinite() ? 0 : 1;
+    if (r.slave_collisions > 0) {
+      ++t.slave_collision_steps;
+      t.slave_collisions += static_cast<std::size_t>(r.slave_collisions);
+      if (t.first_slave_collision_s < 0.0) {
+        t.first_slave_collision_s = r.time_s;
+      }
+      slave_collision_bodies_ |= r.slave_collision_bodies;
+    }
   }
 
   void note_deflection(std::size_t flat_segment, double deflection_m) {
@@ -265,6 +273,11 @@ class SessionAccountant {
       if (options_.teleop_target_world) {
         t.target_error_m = (t.ball_final_world - *options_.teleop_target_world).norm();
       }
+      for (std::size_t b = 0; b < std::min<std::size_t>(desc.bodies.size(), 64); ++b) {
+        if ((slave_collision_bodies_ >> b) & 1U) {
+          t.slave_collision_bodies.push_back(desc.bodies[b].name);
+        }
+      }
     }
     return std::move(summary_);
   }
@@ -277,6 +290,7 @@ class SessionAccountant {
   std::vector<double> force_sum_;
   std::vector<ProxyCheck> checks_;
   std::vector<double> cost_us_;
+  std::uint64_t slave_collision_bodies_ = 0;  // a bit per body index (TeleopStepResult)
   // Per-segment touch flags of one step, so a tool-step counts once per segment.
   std::vector<std::uint8_t> touched_;
   double ball_start_z_ = 0.0;
@@ -502,6 +516,18 @@ std::string format_session_summary(const SessionSummary& s) {
                   "tracking %.3f mm\n",
                   t.max_sheet_deflection_m * 1e3, t.max_slave_tracking_error_m * 1e3);
     out << line;
+    if (t.slave_collision_steps == 0) {
+      out << "slave collisions none (no link, palm or pad inside the floor or the sheet)\n";
+    } else {
+      std::snprintf(line, sizeof line,
+                    "slave collisions in %zu steps, first at %.3f s:", t.slave_collision_steps,
+                    t.first_slave_collision_s);
+      out << line;
+      for (std::size_t i = 0; i < t.slave_collision_bodies.size(); ++i) {
+        out << (i == 0 ? " " : ", ") << t.slave_collision_bodies[i];
+      }
+      out << " (the real robot would hit them)\n";
+    }
   }
   for (const BodySummary& b : s.bodies) {
     std::snprintf(line, sizeof line,

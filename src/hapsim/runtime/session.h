@@ -92,6 +92,12 @@ struct TeleopSummary {
   double max_sheet_deflection_m = 0.0;
   double max_slave_tracking_error_m = 0.0;
   std::size_t nonfinite_ball_steps = 0;
+  /// Slave collisions (TeleopStepResult::slave_collisions): steps with one, their sum over the
+  /// run, the first one's time (-1: none) and the bodies involved (the slave's and what it hit).
+  std::size_t slave_collision_steps = 0;
+  std::size_t slave_collisions = 0;
+  double first_slave_collision_s = -1.0;
+  std::vector<std::string> slave_collision_bodies;
   Vec3 ball_final_world = Vec3::Zero();
   /// With SessionOptions::teleop_target_world: the ball's final distance from it.
   std::optional<double> target_error_m;

@@ -10,8 +10,6 @@ TeleopSnapshot make_teleop_snapshot(const World& world) {
   TeleopSnapshot s;
   const RigState& rig = *world.rig();
   s.slave_q.assign(rig.slave->q().size(), 0.0);
-  s.sheet_heights_m.assign(
-      world.sheet(world.description().teleop->sheet_body)->surface_heights().size(), 0.0);
   s.time_s = rig.result.time_s;
   fill_teleop_snapshot(s, world);
   return s;
@@ -30,12 +28,7 @@ void fill_teleop_snapshot(TeleopSnapshot& s, const World& world) noexcept {
   s.pad_force_n = r.gripper.pad_force_n;
   s.grasp_force_n = r.gripper.grasp_force_n();
   s.held = r.held;
-  const TeleopRigDescription& d = *world.description().teleop;
-  s.ball_p_world = world.body_pose(d.ball_body).translation();
-  const VirtualSheet& sheet = *world.sheet(d.sheet_body);
-  const auto h = sheet.surface_heights();
-  std::copy_n(h.begin(), std::min(h.size(), s.sheet_heights_m.size()), s.sheet_heights_m.begin());
-  s.sheet_depth_m = sheet.max_depth_m();
+  s.sheet_depth_m = world.sheet(world.description().teleop->sheet_body)->max_depth_m();
   s.master_joint_rad = r.master_arm_rad;
   s.master_finger_rad = r.master_finger_rad;
   s.X_master_hand = world.model().master()->hand_pose(r.master_arm_rad);

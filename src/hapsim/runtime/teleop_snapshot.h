@@ -1,6 +1,7 @@
-// What the viewer (and later the network) sees of a teleoperation rig: the newest cycle's master
-// input and command, the slave's joints and tool, the gripper, the ball and the sheet's surface;
-// the rig's part of a WorldSnapshot, published by the world's haptic client through its triple
+// What the viewer (and later the network) sees of a teleoperation rig beyond its bodies (the ball,
+// the sheet, the pads and the slave's links are the WorldSnapshot's, as every body is): the
+// newest cycle's master input and command, the slave's joints and tool, the gripper; the rig's
+// part of a WorldSnapshot, published by the world's haptic client through its triple
 // buffer (world_haptic_client.h).
 // Sized once for a world, so filling one never allocates.
 #pragma once
@@ -35,9 +36,8 @@ struct TeleopSnapshot {
   /// (N₁ + N₂) / 2: what the master's fingers feel, newtons.
   double grasp_force_n = 0.0;
   bool held = false;
-  Vec3 ball_p_world = Vec3::Zero();
-  /// The sheet's surface heights in its frame, row-major (j·N + i), N = nodes_per_side, metres.
-  std::vector<double> sheet_heights_m;
+  /// The sheet's deepest dent (its surface and the ball's pose are the WorldSnapshot's, as every
+  /// body's), metres.
   double sheet_depth_m = 0.0;
 };
 

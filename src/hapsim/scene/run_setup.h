@@ -41,8 +41,9 @@ struct RunSetupOptions {
   std::optional<ContactMethod> method;
   /// Every deformable body made static (the viewer's "deformation: none").
   bool rigid = false;
-  /// A URDF slave's collision meshes too (for drawing it; a run needs only the kinematics).
-  bool load_link_meshes = false;
+  /// A URDF slave's collision meshes: its links' bodies (they collide with the ball and are
+  /// drawn). Off: a box per link between joint origins, as for a chain without meshes.
+  bool load_link_meshes = true;
 };
 
 struct RunSetup {

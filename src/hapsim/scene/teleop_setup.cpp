@@ -46,8 +46,7 @@ TeleopSetup make_teleop_setup(const SceneDescription& scene,
                               const std::optional<std::filesystem::path>& trajectory,
                               bool load_link_meshes) {
   TeleopSetup s;
-  s.description = rig_world(rig_description(scene, load_link_meshes));
-  TeleopRigDescription& d = *s.description.teleop;
+  TeleopRigDescription d = rig_description(scene, load_link_meshes);
   const MasterArm master(d.master);
   if (trajectory || !scene.device.has_pick_and_place) {
     const std::filesystem::path file = trajectory ? *trajectory : scene.device.trajectory_file;
@@ -64,7 +63,8 @@ TeleopSetup make_teleop_setup(const SceneDescription& scene,
     script.place_world = scene.device.pick_and_place.place_m;
     script.clearance_m = scene.device.pick_and_place.clearance_m;
     script.carry_s = scene.device.pick_and_place.carry_s;
-    script.pad_depth_m = d.gripper.pad_depth_m;
+    script.grasp_depth_m =
+        grasp_depth_m(d.gripper.pad_depth_m, d.gripper.pad_half_m.z(), d.ball.radius_m);
     script.open_width_m = 0.9 * d.follower.gripper_max_width_m;
     s.trajectory =
         make_pick_and_place_plan(script, master, d.mapping, d.follower.gripper_max_width_m)
@@ -88,6 +88,8 @@ TeleopSetup make_teleop_setup(const SceneDescription& scene,
   }
   s.slave_name =
       scene.teleop.slave_urdf.empty() ? "procedural Motoman" : scene.teleop.slave_urdf.string();
+  // Built with the start joints: the slave's bodies start where its follower does.
+  s.description = rig_world(std::move(d));
   return s;
 }
 

@@ -29,8 +29,8 @@ struct TeleopSetup {
 };
 
 /// Builds the setup of a teleop scene (`scene.is_teleop`). `trajectory`: a master trajectory CSV
-/// to play instead of the scene's device (--device sim:FILE). `load_link_meshes`: also load the
-/// URDF slave's collision meshes (for display; a run needs only the kinematics).
+/// to play instead of the scene's device (--device sim:FILE). `load_link_meshes`: load the URDF
+/// slave's collision meshes as its links' bodies (else a box per link between joint origins).
 /// Throws hapsim::Error naming the file: a URDF that does not load, a trajectory without the
 /// master's columns (j0..j2, f0, f1), a pick-and-place out of the master's reach, or a first
 /// master pose that puts the slave's target out of its reach.

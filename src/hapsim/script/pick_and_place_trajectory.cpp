@@ -1,9 +1,10 @@
 #include "hapsim/script/pick_and_place_trajectory.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/script/palpation_trajectory.h"
 #include "hapsim/kinematics/inverse_kinematics.h"
+#include "hapsim/script/palpation_trajectory.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -21,6 +22,13 @@ struct Waypoint {
 
 }  // namespace
 
+double grasp_depth_m(double pad_depth_m, double pad_half_height_m, double ball_radius_m,
+                     double clearance_m) {
+  // The palm's underside is the pads' top, pad_depth − half below the flange; the ball's top is
+  // its radius above its centre.
+  return pad_depth_m + std::max(0.0, ball_radius_m + clearance_m - pad_half_height_m);
+}
+
 PickAndPlacePlan make_pick_and_place_plan(const PickAndPlaceScript& s, const MasterArm& master,
                                           const TeleopMapping& mapping, double slave_max_width_m) {
   const char* where = "pick-and-place script";
@@ -34,10 +42,10 @@ PickAndPlacePlan make_pick_and_place_plan(const PickAndPlaceScript& s, const Mas
     throw Error(where, "the gripper width and the mapping scale must be > 0");
   }
   const Vec3 up = Vec3::UnitZ();
-  const Vec3 above_pick = s.pick_world + up * (s.pad_depth_m + s.clearance_m);
-  const Vec3 at_pick = s.pick_world + up * s.pad_depth_m;
-  const Vec3 above_place = s.place_world + up * (s.pad_depth_m + s.clearance_m);
-  const Vec3 at_place = s.place_world + up * (s.pad_depth_m + s.release_height_m);
+  const Vec3 above_pick = s.pick_world + up * (s.grasp_depth_m + s.clearance_m);
+  const Vec3 at_pick = s.pick_world + up * s.grasp_depth_m;
+  const Vec3 above_place = s.place_world + up * (s.grasp_depth_m + s.clearance_m);
+  const Vec3 at_place = s.place_world + up * (s.grasp_depth_m + s.release_height_m);
   const std::vector<Waypoint> plan{
       {"hover", s.hover_s, above_pick, s.open_width_m},
       {"explore", s.explore_s, above_pick, s.open_width_m, true},

@@ -5,9 +5,9 @@
 // so the same script works whatever the scale, offset or master geometry.
 #pragma once
 
-#include "hapsim/script/trajectory.h"
 #include "hapsim/kinematics/master_arm.h"
 #include "hapsim/kinematics/slave_follower.h"
+#include "hapsim/script/trajectory.h"
 
 #include <string>
 #include <vector>
@@ -18,8 +18,10 @@ struct PickAndPlaceScript {
   /// The ball's centre where it rests, and where it should end up resting (world, metres).
   Vec3 pick_world = Vec3(0.5, -0.25, 0.03);
   Vec3 place_world = Vec3(0.5, 0.25, 0.08);
-  /// Pad centres below the flange along the tool's approach axis (the gripper's pad depth).
-  double pad_depth_m = 0.07;
+  /// How far below the flange, along the tool's approach axis, the ball's centre is held: the
+  /// gripper's pad depth, or deeper when the ball is taller than the pads so that the gripper's
+  /// palm above them clears it (grasp_depth_m()).
+  double grasp_depth_m = 0.07;
   /// Slave gripper openings: open (around the ball) and the closing command (pads stop on it).
   double open_width_m = 0.09;
   double closed_width_m = 0.0;
@@ -47,6 +49,13 @@ struct PickAndPlacePlan {
   /// The slave flange target at the start (for starting the slave there).
   Vec3 first_flange_world = Vec3::Zero();
 };
+
+/// Where a parallel gripper holds a ball's centre below its flange: at the pads' centre depth, or
+/// lower when the ball's radius is more than the pads' half height, so the palm just above the
+/// pads stays `clearance_m` clear of the ball's top (a grasp centred on the pads would press the
+/// palm into it).
+[[nodiscard]] double grasp_depth_m(double pad_depth_m, double pad_half_height_m,
+                                   double ball_radius_m, double clearance_m = 0.003);
 
 /// Throws hapsim::Error ("pick-and-place script") when a duration is not positive or a waypoint
 /// is out of the master arm's reach through the mapping.

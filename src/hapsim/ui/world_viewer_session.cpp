@@ -5,7 +5,6 @@
 #include "hapsim/device/master_probe_device.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/kinematics/hand_model.h"
-#include "hapsim/render/teleop_scene.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/scene/run_setup.h"
@@ -61,12 +60,12 @@ Vec3 probe_start_for(const WorldDescription& world, const Box3& bounds_world) {
 // haptic loop with its device (the viewer's mouse probe, the scene's script or a trajectory, a 3D
 // mouse; for a teleoperation rig the probe is the slave tool's target, turned into master joints by
 // MasterProbeDevice); one client, one snapshot, one recorder. What is drawn and read out differs
-// per kind of thing: bodies and tools (WorldScene), a rig (TeleopScene).
+// per kind of thing: bodies and tools, or a rig (its readout and controls); one WorldScene draws
+// both.
 class WorldViewerSession final : public ViewerSession {
  public:
   WorldViewerSession(const ViewerConfig& config, SceneDescription scene) : config_(config) {
     RunSetupOptions setup_options;
-    setup_options.load_link_meshes = true;  // a URDF slave is drawn with its own meshes
     if (!config.method.empty()) {
       setup_options.method = method_from(config.method);
     }
@@ -94,8 +93,8 @@ class WorldViewerSession final : public ViewerSession {
     }
     // The position a mouse or 3D mouse starts at, and what turns it into the device's input.
     std::optional<MasterHandMapping> hand_mapping;
+    view_ = std::make_unique<WorldScene>(*world_);
     if (world_->rig() != nullptr) {
-      rig_view_ = std::make_unique<TeleopScene>(*world_);
       // The probe starts where the master's hand is at the script's first sample, so the slave
       // starts still (the run setup solved its start joints for that pose). The cursor points at
       // the slave's tool: the probe is its target in the world.
@@ -106,7 +105,6 @@ class WorldViewerSession final : public ViewerSession {
       hand_mapping->set_probe_in_slave_frame(world_->description().teleop->mapping);
       probe_start_world_ = hand_mapping->probe_for(first_arm);
     } else {
-      view_ = std::make_unique<WorldScene>(*world_);
       probe_start_world_ = probe_start_for(scene_.world, view_->rest_bounds_world());
     }
     const std::string target = hand_mapping ? " as the slave tool's target" : "";
@@ -187,11 +185,11 @@ class WorldViewerSession final : public ViewerSession {
     TripleBuffer<WorldSnapshot>& snapshots = *client_->snapshots();
     snapshots.update();
     const WorldSnapshot& s = snapshots.read_slot();
-    if (rig_view_) {
-      update_rig(*s.teleop);
+    view_->update(s);
+    if (s.teleop) {
+      update_rig(s, *s.teleop);
       return;
     }
-    view_->update(s);
     const WorldDescription& d = world_->description();
     readout_.time_s = s.time_s;
     readout_.cycle = s.cycle;
@@ -227,10 +225,10 @@ class WorldViewerSession final : public ViewerSession {
   }
 
   RenderScene& render_scene() override {
-    return rig_view_ ? rig_view_->scene() : view_->scene();
+    return view_->scene();
   }
   Box3 bounds_world() const override {
-    return rig_view_ ? rig_view_->rest_bounds_world() : view_->rest_bounds_world();
+    return view_->rest_bounds_world();
   }
   const SessionReadout& readout() const override {
     return readout_;
@@ -325,7 +323,7 @@ class WorldViewerSession final : public ViewerSession {
   }
 
   void draw_controls() override {
-    if (rig_view_) {
+    if (world_->rig() != nullptr) {
       draw_rig_controls();
       return;
     }
@@ -396,8 +394,7 @@ class WorldViewerSession final : public ViewerSession {
 
   // The rig's readout: the slave tool and the master hand, grasp and pad forces, ball, gripper,
   // the sheet's dent, the slave's and the master's joints and the torques sent.
-  void update_rig(const TeleopSnapshot& s) {
-    rig_view_->update(s);
+  void update_rig(const WorldSnapshot& world, const TeleopSnapshot& s) {
     SessionReadout& r = readout_;
     r.time_s = s.time_s;
     r.cycle = s.cycle;
@@ -426,7 +423,9 @@ class WorldViewerSession final : public ViewerSession {
 
     char text[160];
     r.lines.clear();
-    r.lines.emplace_back("ball (mm)", format_mm(s.ball_p_world) + (s.held ? "  held" : "  free"));
+    const Vec3 ball_p_world =
+        world.body_poses_world[world_->description().teleop->ball_body].translation();
+    r.lines.emplace_back("ball (mm)", format_mm(ball_p_world) + (s.held ? "  held" : "  free"));
     std::snprintf(text, sizeof text, "%.1f mm, grasp %.2f N", s.gripper_width_m * 1e3,
                   s.grasp_force_n);
     r.lines.emplace_back("gripper", text);
@@ -456,12 +455,12 @@ class WorldViewerSession final : public ViewerSession {
   }
 
   void draw_rig_controls() {
-    TeleopSceneOptions o = rig_view_->options();
+    WorldSceneOptions o = view_->options();
     bool changed = ImGui::Checkbox("master arm", &o.show_master);
     ImGui::SameLine();
     changed |= ImGui::Checkbox("joints", &o.show_joints);
     if (changed) {
-      rig_view_->set_options(o);
+      view_->set_options(o);
     }
     if (mouse_ != nullptr) {
       ImGui::TextWrapped(
@@ -476,9 +475,8 @@ class WorldViewerSession final : public ViewerSession {
   ViewerConfig config_;
   SceneDescription scene_;
   std::unique_ptr<World> world_;
-  std::unique_ptr<WorldScene> view_;       // bodies and tools
-  std::unique_ptr<TeleopScene> rig_view_;  // or a teleoperation rig
-  std::unique_ptr<Device> probe_;          // a mouse or 3D mouse behind a rig's MasterProbeDevice
+  std::unique_ptr<WorldScene> view_;
+  std::unique_ptr<Device> probe_;  // a mouse or 3D mouse behind a rig's MasterProbeDevice
   std::unique_ptr<Device> device_;
   InteractiveDevice* mouse_ = nullptr;
   std::unique_ptr<WorldHapticClient> client_;

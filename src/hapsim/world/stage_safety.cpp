@@ -14,10 +14,11 @@ namespace hapsim::stage {
 
 namespace {
 
-// The rig's forces back to the master: the pads' reaction at the slave's tool, scaled into the
-// master's frame and turned into joint torques through the master's Jᵀ; the grasp force on both
-// fingers.
-void rig_command(const WorldModel& model, RigState& rig) noexcept {
+// The rig's forces back to the master: the reaction at the slave's tool (the pads', and the
+// palm's and stem's when the ball presses them: the gripper's parts past the wrist), scaled into
+// the master's frame and turned into joint torques through the master's Jᵀ; the grasp force on
+// both fingers. The links' contacts are not felt: they are the arm's, not the hand's.
+void rig_command(const WorldModel& model, const WorldState& state, RigState& rig) noexcept {
   TeleopStepResult& r = rig.result;
   r.command = DeviceCommand{};
   if (!rig.input_usable) {
@@ -26,7 +27,12 @@ void rig_command(const WorldModel& model, RigState& rig) noexcept {
   const TeleopRigDescription& d = *model.description().teleop;
   // What the ball pushes on the pads (held by friction: its weight and whatever the sheet or
   // the floor push on it, carried through the grasp).
-  const Vec3 at_tool = -r.gripper.force_on_ball_world_n;
+  Vec3 at_tool = -r.gripper.force_on_ball_world_n;
+  for (const TeleopRigDescription::SlaveBody& s : d.slave_bodies) {
+    if (s.frame == kToolFrame) {
+      at_tool += state.bodies[s.body].force_world_n;
+    }
+  }
   const Vec3 at_master = d.mapping.X_slave_master.linear().transpose() * at_tool * d.force_scale;
   const MasterTorques t =
       model.master()->torques(r.master_arm_rad, at_master, r.gripper.grasp_force_n());
@@ -52,7 +58,7 @@ void safety(const WorldModel& model, WorldState& state) noexcept {
   state.command = DeviceCommand{};
   if (state.rig) {
     // A rig's master gets the rig's torques and grasp (its scenes have no probe tools).
-    rig_command(model, *state.rig);
+    rig_command(model, state, *state.rig);
     state.command = state.rig->result.command;
   }
   if (!state.input_usable) {

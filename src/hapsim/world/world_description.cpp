@@ -96,7 +96,8 @@ WorldDescription rig_world(TeleopRigDescription rig, std::string name) {
   d.materials = {spring_material("ball", rigid),
                  spring_material("sheet", rig.environment.sheet_contact),
                  spring_material("pad", rig.gripper.pad_contact, rig.gripper.max_force_n),
-                 spring_material("floor", rig.environment.floor_contact)};
+                 spring_material("floor", rig.environment.floor_contact),
+                 spring_material("link", rig.gripper.pad_contact)};
   if (rig.environment.has_floor) {
     rig.floor_body = d.bodies.size();
     const Vec3 half(2.0, 2.0, 0.05);
@@ -122,10 +123,38 @@ WorldDescription rig_world(TeleopRigDescription rig, std::string name) {
   ball.rigid.inertia_kg_m2 = Mat3::Identity() * 0.4 * rig.ball.mass_kg * r * r;
   d.bodies.push_back(std::move(ball));
   d.gravity_m_per_s2 = rig.ball.gravity_m_per_s2;
+  // The slave at its start joints (as its follower clamps them), the gripper open: where the
+  // rig's place stage will put its bodies on the first step.
+  const SerialChain& chain = *rig.slave;
+  std::vector<double> q = rig.slave_start_rad;
+  q.resize(static_cast<std::size_t>(chain.dof()), 0.0);
+  chain.clamp_to_limits(q);
+  std::vector<Iso3> frames(static_cast<std::size_t>(chain.dof()));
+  const Iso3 X_world_tool = chain.frames(q, frames);
+  const auto frame_pose = [&](int frame) {
+    return frame == kToolFrame ? X_world_tool
+           : frame < 0         ? Iso3::Identity()
+                               : frames[static_cast<std::size_t>(frame)];
+  };
+  const double open_half_m = 0.5 * rig.follower.gripper_max_width_m + rig.gripper.pad_half_m.y();
   for (std::size_t i = 0; i < 2; ++i) {
     rig.pad_body[i] = d.bodies.size();
-    d.bodies.push_back(rig_body(i == 0 ? "pad_plus_y" : "pad_minus_y", BodyKind::kKinematic,
-                                Iso3::Identity(), make_box(rig.gripper.pad_half_m), 2));
+    const double side = i == 0 ? 1.0 : -1.0;
+    d.bodies.push_back(rig_body(
+        i == 0 ? "pad_plus_y" : "pad_minus_y", BodyKind::kKinematic,
+        X_world_tool * Eigen::Translation3d(0.0, side * open_half_m, rig.gripper.pad_depth_m),
+        make_box(rig.gripper.pad_half_m), 2));
+  }
+  // The slave's own links, palm and stem: kinematic too, so they push the ball as the pads do.
+  std::vector<SlaveShape> shapes = slave_link_shapes(chain);
+  for (SlaveShape& s : gripper_shapes(rig.gripper, rig.follower.gripper_max_width_m)) {
+    shapes.push_back(std::move(s));
+  }
+  rig.slave_bodies.clear();
+  for (SlaveShape& s : shapes) {
+    rig.slave_bodies.push_back({d.bodies.size(), s.frame, s.X_frame_mesh});
+    d.bodies.push_back(rig_body("slave_" + s.name, BodyKind::kKinematic,
+                                frame_pose(s.frame) * s.X_frame_mesh, std::move(s.mesh), 4));
   }
   d.teleop = std::move(rig);
   return d;

@@ -18,6 +18,7 @@
 #include "hapsim/kinematics/master_arm.h"
 #include "hapsim/kinematics/serial_chain.h"
 #include "hapsim/kinematics/slave_follower.h"
+#include "hapsim/kinematics/slave_shapes.h"
 
 #include <array>
 #include <cstdint>
@@ -172,6 +173,16 @@ struct TeleopRigDescription {
   std::size_t sheet_body = kNoBody;
   std::array<std::size_t, 2> pad_body{kNoBody, kNoBody};
   std::size_t floor_body = kNoBody;
+  /// A body of the slave itself (kinematic: a link, the gripper's palm or stem), placed each step
+  /// where its chain frame is (slave_shapes.h): X_world_body = X_world_frame · X_frame_body.
+  struct SlaveBody {
+    std::size_t body = kNoBody;
+    /// −1: the base; i: joint i's frame after its motion; kToolFrame: the tool (flange).
+    int frame = -1;
+    Iso3 X_frame_body = Iso3::Identity();
+  };
+  /// The links in chain order, then the palm and stem (rig_world() adds them).
+  std::vector<SlaveBody> slave_bodies;
 };
 
 struct WorldDescription {
@@ -194,9 +205,10 @@ struct WorldDescription {
 };
 
 /// A world made of a teleoperation rig (the teleoperation scenes): the rig, and as ordinary bodies
-/// its floor (static), sheet (deformable, Gaussian), ball (dynamic sphere) and gripper pads
-/// (kinematic boxes), each with a penalty material made from the rig's contact springs, so the
-/// ball meets them through the same contact code as every other body.
+/// its floor (static), sheet (deformable, Gaussian), ball (dynamic sphere), gripper pads
+/// (kinematic boxes) and the slave's links, palm and stem (kinematic: slave_shapes.h, at the
+/// slave's start joints), each with a penalty material made from the rig's contact springs, so
+/// the ball meets them through the same contact code as every other body.
 [[nodiscard]] WorldDescription rig_world(TeleopRigDescription rig, std::string name = "teleop");
 
 /// A content hash of a world description (meshes, materials, tools), as recordings carry it.

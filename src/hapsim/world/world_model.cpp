@@ -77,9 +77,14 @@ void check_rig_bodies(const WorldDescription& w) {
       !is(d.sheet_body, BodyKind::kDeformable) ||
       w.bodies[d.sheet_body].deformation != BodyDeformation::kGaussianSheet ||
       !is(d.pad_body[0], BodyKind::kKinematic) || !is(d.pad_body[1], BodyKind::kKinematic) ||
-      (d.floor_body != TeleopRigDescription::kNoBody && !is(d.floor_body, BodyKind::kStatic))) {
+      (d.floor_body != TeleopRigDescription::kNoBody && !is(d.floor_body, BodyKind::kStatic)) ||
+      std::any_of(d.slave_bodies.begin(), d.slave_bodies.end(),
+                  [&](const TeleopRigDescription::SlaveBody& s) {
+                    return !is(s.body, BodyKind::kKinematic) ||
+                           !(s.frame == kToolFrame || (s.frame >= -1 && s.frame < d.slave->dof()));
+                  })) {
     throw Error("teleop",
-                "the rig's ball, sheet, pads and floor must be bodies of the world "
+                "the rig's ball, sheet, pads, floor and slave links must be bodies of the world "
                 "(build the world with rig_world())");
   }
 }

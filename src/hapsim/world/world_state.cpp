@@ -2,6 +2,7 @@
 
 #include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/collision/sphere_tree.h"
 #include "hapsim/core/error.h"
 #include "hapsim/deform/sheet_query.h"
 #include "hapsim/world/world_model.h"
@@ -22,7 +23,9 @@ std::vector<double> start_joints(const TeleopRigDescription& d) {
 RigState::RigState(const TeleopRigDescription& rig)
     : description(&rig),
       slave_start_rad(start_joints(rig)),
-      slave(std::make_unique<SlaveFollower>(*rig.slave, slave_start_rad, rig.follower)) {}
+      slave(std::make_unique<SlaveFollower>(*rig.slave, slave_start_rad, rig.follower)),
+      frames(static_cast<std::size_t>(rig.slave->dof())),
+      slave_body_previous(rig.slave_bodies.size()) {}
 
 // haptic path
 void RigState::reset() noexcept {
@@ -67,6 +70,45 @@ void place_bodies(const WorldModel& model, std::vector<BodyState>& bodies) {
       body.v_world = d.bodies[b].rigid.v_world;
       body.w_world = d.bodies[b].rigid.w_world;
     }
+  }
+}
+
+// The slave's bodies that can hit something (links beyond the waist, palm, stem, pads) and the
+// bodies they cannot push back (static, deformable), for the place stage's slave collisions.
+void find_slave_collision_pairs(const WorldModel& model, RigState& rig) {
+  const TeleopRigDescription& d = *model.description().teleop;
+  const auto add_collider = [&](std::size_t b) {
+    const BodyModel& bm = model.bodies()[b];
+    for (std::size_t flat = bm.first_segment; flat < bm.first_segment + bm.segment_count; ++flat) {
+      const SphereTree* tree = model.segments()[flat].body_tree.get();
+      if (tree == nullptr) {
+        continue;  // no body trees: the world has no dynamic body (cannot be a rig's)
+      }
+      rig.colliders.push_back({b, flat});
+    }
+  };
+  // The base and the link the first joint turns (the waist) stand on the robot's mount: only the
+  // links beyond, and the gripper, can hit something.
+  for (const TeleopRigDescription::SlaveBody& s : d.slave_bodies) {
+    if (s.frame >= 1 || s.frame == kToolFrame) {
+      add_collider(s.body);
+    }
+  }
+  for (const std::size_t pad : d.pad_body) {
+    add_collider(pad);
+  }
+  for (std::size_t flat = 0; flat < model.segments().size(); ++flat) {
+    const SegmentModel& seg = model.segments()[flat];
+    const BodyKind kind = model.bodies()[seg.body].kind;
+    if (kind != BodyKind::kStatic && kind != BodyKind::kDeformable) {
+      continue;
+    }
+    Box3 bounds_world;
+    const Box3& b = seg.rest_bounds_body;
+    for (int corner = 0; corner < 8; ++corner) {
+      bounds_world.extend(seg.X_world_body * b.corner(static_cast<Box3::CornerType>(corner)));
+    }
+    rig.obstacles.push_back({seg.body, flat, bounds_world});
   }
 }
 
@@ -171,6 +213,7 @@ WorldState::WorldState(const WorldModel& model) {
       1));
   if (d.teleop) {
     rig = std::make_unique<RigState>(*d.teleop);
+    find_slave_collision_pairs(model, *rig);
   }
   result.tools = tool_states;
   result.contacts = {contacts.data(), 0};

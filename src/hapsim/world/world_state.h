@@ -123,6 +123,12 @@ struct TeleopStepResult {
   Vec3 ball_p_world = Vec3::Zero();
   bool held = false;
   double sheet_depth_m = 0.0;
+  /// Place stage: pairs (slave body, static or deformable body) in contact this step — a link,
+  /// the palm, the stem or a pad more than RigState::kCollisionDepthM inside the floor, the sheet
+  /// or another body that cannot be pushed back: where the real robot would hit the table.
+  std::int32_t slave_collisions = 0;
+  /// Which bodies they were, a bit per body index (< 64): the slave's and the others.
+  std::uint64_t slave_collision_bodies = 0;
 };
 
 struct StepResult {
@@ -262,6 +268,32 @@ struct RigState {
   std::array<Vec3, 2> pad_previous_world{Vec3::Zero(), Vec3::Zero()};
   Mat3 tool_previous_R = Mat3::Identity();
   bool has_pad_previous = false;
+  /// Place stage: the slave's joint frames this step (dof(), sized at construction).
+  std::vector<Iso3> frames;
+  /// Place stage: each slave body's pose last step (TeleopRigDescription::slave_bodies order),
+  /// for its velocity.
+  std::vector<Iso3> slave_body_previous;
+
+  /// A slave collision is counted when a slave body's surface is deeper than this inside another
+  /// body (a graze is not a hit).
+  static constexpr double kCollisionDepthM = 1e-3;
+  /// What the place stage checks for slave collisions (built with the world state): the slave's
+  /// bodies (not its base and waist — the links on the base frame and joint 0's frame — which
+  /// stand on the robot's mount; their sphere trees are the body-contact stage's), and the bodies
+  /// they cannot push back (static and deformable) with their segments' world bounds (those
+  /// bodies never move).
+  struct Collider {
+    std::size_t body = 0;
+    std::size_t flat = 0;  ///< its segment
+  };
+  struct Obstacle {
+    std::size_t body = 0;
+    std::size_t flat = 0;
+    Box3 bounds_world;
+  };
+  std::vector<Collider> colliders;
+  std::vector<Obstacle> obstacles;
+
   /// Respond stage: the grasp holds (both pads press the ball from opposite sides hard enough
   /// that friction carries its weight). A report: the ball is held by friction, not attached.
   bool held = false;

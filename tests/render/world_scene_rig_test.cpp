@@ -1,12 +1,16 @@
-// TeleopScene: what it draws checked against the world's own geometry, not stored images — after
-// a scripted pick-and-place the sheet mesh holds the world's dented heights exactly, the ball's
-// colour appears where the ball's centre projects, the pads sit (and are drawn) where the slave
-// chain's forward kinematics puts them, and URDF-style link meshes follow their chain frames.
-#include "hapsim/render/teleop_scene.h"
+// WorldScene drawing a teleoperation rig: what it draws checked against the world's own geometry,
+// not stored images — after a scripted pick-and-place the sheet mesh holds the world's dented
+// heights exactly (from the world and from a snapshot), the ball's colour appears where the
+// ball's centre projects, the pads are drawn where the slave chain's forward kinematics puts them,
+// and the slave's links (URDF-style meshes, boxes between joint origins, the GP7's collision
+// meshes) where its chain frames are.
+#include "hapsim/render/world_scene.h"
 
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/kinematics/procedural_motoman.h"
+#include "hapsim/render/image_compare.h"
 #include "hapsim/render/renderer.h"
+#include "hapsim/runtime/world_snapshot.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/scene/teleop_setup.h"
 #include "render/gl_test_context.h"
@@ -16,6 +20,7 @@
 #include <cmath>
 #include <filesystem>
 #include <memory>
+#include <tuple>
 
 namespace hapsim {
 namespace {
@@ -27,7 +32,7 @@ constexpr int kH = 240;
 
 // The default teleop scene (procedural Motoman, ball on the floor, sheet on a frame), stepped
 // through its whole scripted pick-and-place: the ball ends resting in a dent of the sheet.
-class TeleopSceneTest : public ::testing::Test {
+class WorldSceneRigTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     SceneDescription scene;
@@ -75,29 +80,34 @@ class TeleopSceneTest : public ::testing::Test {
   static std::string why_not_;
 };
 
-std::unique_ptr<TeleopSetup> TeleopSceneTest::setup_;
-std::unique_ptr<World> TeleopSceneTest::world_;
-std::unique_ptr<OffscreenContext> TeleopSceneTest::context_;
-std::unique_ptr<Renderer> TeleopSceneTest::renderer_;
-std::string TeleopSceneTest::why_not_;
+std::unique_ptr<TeleopSetup> WorldSceneRigTest::setup_;
+std::unique_ptr<World> WorldSceneRigTest::world_;
+std::unique_ptr<OffscreenContext> WorldSceneRigTest::context_;
+std::unique_ptr<Renderer> WorldSceneRigTest::renderer_;
+std::string WorldSceneRigTest::why_not_;
 
-TEST_F(TeleopSceneTest, SheetMeshHoldsTheWorldsDentedHeights) {
+TEST_F(WorldSceneRigTest, SheetMeshHoldsTheWorldsDentedHeights) {
   const World& world = *world_;
   ASSERT_GT(world.sheet(world.description().teleop->sheet_body)->max_depth_m(), 1e-4)
       << "the ball should rest in a dent";
-  TeleopScene from_world(world);
+  WorldScene from_world(world);
   from_world.update_from_world(world);
-  TeleopScene from_snapshot(world);
-  from_snapshot.update(make_teleop_snapshot(world));
+  WorldScene from_snapshot(world);
+  from_snapshot.update(make_world_snapshot(world));
   const auto heights = world.sheet(world.description().teleop->sheet_body)->surface_heights();
   const TriangleMesh& rest = world.sheet(world.description().teleop->sheet_body)->mesh();
-  for (const TeleopScene* scene : {&from_world, &from_snapshot}) {
-    const RenderMesh& sheet = scene->scene().mesh(scene->sheet_mesh());
+  const std::size_t flat = world.flat_segment(world.description().teleop->sheet_body, 0);
+  for (const WorldScene* scene : {&from_world, &from_snapshot}) {
+    const RenderMesh& sheet = scene->scene().mesh(scene->segment_mesh(flat));
     ASSERT_EQ(sheet.geometry().vertices.size(), heights.size());
+    // A snapshot carries positions as float.
+    const bool exact = scene == &from_world;
     for (std::size_t k = 0; k < heights.size(); ++k) {
-      ASSERT_EQ(sheet.geometry().vertices[k].z(), heights[k]) << "node " << k;
-      ASSERT_EQ(sheet.geometry().vertices[k].x(), rest.vertices[k].x());
-      ASSERT_EQ(sheet.geometry().vertices[k].y(), rest.vertices[k].y());
+      const Vec3& v = sheet.geometry().vertices[k];
+      ASSERT_EQ(v.z(), exact ? heights[k] : static_cast<double>(static_cast<float>(heights[k])))
+          << "node " << k;
+      ASSERT_NEAR(v.x(), rest.vertices[k].x(), exact ? 0.0 : 1e-7);
+      ASSERT_NEAR(v.y(), rest.vertices[k].y(), exact ? 0.0 : 1e-7);
     }
     EXPECT_TRUE(
         sheet.X_world_mesh.isApprox(world.description().teleop->environment.X_world_sheet, 0.0));
@@ -116,13 +126,14 @@ TEST_F(TeleopSceneTest, SheetMeshHoldsTheWorldsDentedHeights) {
             -0.5 * world.sheet(world.description().teleop->sheet_body)->max_depth_m());
 }
 
-TEST_F(TeleopSceneTest, BallColourAppearsWhereItsCentreProjects) {
+TEST_F(WorldSceneRigTest, BallColourAppearsWhereItsCentreProjects) {
   require_gl();
   const World& world = *world_;
-  TeleopScene scene(world);
+  WorldScene scene(world);
   scene.update_from_world(world);
   // Look at the ball from beyond it (the robot behind it), a little from above.
-  const Vec3 ball = world.body_pose(world.description().teleop->ball_body).translation();
+  const std::size_t ball_body = world.description().teleop->ball_body;
+  const Vec3 ball = world.body_pose(ball_body).translation();
   OrbitCamera cam;
   cam.target_world = ball;
   cam.yaw_rad = std::atan2(ball.y(), ball.x());
@@ -136,19 +147,64 @@ TEST_F(TeleopSceneTest, BallColourAppearsWhereItsCentreProjects) {
   EXPECT_TRUE(dominant(pixel_at(with_ball, kW, x, y), 0, 60))
       << "pixel " << x << "," << y << " = " << pixel_at(with_ball, kW, x, y).r << " "
       << pixel_at(with_ball, kW, x, y).g << " " << pixel_at(with_ball, kW, x, y).b;
-  // Without the ball the red is gone (it was the ball, not the robot or the background).
-  ASSERT_FALSE(scene.scene().spheres.empty());
-  ASSERT_EQ(scene.scene().spheres[0].centre_world, ball);
-  scene.scene().spheres.erase(scene.scene().spheres.begin());
+  // The ball is drawn where its body is; without it the red is gone (it was the ball, not the
+  // robot or the background).
+  const std::size_t flat = world.flat_segment(ball_body, 0);
+  EXPECT_TRUE(scene.scene()
+                  .mesh(scene.segment_mesh(flat))
+                  .X_world_mesh.isApprox(world.body_pose(ball_body), 0.0));
+  scene.set_segment_visible(flat, false);
   const auto without = render(scene.scene(), cam);
   EXPECT_FALSE(dominant(pixel_at(without, kW, x, y), 0, 60));
 }
 
-TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
+TEST_F(WorldSceneRigTest, BallsImprintShowsInTheDrawnSheet) {
   require_gl();
   const World& world = *world_;
-  TeleopScene scene(world);
+  const TeleopRigDescription& rig = *world.description().teleop;
+  // Only the sheet, from a little above, around where the ball rests: once as the world left it
+  // (the ball's dent), once at rest (a world not stepped).
+  const World flat(world.description());
+  const Vec3 ball = world.body_pose(rig.ball_body).translation();
+  OrbitCamera cam;
+  cam.target_world = ball - Vec3(0.0, 0.0, rig.ball.radius_m);
+  cam.yaw_rad = 0.3;
+  cam.pitch_rad = 0.35;
+  cam.distance_m = 0.25;
+  std::vector<std::vector<std::uint8_t>> images;
+  for (const World* w : {&world, static_cast<const World*>(&flat)}) {
+    WorldScene scene(*w);
+    scene.update_from_world(*w);
+    RenderScene& rs = scene.scene();
+    for (std::size_t i = 0; i < scene.segment_count(); ++i) {
+      scene.set_segment_visible(i, i == world.flat_segment(rig.sheet_body, 0));
+    }
+    rs.spheres.clear();
+    rs.segments.clear();
+    rs.shadow_marks.clear();
+    rs.floor.visible = false;
+    images.push_back(render(rs, cam));
+  }
+  // The dent (a fraction of a millimetre, drawn darker by its depth) shows where the ball sat.
+  const ImageDiff d = compare_images(images[0], images[1], kW, kH);
+  EXPECT_GT(d.differing_fraction, 0.01);
+  const Vec3 px = cam.project(ball - Vec3(0.0, 0.0, rig.ball.radius_m), kW, kH);
+  const test::Pixel dented =
+      pixel_at(images[0], kW, static_cast<int>(px.x()), static_cast<int>(px.y()));
+  const test::Pixel at_rest =
+      pixel_at(images[1], kW, static_cast<int>(px.x()), static_cast<int>(px.y()));
+  EXPECT_NE(std::tuple(dented.r, dented.g, dented.b), std::tuple(at_rest.r, at_rest.g, at_rest.b));
+}
+
+TEST_F(WorldSceneRigTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
+  require_gl();
+  const World& world = *world_;
+  WorldScene scene(world);
   scene.update_from_world(world);
+  const auto pad_mesh = [&](int i) {
+    return scene.segment_mesh(
+        world.flat_segment(world.description().teleop->pad_body[static_cast<std::size_t>(i)], 0));
+  };
   // Independent geometry: the tool from the chain's FK, the pads across its y at the pad depth.
   const Iso3 X_tool = world.rig()->slave->chain().forward(world.rig()->slave->q());
   const ParallelGripperParams& p = world.description().teleop->gripper;
@@ -156,7 +212,7 @@ TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
   const Vec3 pad_world[2] = {X_tool * Vec3(0.0, 0.5 * w + p.pad_half_m.y(), p.pad_depth_m),
                              X_tool * Vec3(0.0, -(0.5 * w + p.pad_half_m.y()), p.pad_depth_m)};
   for (int i = 0; i < 2; ++i) {
-    const RenderMesh& pad = scene.scene().mesh(scene.pad_mesh(i));
+    const RenderMesh& pad = scene.scene().mesh(pad_mesh(i));
     EXPECT_LT((pad.X_world_mesh.translation() - pad_world[i]).norm(), 1e-12) << "pad " << i;
     EXPECT_TRUE(pad.X_world_mesh.linear().isApprox(X_tool.linear(), 1e-12));
   }
@@ -184,8 +240,8 @@ TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
   cam.pitch_rad = 0.3;
   cam.distance_m = 0.35;
   for (int i = 0; i < 2; ++i) {
-    rs.mesh(scene.pad_mesh(i)).visible = true;
-    rs.mesh(scene.pad_mesh(i)).colour = Vec3f(0.1f, 0.9f, 0.1f);
+    rs.mesh(pad_mesh(i)).visible = true;
+    rs.mesh(pad_mesh(i)).colour = Vec3f(0.1f, 0.9f, 0.1f);
   }
   const auto image = render(rs, cam);
   for (int i = 0; i < 2; ++i) {
@@ -199,7 +255,27 @@ TEST_F(TeleopSceneTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
   }
 }
 
-TEST(TeleopScene, LinkMeshesFollowTheirChainFrames) {
+// The render meshes of the slave's links (its bodies off the tool frame), in chain order.
+std::vector<MeshId> link_meshes(const World& world, const WorldScene& scene) {
+  std::vector<MeshId> ids;
+  for (const TeleopRigDescription::SlaveBody& s : world.description().teleop->slave_bodies) {
+    if (s.frame != kToolFrame) {
+      ids.push_back(scene.segment_mesh(world.flat_segment(s.body, 0)));
+    }
+  }
+  return ids;
+}
+
+// The middle of a mesh's vertices' bounds, world frame (a box's centre, however it turns).
+Vec3 bounds_centre_world(const RenderMesh& m) {
+  Box3 b;
+  for (const Vec3& v : m.geometry().vertices) {
+    b.extend(m.X_world_mesh * v);
+  }
+  return b.center();
+}
+
+TEST(WorldSceneRig, LinkMeshesFollowTheirChainFrames) {
   // The procedural Motoman with a mesh on joint 2's frame, as a URDF's collision meshes come.
   SerialChain chain = make_procedural_motoman();
   ChainLinkGeometry g;
@@ -212,25 +288,24 @@ TEST(TeleopScene, LinkMeshesFollowTheirChainFrames) {
   d.slave = std::make_shared<const SerialChain>(std::move(chain));
   d.slave_start_rad = {0.3, -0.2, 0.4, 0.1, 0.5, -0.2};
   World world(rig_world(d));
-  TeleopScene scene(world);
-  ASSERT_EQ(scene.link_meshes().size(), 1u);
+  WorldScene scene(world);
+  ASSERT_EQ(link_meshes(world, scene).size(), 1u);
   std::array<Iso3, kMaxChainJoints> frames;
   static_cast<void>(world.rig()->slave->chain().frames(world.rig()->slave->q(), frames));
-  const RenderMesh& mesh = scene.scene().mesh(scene.link_meshes()[0]);
+  const RenderMesh& mesh = scene.scene().mesh(link_meshes(world, scene)[0]);
   EXPECT_TRUE(mesh.X_world_mesh.isApprox(frames[2] * g.X_frame_mesh, 1e-12));
-  EXPECT_EQ(mesh.geometry().vertices.size(), g.mesh.vertices.size());
   // The bounds frame the whole scene: the ball, the sheet and the master drawn beside.
   const Box3& b = scene.rest_bounds_world();
   EXPECT_TRUE(b.contains(world.body_pose(world.description().teleop->ball_body).translation()));
   EXPECT_TRUE(b.contains(scene.master_display_origin_world()));
 }
 
-TEST(TeleopScene, BoxLinksJoinTheJointOrigins) {
+TEST(WorldSceneRig, BoxLinksJoinTheJointOrigins) {
   TeleopRigDescription d;
   d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
   d.slave_start_rad = {0.3, -0.2, 0.4, 0.1, 0.5, -0.2};
   World world(rig_world(d));
-  TeleopScene scene(world);
+  WorldScene scene(world);
   const SerialChain& chain = world.rig()->slave->chain();
   std::array<Iso3, kMaxChainJoints> frames;
   const Iso3 tip = chain.frames(world.rig()->slave->q(), frames);
@@ -247,21 +322,18 @@ TEST(TeleopScene, BoxLinksJoinTheJointOrigins) {
       midpoints.push_back(0.5 * (origins[k] + origins[k - 1]));
     }
   }
-  ASSERT_EQ(scene.link_meshes().size(), midpoints.size());
+  const std::vector<MeshId> links = link_meshes(world, scene);
+  ASSERT_EQ(links.size(), midpoints.size());
   for (std::size_t l = 0; l < midpoints.size(); ++l) {
-    const RenderMesh& m = scene.scene().mesh(scene.link_meshes()[l]);
-    Vec3 c = Vec3::Zero();
-    for (const Vec3& v : m.geometry().vertices) {
-      c += m.X_world_mesh * v;
-    }
-    c /= static_cast<double>(m.geometry().vertices.size());
-    EXPECT_LT((c - midpoints[l]).norm(), 1e-9) << "link box " << l;
+    const RenderMesh& m = scene.scene().mesh(links[l]);
+    EXPECT_LT((bounds_centre_world(m) - midpoints[l]).norm(), 1e-9) << "link box " << l;
+    EXPECT_EQ(m.colour, RigColours{}.robot);
   }
-  // And a joint sphere at each joint (after the ball).
+  // And a joint sphere at each joint (the first spheres drawn).
   const auto& spheres = scene.scene().spheres;
-  ASSERT_GE(spheres.size(), 1u + static_cast<std::size_t>(chain.dof()));
+  ASSERT_GE(spheres.size(), static_cast<std::size_t>(chain.dof()));
   for (int k = 0; k < chain.dof(); ++k) {
-    EXPECT_LT((spheres[1 + static_cast<std::size_t>(k)].centre_world -
+    EXPECT_LT((spheres[static_cast<std::size_t>(k)].centre_world -
                frames[static_cast<std::size_t>(k)].translation())
                   .norm(),
               1e-12);
@@ -274,7 +346,7 @@ TEST(TeleopScene, BoxLinksJoinTheJointOrigins) {
 namespace hapsim {
 namespace {
 
-TEST(TeleopScene, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
+TEST(WorldSceneRig, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
   const auto data = std::filesystem::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7";
   if (!std::filesystem::exists(data / "gp7.urdf")) {
     GTEST_SKIP() << "Motoman GP7 URDF not found in " << data << " (real-data tests skip)";
@@ -287,23 +359,25 @@ TEST(TeleopScene, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
   const SerialChain& chain = *setup.description.teleop->slave;
   ASSERT_FALSE(chain.link_geometry().empty());
   World world(setup.description);
-  TeleopScene drawn(world);
+  WorldScene drawn(world);
   std::array<Iso3, kMaxChainJoints> frames;
   static_cast<void>(chain.frames(world.rig()->slave->q(), frames));
+  const std::vector<MeshId> links = link_meshes(world, drawn);
   std::size_t l = 0;
   for (const ChainLinkGeometry& g : chain.link_geometry()) {
     if (g.mesh.empty()) {
       continue;
     }
-    ASSERT_LT(l, drawn.link_meshes().size());
-    const RenderMesh& m = drawn.scene().mesh(drawn.link_meshes()[l++]);
+    ASSERT_LT(l, links.size());
+    const RenderMesh& m = drawn.scene().mesh(links[l++]);
     const Iso3 X_world_frame =
         g.frame < 0 ? Iso3::Identity() : frames[static_cast<std::size_t>(g.frame)];
     EXPECT_TRUE(m.X_world_mesh.isApprox(X_world_frame * g.X_frame_mesh, 1e-12)) << g.link;
     EXPECT_EQ(m.geometry().vertices.size(), g.mesh.vertices.size()) << g.link;
   }
-  EXPECT_EQ(l, drawn.link_meshes().size());
-  // Meshes drawn: no joint spheres, just the ball and the master's joints.
+  EXPECT_EQ(l, links.size());
+  // Meshes drawn: no joint spheres, just the master's joints.
+  EXPECT_EQ(drawn.scene().spheres.size(), 4u);
   EXPECT_TRUE(drawn.rest_bounds_world().contains(frames[0].translation()));
 }
 
