@@ -219,6 +219,52 @@ TEST(DynamicMesh, ProbePushingACubeAlongTheFloorFeelsDynamicFriction) {
   EXPECT_LT((world.body_pose(1).linear() - Mat3::Identity()).norm(), 0.02);
 }
 
+// One static segment whose mesh is two walls squeezes a cube between them: the vertex forces on
+// its two sides cancel, but friction is limited by what presses on each side (Coulomb: the cube
+// hangs when 2·μ·N_side > m·g, falls when not), not by their near-zero sum.
+TEST(DynamicMesh, CubeSqueezedInASlotOfOneSegmentHangsByFrictionOnBothSides) {
+  const double half = 0.02;
+  const double mass = 0.2;
+  const double squeeze = 0.0005;  // each wall 0.5 mm into the cube's side
+  const auto run = [&](double mu) {
+    WorldDescription d;
+    d.gravity_m_per_s2 = Vec3(0.0, 0.0, -kG);
+    d.materials = {penalty("cube", 20000.0, mu), penalty("wall", 20000.0, mu)};
+    BodyDescription slot;
+    slot.name = "slot";
+    SegmentDescription s;
+    s.name = "walls";
+    s.material = 1;
+    for (const double side : {-1.0, 1.0}) {
+      TriangleMesh wall = make_box(Vec3(0.01, 0.05, 0.05));
+      const auto first = static_cast<std::uint32_t>(s.mesh.vertices.size());
+      for (const Vec3& v : wall.vertices) {
+        s.mesh.vertices.push_back(v + Vec3(side * (half + 0.01 - squeeze), 0.0, 0.0));
+      }
+      for (const auto& t : wall.triangles) {
+        s.mesh.triangles.push_back({t[0] + first, t[1] + first, t[2] + first});
+      }
+    }
+    s.mesh.compute_vertex_normals();
+    slot.segments.push_back(std::move(s));
+    d.bodies = {std::move(slot), cube_body("cube", half, mass, Iso3::Identity(), 0)};
+    d.tools.push_back(ToolDescription{"probe", 0.005, Vec3::Zero(), -1});
+    World world(std::move(d));
+    for (int i = 0; i < 1000; ++i) {
+      world.step(kAway, 1e-3);
+    }
+    return world.body_pose(1).translation().z();
+  };
+  // Four corner springs of 10 kN/m (in series) on each side: N_side = 4·k·squeeze = 20 N.
+  const double n_side = 4.0 * 10000.0 * squeeze;
+  const double holds_mu = 0.5;   // 2·μ·N = 20 N > m·g = 1.96 N
+  const double slips_mu = 0.02;  // 2·μ·N = 0.8 N < m·g
+  ASSERT_GT(2.0 * holds_mu * n_side, mass * kG);
+  ASSERT_LT(2.0 * slips_mu * n_side, mass * kG);
+  EXPECT_GT(run(holds_mu), -1e-3) << "hangs in the slot (sagging by its stick springs only)";
+  EXPECT_LT(run(slips_mu), -0.05) << "slides out of the slot";
+}
+
 TEST(DynamicMesh, CubeOnTheSheetIsCarried) {
   const double half = 0.015;
   const double mass = 0.05;

@@ -61,6 +61,7 @@ struct SphereTree::Impl {
   std::vector<double> tx, ty, tz, tr;
   std::size_t depth = 0;
   std::size_t point_stack_bound = 0;
+  std::size_t max_children = 1;  // the most children of any node (tree-vs-tree stack bound)
 
   void build_topology(const TriangleMesh& mesh, int branching, int max_leaf,
                       const ProgressFn& progress);
@@ -198,10 +199,12 @@ void SphereTree::Impl::build_topology(const TriangleMesh& mesh, int branching, i
   std::vector<std::size_t> stack_need(node_count, 1);
   depth = 0;
   point_stack_bound = 1;
+  max_children = 1;
   for (std::size_t i = 0; i < node_count; ++i) {
     depth = std::max<std::size_t>(depth, level[i] + 1U);
     point_stack_bound = std::max(point_stack_bound, stack_need[i]);
     const Node& nd = nodes[i];
+    max_children = std::max<std::size_t>(max_children, nd.child_count);
     for (std::uint32_t c = 0; c < nd.child_count; ++c) {
       stack_need[nd.first_child + c] = stack_need[i] + nd.child_count - 1;
     }
@@ -491,13 +494,8 @@ bool SphereTree::overlapping_leaves(const SphereTree& other, const Iso3& X_this_
     return true;
   }
   // Each step pops one pair and pushes at most `children` pairs, along at most
-  // depth_a + depth_b steps.
-  std::size_t max_children = 1;
-  for (const Impl* im : {&a, &b}) {
-    for (const Node& nd : im->nodes) {
-      max_children = std::max<std::size_t>(max_children, nd.child_count);
-    }
-  }
+  // depth_a + depth_b steps (both known since the build: this runs every haptic step).
+  const std::size_t max_children = std::max(a.max_children, b.max_children);
   if ((a.depth + b.depth) * (max_children - 1) + 1 > kMaxPairStack) {
     throw std::length_error("SphereTree::overlapping_leaves: trees too deep for the pair stack");
   }

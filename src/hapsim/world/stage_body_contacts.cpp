@@ -70,6 +70,9 @@ struct PairContact {
   Vec3 f_normal_on_a_n = Vec3::Zero();
   /// The normal force is already on both bodies (a mesh's vertex springs, each where it acts).
   bool normal_applied = false;
+  /// What friction is limited by: the sum of the normal forces' sizes (a mesh's vertex forces
+  /// may point different ways, as in a groove or a slot), newtons.
+  double normal_load_n = 0.0;
   /// A mesh: how far its vertex forces spread around p_a_world (their force-weighted rms
   /// distance), what friction against spinning about the normal acts over. 0 for a sphere.
   double spin_radius_m = 0.0;
@@ -120,6 +123,7 @@ bool sphere_pair(const WorldModel& model, WorldState& state, const SegmentModel&
   const ContactMaterial material =
       combine_materials(state.body_materials[own_seg.material], state.body_materials[seg.material]);
   c.f_normal_on_a_n = penalty_force(material, c.depth_m, c.n_world, -v_rel.dot(c.n_world));
+  c.normal_load_n = c.f_normal_on_a_n.norm();
   if (!seg.sheet) {  // a sheet gives way a step later: its contact stays explicit
     const double f_n = c.f_normal_on_a_n.norm();
     const BodyModel& other_model = model.bodies()[seg.body];
@@ -216,8 +220,12 @@ class MeshPair {
     c.p_b_world = c.p_a_world;
     c.spin_radius_m =
         std::sqrt(std::max(0.0, weighted_square_m2_ / weight_ - c.p_a_world.squaredNorm()));
+    // The friction plane: across the summed force, unless the vertex forces mostly cancel (a
+    // body pinched in a slot), then across the hardest-pressed vertex's normal.
     const double n_norm = f_normal_on_a_.norm();
-    c.n_world = n_norm > 0.0 ? Vec3(f_normal_on_a_ / n_norm) : normal_sum_.normalized();
+    c.n_world = n_norm >= 0.5 * force_sizes_n_ && n_norm > 0.0 ? Vec3(f_normal_on_a_ / n_norm)
+                                                               : hardest_normal_;
+    c.normal_load_n = force_sizes_n_;
     c.depth_m = deepest_m_;
     c.f_normal_on_a_n = f_normal_on_a_;
     c.normal_applied = true;
@@ -284,7 +292,12 @@ class MeshPair {
                         body_a_.velocity_at(p_world, model_a_.com_body));
     }
     f_normal_on_a_ += f;
-    normal_sum_ += n_world;
+    const double f_n = f.norm();
+    force_sizes_n_ += f_n;
+    if (f_n >= hardest_n_) {
+      hardest_n_ = f_n;
+      hardest_normal_ = n_world;
+    }
     // The stick point sits where the springs push, weighted by how hard (a bare touch: evenly).
     const double w = f.norm() + 1e-12;
     weighted_point_world_ += w * p_world;
@@ -312,7 +325,9 @@ class MeshPair {
   Box3 bounds_a_;
   Box3 bounds_b_;
   Vec3 f_normal_on_a_ = Vec3::Zero();
-  Vec3 normal_sum_ = Vec3::Zero();
+  double force_sizes_n_ = 0.0;
+  double hardest_n_ = 0.0;
+  Vec3 hardest_normal_ = Vec3::UnitZ();
   Vec3 weighted_point_world_ = Vec3::Zero();
   double weighted_square_m2_ = 0.0;
   double weight_ = 0.0;
@@ -324,8 +339,7 @@ class MeshPair {
 // that radius. It stops a box spinning on a table; a steady torque below the limit creeps.
 void spin_friction(BodyState& own, BodyState& other, const PairContact& c,
                    const ContactMaterial& material, bool explicit_only) noexcept {
-  const double normal_n = c.f_normal_on_a_n.norm();
-  const double limit_nm = material.dynamic_friction * normal_n * c.spin_radius_m;
+  const double limit_nm = material.dynamic_friction * c.normal_load_n * c.spin_radius_m;
   const double b_nms = material.damping_n_s_per_m * c.spin_radius_m * c.spin_radius_m;
   if (!(limit_nm > 0.0) || !(b_nms > 0.0) || !std::isfinite(b_nms)) {
     return;
@@ -378,12 +392,12 @@ void finish_pair(const WorldModel& model, WorldState& state, const SegmentModel&
       combine_materials(state.body_materials[own_seg.material], state.body_materials[seg.material]);
   // A stick spring from that point to where it stuck on the other body.
   StickPoint stick{pair.stick_body.active, other.X_world_body * pair.stick_body.p};
-  const Vec3 f_friction = contact_friction_force(material, c.f_normal_on_a_n.norm(), c.n_world,
-                                                 v_rel, p_friction_world, stick);
+  const Vec3 f_friction =
+      contact_friction_force(material, c.normal_load_n, c.n_world, v_rel, p_friction_world, stick);
   pair.stick_body = {stick.active, other.X_body_world * stick.p};
   pair.stick_own_body = own.X_body_world * p_friction_world;
   if (!seg.sheet) {
-    const double f_n = c.f_normal_on_a_n.norm();
+    const double f_n = c.normal_load_n;
     linearise_friction(own, own_model, p_friction_world, c.n_world, material, f_n, f_friction,
                        other.velocity_at(p_other_world, other_model.com_body));
     linearise_friction(other, other_model, p_other_world, c.n_world, material, f_n, f_friction,
