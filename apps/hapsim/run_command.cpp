@@ -143,6 +143,22 @@ constexpr double kKneeYaw = 1.95;
 constexpr double kKneePitch = 0.3;
 constexpr double kTeleopYaw = -0.9;
 constexpr double kTeleopPitch = 0.45;
+// A table-top scene (free bodies, a sheet, no rig) from the front, well above: at the knee's
+// shallow angle a sheet 5 cm over a table reads as lying behind it.
+constexpr double kTableTopPitch = 0.75;
+
+// Whether the world has bodies that move or a sheet, and no rig: a table-top scene.
+bool table_top(const World& world) {
+  if (world.rig() != nullptr) {
+    return false;
+  }
+  for (const BodyDescription& b : world.description().bodies) {
+    if (b.kind == BodyKind::kDynamic || b.deformation == BodyDeformation::kGaussianSheet) {
+      return true;
+    }
+  }
+  return false;
+}
 
 ContactMethod parse_method(const std::string& name) {
   return parse_contact_method(name).value_or(ContactMethod::kKnee);  // CLI11 has checked it
@@ -373,7 +389,8 @@ void run(const RunArgs& args) {
           o.sphere_tree_level = args.sphere_tree_level;
           return std::make_unique<WorldScene>(w, o);
         },
-        teleop ? kTeleopYaw : kKneeYaw, teleop ? kTeleopPitch : kKneePitch);
+        teleop ? kTeleopYaw : kKneeYaw,
+        teleop ? kTeleopPitch : (table_top(*world) ? kTableTopPitch : kKneePitch));
   }
 
   SessionOptions options;
