@@ -129,7 +129,7 @@ TEST(WorldSceneSheet, TeleopSheetsDrawnVerticesAreTheWorldsSheet) {
 }
 
 // Drawn: what `hapsim run --snapshot` shows of hand_ball_sheet.json (its camera: azimuth 1.95,
-// elevation 0.3, framed on the rest bounds), and a view from the side, level with the table.
+// elevation 0.75, framed on the rest bounds), and a view from the side, level with the table.
 class WorldSceneSheetPicture : public ::testing::Test {
  protected:
   static constexpr int kW = 640;
@@ -200,7 +200,7 @@ TEST_F(WorldSceneSheetPicture, SheetFillsTheQuadItsWorldCornersProjectTo) {
   WorldScene view(world);
   view.update_from_world(world);
   const OrbitCamera cam =
-      framed_camera(view.rest_bounds_world(), static_cast<double>(kW) / kH, 1.95, 0.3);
+      framed_camera(view.rest_bounds_world(), static_cast<double>(kW) / kH, 1.95, 0.75);
   const auto image = render(view.scene(), cam);
   const Iso3& X = world.body_pose(body_named(world.description(), "sheet"));
   std::array<Vec3, 4> quad;
