@@ -11,6 +11,7 @@
 #include "hapsim/world/world.h"
 
 #include "support/allocation_counter.h"
+#include "support/body_fixtures.h"
 
 #include <gtest/gtest.h>
 
@@ -19,20 +20,15 @@
 namespace hapsim {
 namespace {
 
+using test::floor_body;
+using test::probe_at;
+
 constexpr double kBallRadius = 0.03;
 constexpr double kBallMass = 0.1;
 constexpr double kG = 9.81;
 
 MaterialDescription penalty(const char* name, double k, double max_force_n, double friction) {
-  MaterialDescription m;
-  m.name = name;
-  m.response = ContactResponse::kPenalty;
-  m.contact.stiffness_n_per_m = k;
-  m.contact.max_penetration_m = 0.01;
-  m.contact.max_force_n = max_force_n;
-  m.contact.static_friction = friction;
-  m.contact.dynamic_friction = friction;
-  return m;
+  return test::penalty_material(name, k, max_force_n, friction);
 }
 
 BodyDescription ball_body(const Vec3& p_world, std::uint32_t material) {
@@ -51,19 +47,6 @@ BodyDescription ball_body(const Vec3& p_world, std::uint32_t material) {
   return b;
 }
 
-// A floor box whose top face is z = 0.
-BodyDescription floor_body(std::uint32_t material) {
-  BodyDescription b;
-  b.name = "floor";
-  b.X_world_body = Iso3(Eigen::Translation3d(0.0, 0.0, -0.05));
-  SegmentDescription s;
-  s.name = "floor";
-  s.material = material;
-  s.mesh = make_box(Vec3(0.3, 0.3, 0.05));
-  b.segments.push_back(std::move(s));
-  return b;
-}
-
 BodyDescription sheet_body(std::uint32_t material) {
   BodyDescription b;
   b.name = "sheet";
@@ -76,12 +59,6 @@ BodyDescription sheet_body(std::uint32_t material) {
   s.two_sided = true;
   b.segments.push_back(std::move(s));
   return b;
-}
-
-DeviceInput probe_at(const Vec3& p) {
-  DeviceInput in;
-  in.p_world = p;
-  return in;
 }
 
 // Far from everything: the tools touch nothing.

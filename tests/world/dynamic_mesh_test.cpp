@@ -9,6 +9,7 @@
 #include "hapsim/world/world.h"
 
 #include "support/allocation_counter.h"
+#include "support/body_fixtures.h"
 
 #include <gtest/gtest.h>
 
@@ -17,18 +18,13 @@
 namespace hapsim {
 namespace {
 
+using test::floor_body;
+using test::probe_at;
+
 constexpr double kG = 9.81;
 
 MaterialDescription penalty(const char* name, double k, double friction) {
-  MaterialDescription m;
-  m.name = name;
-  m.response = ContactResponse::kPenalty;
-  m.contact.stiffness_n_per_m = k;
-  m.contact.max_penetration_m = 0.01;
-  m.contact.max_force_n = 50.0;
-  m.contact.static_friction = friction;
-  m.contact.dynamic_friction = friction;
-  return m;
+  return test::penalty_material(name, k, 50.0, friction);
 }
 
 // A dynamic cube of half side `half_m` (a 12-triangle mesh) whose mass properties come from its
@@ -51,27 +47,8 @@ BodyDescription cube_body(const char* name, double half_m, double mass_kg, const
   return b;
 }
 
-// A static floor box whose top face is z = 0.
-BodyDescription floor_body(std::uint32_t material) {
-  BodyDescription b;
-  b.name = "floor";
-  b.X_world_body = Iso3(Eigen::Translation3d(0.0, 0.0, -0.05));
-  SegmentDescription s;
-  s.name = "floor";
-  s.material = material;
-  s.mesh = make_box(Vec3(0.3, 0.3, 0.05));
-  b.segments.push_back(std::move(s));
-  return b;
-}
-
 Iso3 at(const Vec3& p) {
   return Iso3(Eigen::Translation3d(p));
-}
-
-DeviceInput probe_at(const Vec3& p) {
-  DeviceInput in;
-  in.p_world = p;
-  return in;
 }
 
 const DeviceInput kAway = probe_at(Vec3(0.0, 0.0, 1.0));
