@@ -148,8 +148,7 @@ class MeshPair {
  public:
   MeshPair(const WorldModel& model, WorldState& state, const SegmentModel& a, std::size_t a_flat,
            const SegmentModel& b, std::size_t b_flat, BodyPairState& pair) noexcept
-      : model_(model),
-        state_(state),
+      : state_(state),
         a_(a),
         b_(b),
         body_a_(state.bodies[a.body]),
@@ -306,7 +305,6 @@ class MeshPair {
     deepest_m_ = std::max(deepest_m_, depth_m);
   }
 
-  const WorldModel& model_;
   WorldState& state_;
   const SegmentModel& a_;
   const SegmentModel& b_;
