@@ -78,6 +78,19 @@ struct PairContact {
   double spin_radius_m = 0.0;
 };
 
+// When both bodies move, a contact spring between them couples their velocity updates (the
+// integrate stage solves them together). haptic path
+void couple_penalty(const WorldModel& model, WorldState& state, std::size_t a, std::size_t b,
+                    const Vec3& p_a_world, const Vec3& p_b_world, const ContactMaterial& material,
+                    const Vec3& n_world, double depth_m, double force_n) noexcept {
+  Mat3 S;
+  Mat3 D;
+  if (model.bodies()[a].dynamic_index >= 0 && model.bodies()[b].dynamic_index >= 0 &&
+      penalty_spring(material, n_world, depth_m, force_n, S, D)) {
+    state.couple_bodies(model, a, b, p_a_world, p_b_world, S, D);
+  }
+}
+
 // The contact of sphere (c_world, r) with segment `flat`, or false. `pair` keeps the hint and
 // whether they touched last step (only then can the centre be deeper than the radius).
 bool sphere_segment_contact(const WorldState& state, const SegmentModel& seg, std::size_t flat,
@@ -131,6 +144,8 @@ bool sphere_pair(const WorldModel& model, WorldState& state, const SegmentModel&
                       other.velocity_at(c.p_b_world, other_model.com_body));
     linearise_penalty(state.bodies[seg.body], other_model, c.p_b_world, c.n_world, material,
                       c.depth_m, f_n, own.velocity_at(c.p_a_world, bm.com_body));
+    couple_penalty(model, state, body, seg.body, c.p_a_world, c.p_b_world, material, c.n_world,
+                   c.depth_m, f_n);
   }
   return true;
 }
@@ -148,7 +163,8 @@ class MeshPair {
  public:
   MeshPair(const WorldModel& model, WorldState& state, const SegmentModel& a, std::size_t a_flat,
            const SegmentModel& b, std::size_t b_flat, BodyPairState& pair) noexcept
-      : state_(state),
+      : model_(model),
+        state_(state),
         a_(a),
         b_(b),
         body_a_(state.bodies[a.body]),
@@ -289,6 +305,8 @@ class MeshPair {
                         body_b_.velocity_at(p_world, model_b_.com_body));
       linearise_penalty(body_b_, model_b_, p_world, n_world, material_, depth_m, f.norm(),
                         body_a_.velocity_at(p_world, model_a_.com_body));
+      couple_penalty(model_, state_, a_.body, b_.body, p_world, p_world, material_, n_world,
+                     depth_m, f.norm());
     }
     f_normal_on_a_ += f;
     const double f_n = f.norm();
@@ -305,6 +323,7 @@ class MeshPair {
     deepest_m_ = std::max(deepest_m_, depth_m);
   }
 
+  const WorldModel& model_;
   WorldState& state_;
   const SegmentModel& a_;
   const SegmentModel& b_;
@@ -335,12 +354,13 @@ class MeshPair {
 // A mesh's contact spread over an area resists spinning about the normal (one stick point does
 // not): viscous, the tangential damping acting at the spread's radius, up to Coulomb's μd·N at
 // that radius. It stops a box spinning on a table; a steady torque below the limit creeps.
-void spin_friction(BodyState& own, BodyState& other, const PairContact& c,
+// Returns the damper it linearised (zero when none), for two dynamic bodies to couple.
+Mat3 spin_friction(BodyState& own, BodyState& other, const PairContact& c,
                    const ContactMaterial& material, bool explicit_only) noexcept {
   const double limit_nm = material.dynamic_friction * c.normal_load_n * c.spin_radius_m;
   const double b_nms = material.damping_n_s_per_m * c.spin_radius_m * c.spin_radius_m;
   if (!(limit_nm > 0.0) || !(b_nms > 0.0) || !std::isfinite(b_nms)) {
-    return;
+    return Mat3::Zero();
   }
   const double spin_rad_per_s = (own.w_world - other.w_world).dot(c.n_world);
   const double viscous_nm = b_nms * spin_rad_per_s;
@@ -348,7 +368,7 @@ void spin_friction(BodyState& own, BodyState& other, const PairContact& c,
   own.torque_world_nm -= torque_nm * c.n_world;
   other.torque_world_nm += torque_nm * c.n_world;
   if (explicit_only || std::abs(viscous_nm) >= limit_nm) {
-    return;  // sliding at the Coulomb limit: no damper to take implicitly
+    return Mat3::Zero();  // sliding at the Coulomb limit: no damper to take implicitly
   }
   // A pure rotation about n: J = [0, n] for own, the same for the other (its ω enters with −).
   const Mat3 nn = b_nms * c.n_world * c.n_world.transpose();
@@ -358,6 +378,7 @@ void spin_friction(BodyState& own, BodyState& other, const PairContact& c,
   if (other.dynamic) {
     other.damping_6.bottomRightCorner<3, 3>() += nn;
   }
+  return nn;
 }
 
 // Friction at the pair's pressing point, the forces on both bodies, a sheet's push and the record.
@@ -400,6 +421,12 @@ void finish_pair(const WorldModel& model, WorldState& state, const SegmentModel&
                        other.velocity_at(p_other_world, other_model.com_body));
     linearise_friction(other, other_model, p_other_world, c.n_world, material, f_n, f_friction,
                        own.velocity_at(p_friction_world, own_model.com_body));
+    Mat3 S;
+    Mat3 D;
+    if (own_model.dynamic_index >= 0 && other_model.dynamic_index >= 0 &&
+        friction_spring(material, c.n_world, f_n, f_friction, S, D)) {
+      state.couple_bodies(model, body, seg.body, p_friction_world, p_other_world, S, D);
+    }
   }
   // What is not on the bodies yet: friction, and for a sphere its normal force too. The other
   // body gets the opposite (integrated when dynamic; a pad's is what the rig feels).
@@ -412,7 +439,11 @@ void finish_pair(const WorldModel& model, WorldState& state, const SegmentModel&
     push(other, other_model, c.p_b_world, -f);
   }
   if (c.spin_radius_m > 0.0) {
-    spin_friction(own, other, c, material, seg.sheet);
+    const Mat3 spin_damper = spin_friction(own, other, c, material, seg.sheet);
+    if (own_model.dynamic_index >= 0 && other_model.dynamic_index >= 0 &&
+        !spin_damper.isZero(0.0)) {
+      state.couple_rotations(model, body, seg.body, spin_damper);
+    }
   }
   const Vec3 f_total = c.f_normal_on_a_n + f_friction;
   if (seg.sheet) {

@@ -226,6 +226,7 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
       } else {
         has_dynamic_meshes_ = true;
       }
+      bm.dynamic_index = static_cast<std::int32_t>(dynamic_bodies_.size());
       dynamic_bodies_.push_back(b);
       for (std::size_t s = 0; s < bm.segment_count; ++s) {
         dynamic_segments_.push_back(bm.first_segment + s);

@@ -38,6 +38,8 @@ struct BodyModel {
   /// A sheet: how deep its elastic field sinks under a 1 N push, metres (its profile at d = 0).
   double sheet_compliance_m_per_n = 0.0;
   // Dynamic bodies only.
+  /// Its index in WorldModel::dynamic_bodies(); −1 for a body that does not move by itself.
+  std::int32_t dynamic_index = -1;
   double mass_kg = 0.0;
   Vec3 com_body = Vec3::Zero();
   Mat3 inertia_body_kg_m2 = Mat3::Identity();

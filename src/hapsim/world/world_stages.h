@@ -58,6 +58,12 @@ void safety(const WorldModel& model, WorldState& state) noexcept;
 void linearise_penalty(BodyState& body, const BodyModel& bm, const Vec3& p_world,
                        const Vec3& n_world, const ContactMaterial& material, double depth_m,
                        double force_n, const Vec3& v_anchor_world) noexcept;
+/// The spring S and damper D (world frame) of a penalty contact or a sticking friction contact,
+/// where their force law is linear; false where it is clamped (no spring). haptic path
+bool penalty_spring(const ContactMaterial& material, const Vec3& n_world, double depth_m,
+                    double force_n, Mat3& S, Mat3& D) noexcept;
+bool friction_spring(const ContactMaterial& material, const Vec3& n_world, double normal_force_n,
+                     const Vec3& f_friction_n, Mat3& S, Mat3& D) noexcept;
 /// The same for a friction stick spring (tangential), only while it sticks. haptic path
 void linearise_friction(BodyState& body, const BodyModel& bm, const Vec3& p_world,
                         const Vec3& n_world, const ContactMaterial& material, double normal_force_n,

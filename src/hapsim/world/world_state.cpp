@@ -38,6 +38,70 @@ void RigState::reset() noexcept {
 
 RigState::~RigState() = default;
 
+namespace {
+
+// J = [I, −[r]×]: the velocity of the point r from a body's centre of mass.
+Eigen::Matrix<double, 3, 6> point_jacobian(const Vec3& r) {
+  Mat3 r_cross;
+  r_cross << 0.0, -r.z(), r.y(), r.z(), 0.0, -r.x(), -r.y(), r.x(), 0.0;
+  Eigen::Matrix<double, 3, 6> J;
+  J << Mat3::Identity(), -r_cross;
+  return J;
+}
+
+}  // namespace
+
+// haptic path
+void WorldState::couple_bodies(const WorldModel& model, std::size_t body_a, std::size_t body_b,
+                               const Vec3& p_a_world, const Vec3& p_b_world, const Mat3& S,
+                               const Mat3& D) noexcept {
+  const std::int32_t i = model.bodies()[body_a].dynamic_index;
+  const std::int32_t j = model.bodies()[body_b].dynamic_index;
+  if (i < 0 || j < 0 || couplings.empty()) {
+    return;
+  }
+  const auto n = static_cast<std::size_t>(model.dynamic_bodies().size());
+  const Eigen::Matrix<double, 3, 6> J_a =
+      point_jacobian(p_a_world - bodies[body_a].com_world(model.bodies()[body_a].com_body));
+  const Eigen::Matrix<double, 3, 6> J_b =
+      point_jacobian(p_b_world - bodies[body_b].com_world(model.bodies()[body_b].com_body));
+  BodyCoupling& ab = couplings[static_cast<std::size_t>(i) * n + static_cast<std::size_t>(j)];
+  BodyCoupling& ba = couplings[static_cast<std::size_t>(j) * n + static_cast<std::size_t>(i)];
+  for (BodyCoupling* c : {&ab, &ba}) {
+    if (!c->active) {
+      c->stiffness_6.setZero();
+      c->damping_6.setZero();
+      c->active = true;
+    }
+  }
+  // F_a = −S·(x_a − x_b) at the points: ∂F_a/∂x_b = J_aᵀ·S·J_b, and the mirror for b.
+  ab.stiffness_6.noalias() += J_a.transpose() * S * J_b;
+  ab.damping_6.noalias() += J_a.transpose() * D * J_b;
+  ba.stiffness_6.noalias() += J_b.transpose() * S * J_a;
+  ba.damping_6.noalias() += J_b.transpose() * D * J_a;
+}
+
+// haptic path
+void WorldState::couple_rotations(const WorldModel& model, std::size_t body_a, std::size_t body_b,
+                                  const Mat3& D) noexcept {
+  const std::int32_t i = model.bodies()[body_a].dynamic_index;
+  const std::int32_t j = model.bodies()[body_b].dynamic_index;
+  if (i < 0 || j < 0 || couplings.empty()) {
+    return;
+  }
+  const auto n = static_cast<std::size_t>(model.dynamic_bodies().size());
+  for (BodyCoupling* c :
+       {&couplings[static_cast<std::size_t>(i) * n + static_cast<std::size_t>(j)],
+        &couplings[static_cast<std::size_t>(j) * n + static_cast<std::size_t>(i)]}) {
+    if (!c->active) {
+      c->stiffness_6.setZero();
+      c->damping_6.setZero();
+      c->active = true;
+    }
+    c->damping_6.bottomRightCorner<3, 3>() += D;
+  }
+}
+
 // haptic path
 void BodyState::add_contact_spring(const Vec3& p_world, const Vec3& com_body, const Mat3& S,
                                    const Mat3& D, const Vec3& v_anchor_world) noexcept {
@@ -45,11 +109,7 @@ void BodyState::add_contact_spring(const Vec3& p_world, const Vec3& com_body, co
     return;
   }
   // The point's velocity is J·[v; ω] with J = [I, −[r]×]; a force f there is Jᵀ·f on the body.
-  const Vec3 r = p_world - com_world(com_body);
-  Mat3 r_cross;
-  r_cross << 0.0, -r.z(), r.y(), r.z(), 0.0, -r.x(), -r.y(), r.x(), 0.0;
-  Eigen::Matrix<double, 3, 6> J;
-  J << Mat3::Identity(), -r_cross;
+  const Eigen::Matrix<double, 3, 6> J = point_jacobian(p_world - com_world(com_body));
   stiffness_6.noalias() += J.transpose() * S * J;
   damping_6.noalias() += J.transpose() * D * J;
   anchor_6.noalias() += J.transpose() * (S * v_anchor_world);
@@ -121,6 +181,9 @@ WorldState::WorldState(const WorldModel& model) {
   segments.resize(segs.size());
   place_bodies(model, bodies);
   body_pairs.resize(model.dynamic_segments().size() * segs.size());
+  if (model.dynamic_bodies().size() > 1) {
+    couplings.resize(model.dynamic_bodies().size() * model.dynamic_bodies().size());
+  }
   if (model.has_dynamic_meshes()) {
     leaf_pairs.reserve(kMaxBodyLeafPairs);
     for (std::size_t i = 0; i < segs.size(); ++i) {

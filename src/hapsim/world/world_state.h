@@ -72,6 +72,12 @@ struct BodyState {
   /// Σ Jᵀ·S·v_anchor: the springs' other ends move (a tool, a pad, another body), so a spring
   /// stretches by dt·(v_point − v_anchor), not dt·v_point.
   Eigen::Matrix<double, 6, 1> anchor_6 = Eigen::Matrix<double, 6, 1>::Zero();
+  /// Integrate stage scratch: the implicit velocity system's inverse, right-hand side and
+  /// solution this step, and whether the body took the implicit path.
+  Eigen::Matrix<double, 6, 6> inverse_6 = Eigen::Matrix<double, 6, 6>::Identity();
+  Eigen::Matrix<double, 6, 1> rhs_6 = Eigen::Matrix<double, 6, 1>::Zero();
+  Eigen::Matrix<double, 6, 1> dv_6 = Eigen::Matrix<double, 6, 1>::Zero();
+  bool implicit = false;
   /// The centre of mass, world frame.
   [[nodiscard]] Vec3 com_world(const Vec3& com_body) const { return X_world_body * com_body; }
   /// Adds a spring of stiffness matrix S and damper D (world frame, N/m and N·s/m) acting at
@@ -88,6 +94,15 @@ struct BodyState {
 /// Overlapping leaf pairs one dynamic mesh and one other segment may have in one step; beyond it
 /// the pair's contacts are partial and WorldState::dropped_body_contacts counts it.
 inline constexpr std::size_t kMaxBodyLeafPairs = 16384;
+
+/// The springs and dampers between two dynamic bodies i and j this step, as they enter body i's
+/// equation: ∂F_i/∂x_j and ∂F_i/∂v_j in generalised coordinates (the integrate stage solves
+/// touching bodies together, not each against the other's old velocity).
+struct BodyCoupling {
+  Eigen::Matrix<double, 6, 6> stiffness_6 = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> damping_6 = Eigen::Matrix<double, 6, 6>::Zero();
+  bool active = false;
+};
 
 /// Per (dynamic segment, flat segment) pair: what the body-contact stage remembers between steps.
 struct BodyPairState {
@@ -330,6 +345,17 @@ struct WorldState {
   /// the pass number behind SegmentState::vertex_pass.
   std::vector<LeafPair> leaf_pairs;
   std::uint32_t vertex_pass = 0;
+  /// Per ordered pair of dynamic bodies (i, j) by their model.dynamic_bodies() indices: [i·n + j].
+  std::vector<BodyCoupling> couplings;
+  /// Adds a spring S and damper D (world frame) between the dynamic bodies' points p_a_world (on
+  /// body a) and p_b_world (on body b) to both bodies' couplings; no-op unless both are dynamic.
+  /// haptic path
+  void couple_bodies(const WorldModel& model, std::size_t body_a, std::size_t body_b,
+                     const Vec3& p_a_world, const Vec3& p_b_world, const Mat3& S,
+                     const Mat3& D) noexcept;
+  /// The same for a rotational damper D between the two bodies' angular velocities. haptic path
+  void couple_rotations(const WorldModel& model, std::size_t body_a, std::size_t body_b,
+                        const Mat3& D) noexcept;
   /// Body contacts stage: this step's contacts of dynamic bodies, capacity fixed at construction.
   std::vector<BodyContact> body_contacts;
   std::size_t body_contact_count = 0;

@@ -61,6 +61,9 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
       body.anchor_6.setZero();
     }
   }
+  for (BodyCoupling& c : state.couplings) {
+    c.active = false;  // zeroed when first used this step
+  }
 
   stage::place_tools(model, state, input, dt);
   stage::detect_contacts(model, state, dt);
