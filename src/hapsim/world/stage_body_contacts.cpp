@@ -371,7 +371,7 @@ Mat3 spin_friction(BodyState& own, BodyState& other, const PairContact& c,
     return Mat3::Zero();  // sliding at the Coulomb limit: no damper to take implicitly
   }
   // A pure rotation about n: J = [0, n] for own, the same for the other (its ω enters with −).
-  const Mat3 nn = b_nms * c.n_world * c.n_world.transpose();
+  Mat3 nn = b_nms * c.n_world * c.n_world.transpose();
   if (own.dynamic) {
     own.damping_6.bottomRightCorner<3, 3>() += nn;
   }
