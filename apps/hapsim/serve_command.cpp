@@ -127,6 +127,9 @@ void serve(const ServeArgs& args) {
           t_s);
       std::fflush(stdout);
       host_driving = host_now;
+      // The host's device and the script are a long way apart: the tools jump, so no velocity
+      // (no ~1000 m/s in the next local model) and no contact side or stick point is kept.
+      world.forget_tool_motion();
     }
     DeviceInput input = setup.device->read(t_s);
     if (host_driving) {

@@ -67,11 +67,11 @@ TEST(ServeProcess, PublishesGatedModelsFollowsADeviceHostAndCountsBadStates) {
       LocalContactModel model;
       const SampleVerdict verdict = gate.admit(m, sent_sequence, model);
       if (verdict != SampleVerdict::kAccepted) {
-        // The step where the host's pose replaces the script's (and back) is a 1 m teleport:
-        // its finite-difference v0 (~1000 m/s) is out of the gate's range, and refused.
+        // The step where the host's pose replaces the script's (and back) is a 1 m teleport; the
+        // world forgets the tools' motion there, so no model carries a ~1000 m/s v0.
         const double speed_m_per_s = Vec3(m.v0_m_per_s[0], m.v0_m_per_s[1], m.v0_m_per_s[2]).norm();
-        EXPECT_EQ(verdict, SampleVerdict::kOutOfRange);
-        EXPECT_GT(speed_m_per_s, 100.0);
+        ADD_FAILURE() << "model refused (" << static_cast<int>(verdict) << "), v0 " << speed_m_per_s
+                      << " m/s";
         return;
       }
       if (model.device_sequence == 0) {
@@ -122,7 +122,7 @@ TEST(ServeProcess, PublishesGatedModelsFollowsADeviceHostAndCountsBadStates) {
               static_cast<unsigned long long>(scripted_touching),
               static_cast<unsigned long long>(answered), served.output.c_str());
   EXPECT_EQ(served.exit_code, 0);
-  EXPECT_LE(gate.rejected(), 2u);  // the two teleports at most
+  EXPECT_EQ(gate.rejected(), 0u);  // not even at the two teleports
   EXPECT_GT(scripted_touching, 0u);
   EXPECT_GT(answered, 0u);
   EXPECT_EQ(answered_wrong, 0u);
