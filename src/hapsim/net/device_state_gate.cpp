@@ -1,26 +1,12 @@
 #include "hapsim/net/device_state_gate.h"
 
+#include "hapsim/net/field_checks.h"
+
 #include <algorithm>
 #include <cmath>
 #include <iterator>
 
 namespace hapsim::net {
-
-namespace {
-
-template <std::size_t N>
-bool all_finite(const double (&values)[N]) noexcept {
-  return std::all_of(std::begin(values), std::end(values),
-                     [](double v) { return std::isfinite(v); });
-}
-
-template <std::size_t N>
-bool within(const double (&values)[N], double limit) noexcept {
-  return std::all_of(std::begin(values), std::end(values),
-                     [limit](double v) { return std::abs(v) <= limit; });
-}
-
-}  // namespace
 
 SampleVerdict DeviceStateGate::check(const hapsim_msg_DeviceState& m) const noexcept {
   if (!std::isfinite(m.device_time_s) || !all_finite(m.p_m) || !all_finite(m.q_wxyz) ||

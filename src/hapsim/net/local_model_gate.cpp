@@ -1,27 +1,12 @@
 #include "hapsim/net/local_model_gate.h"
 
+#include "hapsim/net/field_checks.h"
 #include "hapsim/net/local_model_codec.h"
 
 #include <algorithm>
 #include <cmath>
 
 namespace hapsim::net {
-
-namespace {
-
-template <std::size_t N>
-bool all_finite(const double (&values)[N]) noexcept {
-  return std::all_of(std::begin(values), std::end(values),
-                     [](double v) { return std::isfinite(v); });
-}
-
-template <std::size_t N>
-bool within(const double (&values)[N], double limit) noexcept {
-  return std::all_of(std::begin(values), std::end(values),
-                     [limit](double v) { return std::abs(v) <= limit; });
-}
-
-}  // namespace
 
 LocalModelGate::LocalModelGate(std::uint16_t device_id, std::uint64_t scene_hash, int finger_count,
                                LocalModelLimits limits) noexcept

@@ -23,10 +23,7 @@ class TopicReader {
   explicit TopicReader(const Participant& participant) {
     Qos qos;
     apply_profile(qos, TopicTraits<T>::kQos);
-    topic_ = DdsEntity(
-        check_dds(dds_create_topic(participant.participant(), &TopicTraits<T>::descriptor(),
-                                   TopicTraits<T>::kName, qos.get(), nullptr),
-                  std::string("creating topic ") + TopicTraits<T>::kName));
+    topic_ = create_topic<T>(participant, qos);
     reader_ = DdsEntity(
         check_dds(dds_create_reader(participant.subscriber(), topic_.get(), qos.get(), nullptr),
                   std::string("creating a reader on ") + TopicTraits<T>::kName));

@@ -16,10 +16,7 @@ class TopicWriter {
   explicit TopicWriter(const Participant& participant) {
     Qos qos;
     apply_profile(qos, TopicTraits<T>::kQos);
-    topic_ = DdsEntity(
-        check_dds(dds_create_topic(participant.participant(), &TopicTraits<T>::descriptor(),
-                                   TopicTraits<T>::kName, qos.get(), nullptr),
-                  std::string("creating topic ") + TopicTraits<T>::kName));
+    topic_ = create_topic<T>(participant, qos);
     writer_ = DdsEntity(
         check_dds(dds_create_writer(participant.publisher(), topic_.get(), qos.get(), nullptr),
                   std::string("creating a writer on ") + TopicTraits<T>::kName));

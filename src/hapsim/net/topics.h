@@ -1,8 +1,12 @@
 // Which C type travels on which topic with which QoS (net/idl/hapsim_messages.idl).
 #pragma once
 
+#include "hapsim/net/dds_entity.h"
 #include "hapsim/net/dds_qos.h"
+#include "hapsim/net/participant.h"
 #include "hapsim_messages.h"
+
+#include <string>
 
 namespace hapsim::net {
 
@@ -22,5 +26,15 @@ struct TopicTraits<hapsim_msg_DeviceState> {
   static constexpr const char* kName = "hapsim_device_state";
   static constexpr QosProfile kQos = QosProfile::kStream;
 };
+
+/// The topic of message type T in `participant`'s domain with `qos` (a reader's and a writer's
+/// QoS must match the topic's). Throws hapsim::Error naming the topic when Cyclone refuses.
+template <typename T>
+[[nodiscard]] DdsEntity create_topic(const Participant& participant, const Qos& qos) {
+  return DdsEntity(
+      check_dds(dds_create_topic(participant.participant(), &TopicTraits<T>::descriptor(),
+                                 TopicTraits<T>::kName, qos.get(), nullptr),
+                std::string("creating topic ") + TopicTraits<T>::kName));
+}
 
 }  // namespace hapsim::net
