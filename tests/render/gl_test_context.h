@@ -4,6 +4,7 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/render/offscreen_context.h"
+#include "hapsim/render/renderer.h"
 
 #include <cstdint>
 #include <memory>
@@ -26,6 +27,27 @@ inline MaybeContext make_test_context(int width, int height, int samples = 1) {
   }
   return out;
 }
+
+/// One offscreen context and renderer a whole suite shares (creating llvmpipe contexts is not
+/// free): opened in SetUpTestSuite, closed in TearDownTestSuite, the renderer before its context.
+struct SharedGl {
+  std::unique_ptr<OffscreenContext> context;
+  std::unique_ptr<Renderer> renderer;
+  std::string why_not;
+
+  void open(int width, int height) {
+    MaybeContext maybe = make_test_context(width, height, 1);
+    why_not = std::move(maybe.why_not);
+    context = std::move(maybe.context);
+    if (context) {
+      renderer = std::make_unique<Renderer>();
+    }
+  }
+  void close() {
+    renderer.reset();
+    context.reset();
+  }
+};
 
 /// RGBA of pixel (x, y), y counted from the top.
 struct Pixel {

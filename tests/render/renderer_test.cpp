@@ -28,21 +28,11 @@ constexpr int kH = 240;
 // One context and renderer for the whole suite (creating llvmpipe contexts is not free).
 class RendererTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() {
-    auto maybe = test::make_test_context(kW, kH, 1);
-    why_not_ = maybe.why_not;
-    context_ = std::move(maybe.context);
-    if (context_) {
-      renderer_ = std::make_unique<Renderer>();
-    }
-  }
-  static void TearDownTestSuite() {
-    renderer_.reset();  // before its context
-    context_.reset();
-  }
+  static void SetUpTestSuite() { gl_.open(kW, kH); }
+  static void TearDownTestSuite() { gl_.close(); }
   void SetUp() override {
-    if (!context_) {
-      GTEST_SKIP() << "no offscreen GL context: " << why_not_;
+    if (!gl_.context) {
+      GTEST_SKIP() << "no offscreen GL context: " << gl_.why_not;
     }
   }
 
@@ -63,9 +53,9 @@ class RendererTest : public ::testing::Test {
   }
 
   static std::vector<std::uint8_t> render(const RenderScene& scene, const OrbitCamera& cam) {
-    renderer_->draw(scene, cam, kW, kH);
+    gl_.renderer->draw(scene, cam, kW, kH);
     EXPECT_EQ(glGetError(), static_cast<GLenum>(GL_NO_ERROR)) << "after draw";
-    return context_->read_rgba();
+    return gl_.context->read_rgba();
   }
 
   // Pixels where any colour channel exceeds `level`.
@@ -77,14 +67,10 @@ class RendererTest : public ::testing::Test {
     return n;
   }
 
-  static std::unique_ptr<OffscreenContext> context_;
-  static std::unique_ptr<Renderer> renderer_;
-  static std::string why_not_;
+  static test::SharedGl gl_;
 };
 
-std::unique_ptr<OffscreenContext> RendererTest::context_;
-std::unique_ptr<Renderer> RendererTest::renderer_;
-std::string RendererTest::why_not_;
+test::SharedGl RendererTest::gl_;
 
 // Where a camera ray through a pixel centre first meets the sphere |p − c| = r, if it does.
 std::optional<Vec3> hit_sphere(const Ray3& ray, const Vec3& c, double r) {

@@ -46,27 +46,21 @@ class WorldSceneRigTest : public ::testing::Test {
     for (int k = 1; k <= steps; ++k) {
       static_cast<void>(world_->step(t.sample_at(t.start_time_s() + k * dt), dt));
     }
-    auto maybe = test::make_test_context(kW, kH, 1);
-    why_not_ = maybe.why_not;
-    context_ = std::move(maybe.context);
-    if (context_) {
-      renderer_ = std::make_unique<Renderer>();
-    }
+    gl_.open(kW, kH);
   }
   static void TearDownTestSuite() {
-    renderer_.reset();  // before its context
-    context_.reset();
+    gl_.close();
     world_.reset();
     setup_.reset();
   }
   void require_gl() {
-    if (!context_) {
-      GTEST_SKIP() << "no offscreen GL context: " << why_not_;
+    if (!gl_.context) {
+      GTEST_SKIP() << "no offscreen GL context: " << gl_.why_not;
     }
   }
   static std::vector<std::uint8_t> render(const RenderScene& scene, const OrbitCamera& cam) {
-    renderer_->draw(scene, cam, kW, kH);
-    return context_->read_rgba();
+    gl_.renderer->draw(scene, cam, kW, kH);
+    return gl_.context->read_rgba();
   }
   static bool dominant(const test::Pixel& p, int channel, int margin) {
     const int c[3] = {p.r, p.g, p.b};
@@ -75,16 +69,12 @@ class WorldSceneRigTest : public ::testing::Test {
 
   static std::unique_ptr<TeleopSetup> setup_;
   static std::unique_ptr<World> world_;
-  static std::unique_ptr<OffscreenContext> context_;
-  static std::unique_ptr<Renderer> renderer_;
-  static std::string why_not_;
+  static test::SharedGl gl_;
 };
 
 std::unique_ptr<TeleopSetup> WorldSceneRigTest::setup_;
 std::unique_ptr<World> WorldSceneRigTest::world_;
-std::unique_ptr<OffscreenContext> WorldSceneRigTest::context_;
-std::unique_ptr<Renderer> WorldSceneRigTest::renderer_;
-std::string WorldSceneRigTest::why_not_;
+test::SharedGl WorldSceneRigTest::gl_;
 
 TEST_F(WorldSceneRigTest, SheetMeshHoldsTheWorldsDentedHeights) {
   const World& world = *world_;

@@ -135,39 +135,25 @@ class WorldSceneSheetPicture : public ::testing::Test {
   static constexpr int kW = 640;
   static constexpr int kH = 360;
 
-  static void SetUpTestSuite() {
-    auto maybe = test::make_test_context(kW, kH, 1);
-    why_not_ = maybe.why_not;
-    context_ = std::move(maybe.context);
-    if (context_) {
-      renderer_ = std::make_unique<Renderer>();
-    }
-  }
-  static void TearDownTestSuite() {
-    renderer_.reset();  // before its context
-    context_.reset();
-  }
+  static void SetUpTestSuite() { gl_.open(kW, kH); }
+  static void TearDownTestSuite() { gl_.close(); }
   void SetUp() override {
-    if (!context_) {
-      GTEST_SKIP() << "no offscreen GL context: " << why_not_;
+    if (!gl_.context) {
+      GTEST_SKIP() << "no offscreen GL context: " << gl_.why_not;
     }
   }
   static std::vector<std::uint8_t> render(const RenderScene& scene, const OrbitCamera& cam) {
-    renderer_->draw(scene, cam, kW, kH);
-    return context_->read_rgba();
+    gl_.renderer->draw(scene, cam, kW, kH);
+    return gl_.context->read_rgba();
   }
   // The sheet's light blue (shaded), the table's brown.
   static bool blue(const test::Pixel& p) { return p.b > p.r + 40; }
   static bool brown(const test::Pixel& p) { return p.r > p.b + 40 && p.g > p.b; }
 
-  static std::unique_ptr<OffscreenContext> context_;
-  static std::unique_ptr<Renderer> renderer_;
-  static std::string why_not_;
+  static test::SharedGl gl_;
 };
 
-std::unique_ptr<OffscreenContext> WorldSceneSheetPicture::context_;
-std::unique_ptr<Renderer> WorldSceneSheetPicture::renderer_;
-std::string WorldSceneSheetPicture::why_not_;
+test::SharedGl WorldSceneSheetPicture::gl_;
 
 // Signed distance (pixels) from (x, y) to the convex quad `q` (counter-clockwise or clockwise):
 // negative inside.
