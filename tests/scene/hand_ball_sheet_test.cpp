@@ -92,7 +92,8 @@ TEST(HandBallSheet, AReplayRunsTheRecordingsLengthNotTheScenes) {
 // A dynamic body of any closed shape from a scene file: its inertia is the solid's at uniform
 // density (a box's m·(b² + c²)/3 about x for half extents a, b, c), and dropped on the table it
 // comes to rest on its four bottom corners, each a spring of both materials in series carrying a
-// quarter of its weight, while the hand works beside it.
+// quarter of its weight, while the hand works beside it. The same block in rubber is refused: its
+// four corners pressing the sheet together would not settle.
 TEST(HandBallSheet, ADynamicBoxFromTheSceneFileRestsOnTheTable) {
   nlohmann::json j = nlohmann::json::parse(std::ifstream(kScene));
   const double a = 0.02;
@@ -104,7 +105,14 @@ TEST(HandBallSheet, ADynamicBoxFromTheSceneFileRestsOnTheTable) {
                          {"mass_kg", mass},
                          {"pose", {{"position_m", {0.0, 0.12, c + 0.01}}}},
                          {"geometry", {{"box", {{"half_extents_m", {a, b, c}}}}}},
-                         {"materials", {{"default", "ball"}}}});
+                         {"materials", {{"default", "foam"}}}});
+  // A foam block: any dynamic body may come to press the sheet, and a box presses it with its
+  // four corners together, so its material must be soft enough for that press to settle (a
+  // rubber block, 2000 N/m, is refused at load: it would ring on the sheet).
+  j["materials"]["foam"] = {{"response", "penalty"},     {"stiffness_n_per_m", 400.0},
+                            {"max_penetration_m", 0.01}, {"max_force_n", 10.0},
+                            {"damping_n_s_per_m", 2.0},  {"static_friction", 0.8},
+                            {"dynamic_friction", 0.6}};
   j["run"]["duration_s"] = 2.0;
   const SceneDescription scene = parse_scene(j.dump(), kScene);
   const BodyDescription& block = scene.world.bodies.back();
@@ -122,10 +130,19 @@ TEST(HandBallSheet, ADynamicBoxFromTheSceneFileRestsOnTheTable) {
   EXPECT_EQ(box.nonfinite_steps, 0U);
   EXPECT_EQ(box.touching_at_end, std::vector<std::string>{"table"});
   EXPECT_LT(box.final_speed_m_per_s, 1e-4);
-  const double k = 2000.0 * 20000.0 / 22000.0;  // ball and table materials in series
+  const double k = 400.0 * 20000.0 / 20400.0;  // foam and table materials in series
   EXPECT_NEAR(box.final_world.z(), c - mass * 9.81 / (4.0 * k), 2e-6);
   EXPECT_NEAR(box.final_world.x(), 0.0, 1e-6);
   EXPECT_NEAR(box.final_world.y(), 0.12, 1e-6);
+
+  j["bodies"].back()["materials"]["default"] = "ball";
+  try {
+    (void)make_run_setup(parse_scene(j.dump(), kScene), DeviceChoice::scene_script());
+    ADD_FAILURE() << "a rubber block that cannot settle on the sheet was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("body 'block' presses the sheet"), std::string::npos)
+        << e.what();
+  }
 }
 
 // Bad dynamic and sheet bodies are refused by the loader, each naming its place.

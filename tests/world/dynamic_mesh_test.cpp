@@ -5,6 +5,7 @@
 // along the floor feels the dynamic friction μ·m·g; a cube rests on the Gaussian sheet, which
 // carries its weight; the step stays allocation-free and replays to the same bits, after a reset
 // too.
+#include "hapsim/core/error.h"
 #include "hapsim/geometry/mass_properties.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/world/world.h"
@@ -299,6 +300,12 @@ TEST(DynamicMesh, CubeOnTheSheetIsCarried) {
   d.bodies.push_back(std::move(sheet));
   d.bodies.push_back(cube_body("cube", half, mass, at(Vec3(0.01, 0.0, half + 0.005)), 0));
   d.tools.push_back(ToolDescription{"probe", 0.005, Vec3::Zero(), -1});
+  // Its four corners press the sheet together: at 8000 N/m a side (4000 in series, k·c = 0.93
+  // for one spring, under the one-spring limit) the corners' dents add up (1.8 times one: the
+  // Gaussian profile over the corners' distances) past it, and the world refuses the press.
+  WorldDescription too_stiff = d;
+  too_stiff.materials = {penalty("cube", 8000.0, 0.5), penalty("sheet", 8000.0, 0.5)};
+  EXPECT_THROW(World{too_stiff}, Error);
   World world(std::move(d));
   for (int i = 0; i < 4000; ++i) {
     world.step(kAway, 1e-3);

@@ -132,6 +132,51 @@ void check_sheet(const WorldDescription& d, const BodyDescription& body) {
   }
 }
 
+// How many of a mesh's vertex springs press a sheet together, at most: for each of the mesh's face
+// directions, the vertices within a couple of millimetres of its support plane there (they sink
+// into the sheet together), each weighted by the sheet's dent under one of them at the others
+// (the Gaussian profile over their distance, relative to its centre); the largest row sum over
+// them bounds the press's gain (Gershgorin). A sphere touches at one point: 1.
+double press_springs(const SegmentDescription& segment, const GaussianSheetProfile& profile) {
+  if (segment.sphere) {
+    return 1.0;
+  }
+  constexpr double kTogether_m = 0.002;
+  const TriangleMesh& mesh = segment.mesh;
+  const double centre = profile.depth_m(0.0, 1.0);
+  double most = 1.0;
+  std::vector<std::uint32_t> plane;
+  for (const auto& t : mesh.triangles) {
+    const Vec3 n = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                       .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+    if (!(n.norm() > 0.0)) {
+      continue;
+    }
+    const Vec3 d = n.normalized();
+    double support = -kInf;
+    for (const Vec3& v : mesh.vertices) {
+      support = std::max(support, v.dot(d));
+    }
+    plane.clear();
+    for (std::uint32_t v = 0; v < mesh.vertices.size(); ++v) {
+      if (mesh.vertices[v].dot(d) > support - kTogether_m) {
+        plane.push_back(v);
+      }
+    }
+    if (static_cast<double>(plane.size()) <= most) {
+      continue;
+    }
+    for (const std::uint32_t i : plane) {
+      double row = 0.0;
+      for (const std::uint32_t j : plane) {
+        row += profile.depth_m((mesh.vertices[i] - mesh.vertices[j]).norm(), 1.0) / centre;
+      }
+      most = std::max(most, row);
+    }
+  }
+  return most;
+}
+
 void check_tool(const ToolDescription& td) {
   if (!(td.radius_m >= 0.0) || !std::isfinite(td.radius_m) || !td.offset_device.allFinite()) {
     throw Error("tool '" + td.name + "'", "needs a finite radius >= 0 and a finite offset");
@@ -234,6 +279,15 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
     }
     bodies_.push_back(bm);
   }
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    if (bodies_[b].sheet) {
+      const GaussianSheetProfile profile(description_.bodies[b].sheet_profile);
+      for (const std::size_t dyn : dynamic_segments_) {
+        bodies_[b].sheet_press_springs.push_back(
+            press_springs(*segments_[dyn].description, profile));
+      }
+    }
+  }
   check_sheet_contacts();
   if (!dynamic_bodies_.empty()) {
     for (SegmentModel& seg : segments_) {
@@ -297,9 +351,13 @@ bool WorldModel::sheet_presses_settle(std::span<const ContactMaterial> materials
         !settles(std::min(own.stiffness_n_per_m, options_.max_stiffness_n_per_m), -1)) {
       return false;
     }
-    for (const std::size_t dyn : dynamic_segments_) {
+    for (std::size_t i = 0; i < dynamic_segments_.size(); ++i) {
+      const std::size_t dyn = dynamic_segments_[i];
       const ContactMaterial& presser = materials[segments_[dyn].material];
-      if (!settles(combine_materials(presser, own).stiffness_n_per_m,
+      // A mesh presses with several springs side by side, the sheet giving way under all.
+      const double springs =
+          bodies_[b].sheet_press_springs.empty() ? 1.0 : bodies_[b].sheet_press_springs[i];
+      if (!settles(springs * combine_materials(presser, own).stiffness_n_per_m,
                    static_cast<std::ptrdiff_t>(segments_[dyn].body))) {
         return false;
       }

@@ -37,6 +37,10 @@ struct BodyModel {
   bool sheet = false;  ///< a Gaussian sheet (one segment)
   /// A sheet: how deep its elastic field sinks under a 1 N push, metres (its profile at d = 0).
   double sheet_compliance_m_per_n = 0.0;
+  /// A sheet: per dynamic segment (model.dynamic_segments() order), how many of that segment's
+  /// contact springs press the sheet at once, weighted by how far the sheet's dent under one
+  /// reaches the others (1 for a ball; a cube's flat face: its four corners, less their spread).
+  std::vector<double> sheet_press_springs;
   // Dynamic bodies only.
   /// Its index in WorldModel::dynamic_bodies(); −1 for a body that does not move by itself.
   std::int32_t dynamic_index = -1;
