@@ -52,8 +52,15 @@ void ForceGraph::draw(double full_scale_n) const {
     draw->AddText(ImVec2(x0, std::max(origin.y, top - 16.0f)), IM_COL32(230, 230, 230, 255), value);
   }
   ImGui::Dummy(ImVec2(width, height));
+  // The labels on a line of their own under the bars (the first one must not join the graph's
+  // line, where a full bar's value is written).
   for (std::size_t i = 0; i < series_.size(); ++i) {
-    ImGui::SameLine(static_cast<float>(i) * slot + 0.5f * slot - 0.5f * bar_w + 8.0f);
+    const float x = static_cast<float>(i) * slot + 0.5f * slot - 0.5f * bar_w + 8.0f;
+    if (i == 0) {
+      ImGui::SetCursorPosX(x);
+    } else {
+      ImGui::SameLine(x);
+    }
     ImGui::TextUnformatted(series_[i].label.c_str());
   }
   char overlay[64];
