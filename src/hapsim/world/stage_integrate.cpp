@@ -37,9 +37,8 @@ void begin_implicit(const BodyModel& bm, const Mat3& inertia_world, const Vec3& 
   body.rhs_6 << (body.force_world_n + bm.mass_kg * gravity) * dt_s,
       (body.torque_world_nm - body.w_world.cross(inertia_world * body.w_world)) * dt_s;
   body.rhs_6.noalias() -= (dt_s * dt_s) * (body.stiffness_6 * v - body.anchor_6);
-  const Eigen::LDLT<Mat6> ldlt(A);
-  body.dv_6 = ldlt.solve(body.rhs_6);
-  body.inverse_6 = ldlt.solve(Mat6::Identity());  // for the coupled sweeps
+  body.dv_6 = A.ldlt().solve(body.rhs_6);
+  body.system_6 = A;  // the coupled sweeps invert it when the body touches another
   body.implicit = true;
 }
 
@@ -85,6 +84,16 @@ void solve_couplings(const WorldModel& model, WorldState& state, double dt_s) no
   }
   if (!any) {
     return;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    BodyState& body = state.bodies[dynamic[i]];
+    bool coupled = false;
+    for (std::size_t j = 0; j < n; ++j) {
+      coupled = coupled || (j != i && state.couplings[i * n + j].active);
+    }
+    if (body.implicit && coupled) {
+      body.inverse_6 = body.system_6.ldlt().solve(Mat6::Identity());
+    }
   }
   for (int sweep = 0; sweep < kCouplingSweeps; ++sweep) {
     for (std::size_t i = 0; i < n; ++i) {

@@ -72,8 +72,10 @@ struct BodyState {
   /// Σ Jᵀ·S·v_anchor: the springs' other ends move (a tool, a pad, another body), so a spring
   /// stretches by dt·(v_point − v_anchor), not dt·v_point.
   Eigen::Matrix<double, 6, 1> anchor_6 = Eigen::Matrix<double, 6, 1>::Zero();
-  /// Integrate stage scratch: the implicit velocity system's inverse, right-hand side and
-  /// solution this step, and whether the body took the implicit path.
+  /// Integrate stage scratch: the implicit velocity system (and its inverse, only when the body
+  /// touches another dynamic body), right-hand side and solution this step, and whether the body
+  /// took the implicit path.
+  Eigen::Matrix<double, 6, 6> system_6 = Eigen::Matrix<double, 6, 6>::Identity();
   Eigen::Matrix<double, 6, 6> inverse_6 = Eigen::Matrix<double, 6, 6>::Identity();
   Eigen::Matrix<double, 6, 1> rhs_6 = Eigen::Matrix<double, 6, 1>::Zero();
   Eigen::Matrix<double, 6, 1> dv_6 = Eigen::Matrix<double, 6, 1>::Zero();
