@@ -25,5 +25,6 @@ void add_run_command(CLI::App& app);
 void add_view_command(CLI::App& app);
 void add_kinematics_commands(CLI::App& app);
 void add_serve_command(CLI::App& app);
+void add_device_command(CLI::App& app);
 
 }  // namespace hapsim::app

@@ -1,39 +1,45 @@
-// `hapsim serve SCENE`: the simulation host of issue 12. Steps the scene's world at --rate on
-// absolute deadlines and publishes, per tool, the local contact model the device renders from
-// (world/local_model_builder.h) on the session's DDS partition. A device host's state
-// (`hapsim device`, or anything that writes the DeviceState topic) drives the world while it
-// keeps arriving; without one, or 100 ms after the last, the scene's own script does. Every
-// received state goes through the gate (net/device_state_gate.h): rejections are counted by
-// reason and printed at the end. Runs until --duration or SIGINT/SIGTERM.
-//
-// Not yet (issue 12): the tissue driven by the force the device rendered, scene state for
-// viewers, the rendered-force log, --legacy-force-udp.
+// `hapsim serve SCENE`: the simulation host (docs/architecture.md#distribution). Steps the
+// scene's world on the real-time haptic loop at --rate, and on the session's DDS partition
+//  * publishes, per tool and step, the local contact model a device host renders from
+//    (net/model_publisher.h);
+//  * lets a device host's gated states drive the world while they keep coming, the scene's own
+//    script otherwise (net/remote_device.h), and says when a host joins or goes silent;
+//  * publishes what it serves (SceneInfo: the scene's text and hash; a late joiner gets it) and,
+//    at --view-rate, what a viewer draws (ViewState, net/view_state_codec.h).
+// At the end it prints the same summary as `hapsim run` (contacts and peak force per segment,
+// forces per tool, safety) plus what went over the network, and --json writes it with the same
+// keys as `hapsim run --json`, so a served run and a one-process run compare key by key.
 #include "commands.h"
+#include "session_json.h"
 
-#include "hapsim/core/device_profile.h"
-#include "hapsim/device/force_safety.h"
 #include "hapsim/net/dds_domain.h"
-#include "hapsim/net/device_state_gate.h"
-#include "hapsim/net/local_model_codec.h"
+#include "hapsim/net/model_publisher.h"
 #include "hapsim/net/participant.h"
+#include "hapsim/net/remote_device.h"
 #include "hapsim/net/scene_hash.h"
-#include "hapsim/net/topic_reader.h"
+#include "hapsim/net/scene_info.h"
 #include "hapsim/net/topic_writer.h"
-#include "hapsim/runtime/deadline_clock.h"
-#include "hapsim/runtime/latency_histogram.h"
+#include "hapsim/net/view_state_codec.h"
+#include "hapsim/runtime/session.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
-#include "hapsim/world/local_model_builder.h"
+
+#include <nlohmann/json.hpp>
 
 #include <atomic>
+#include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <iterator>
 #include <limits>
 #include <memory>
+#include <sstream>
 #include <string>
-#include <vector>
+#include <thread>
 
 namespace hapsim::app {
 namespace {
@@ -46,20 +52,106 @@ struct ServeArgs {
   int domain = 0;
   int device_id = 0;
   std::string data_dir;
+  bool wait_for_device = false;
+  double view_rate_hz = 30.0;
+  std::string json_path;
 };
 
-volatile std::sig_atomic_t g_stop = 0;
+std::atomic<bool> g_stop{false};
 extern "C" void request_stop(int /*signal*/) {
-  g_stop = 1;
+  g_stop.store(true, std::memory_order_relaxed);
 }
 
-// A device host drives the world while its states keep coming; after this long without one the
-// scene's script takes over again.
-constexpr std::int64_t kDeviceHostTimeout_ns = 100'000'000;
+// Longest a served run may be asked to last; "until stopped" is this long.
+constexpr double kUntilStopped_s = 365.0 * 24.0 * 3600.0;
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    throw CommandError(path + ": cannot read the scene file");
+  }
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Off the haptic thread: publishes the newest snapshot for viewers at the view rate and prints
+// every change of who drives the world, until `done`.
+class ServeMonitor {
+ public:
+  ServeMonitor(const net::Participant& participant, const World& world, std::uint64_t hash,
+               std::uint64_t serve_id, const net::RemoteDevice& device, double view_rate_hz)
+      : views_out_(participant),
+        encoder_(world),
+        hash_(hash),
+        serve_id_(serve_id),
+        device_(device),
+        period_(std::chrono::microseconds(static_cast<std::int64_t>(1e6 / view_rate_hz))) {}
+
+  void set_snapshots(TripleBuffer<WorldSnapshot>& snapshots) { snapshots_ = &snapshots; }
+
+  void start() {
+    thread_ = std::thread([this] { run(); });
+  }
+  void stop() {
+    done_.store(true, std::memory_order_relaxed);
+    if (thread_.joinable()) {
+      thread_.join();
+    }
+  }
+  [[nodiscard]] std::uint64_t views_published() const { return views_; }
+
+ private:
+  void run() {
+    const auto start = std::chrono::steady_clock::now();
+    std::uint64_t transitions = device_.transitions();
+    while (!done_.load(std::memory_order_relaxed)) {
+      std::this_thread::sleep_for(period_);
+      const double t_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (device_.transitions() != transitions) {
+        transitions = device_.transitions();
+        std::printf("device host  %s at %.3f s\n",
+                    device_.host_driving()
+                        ? "joined: its states drive the world"
+                        : "silent: the scene's script drives the world (the device host stopped "
+                          "or its link is down)",
+                    t_s);
+        std::fflush(stdout);
+      }
+      if (snapshots_ != nullptr && snapshots_->update()) {
+        views_ += views_out_.write(encoder_.encode(snapshots_->read_slot(), hash_, serve_id_,
+                                                   device_.host_driving()))
+                      ? 1
+                      : 0;
+      }
+    }
+  }
+
+  net::TopicWriter<hapsim_msg_ViewState> views_out_;
+  net::ViewStateEncoder encoder_;
+  std::uint64_t hash_;
+  std::uint64_t serve_id_;
+  const net::RemoteDevice& device_;
+  std::chrono::microseconds period_;
+  TripleBuffer<WorldSnapshot>* snapshots_ = nullptr;
+  std::atomic<bool> done_{false};
+  std::uint64_t views_ = 0;
+  std::thread thread_;
+};
 
 void serve(const ServeArgs& args) {
   if (!(args.rate_hz >= 10.0 && args.rate_hz <= 10'000.0)) {
     throw CommandError("--rate " + std::to_string(args.rate_hz) + ": expected 10 to 10000 Hz");
+  }
+  if (!(args.view_rate_hz >= 1.0 && args.view_rate_hz <= 240.0)) {
+    throw CommandError("--view-rate " + std::to_string(args.view_rate_hz) +
+                       ": expected 1 to 240 Hz");
+  }
+  std::unique_ptr<std::ofstream> json_out;
+  if (!args.json_path.empty()) {
+    json_out = std::make_unique<std::ofstream>(args.json_path);
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": cannot open for writing");
+    }
   }
   SceneLoadOptions load_options;
   if (!args.data_dir.empty()) {
@@ -72,96 +164,106 @@ void serve(const ServeArgs& args) {
     throw CommandError(args.scene + ": a teleoperation rig is not served over the network yet");
   }
   const std::uint64_t hash = net::scene_hash(world.content_hash());
+  const std::uint64_t serve_id = net::draw_serve_id();
   const auto device_id = static_cast<std::uint16_t>(args.device_id);
   const std::size_t tools = std::min<std::size_t>(world.description().tools.size(), kMaxFingers);
+  if (world.description().tools.size() > tools) {
+    std::printf("note         %zu tools: models are served for the first %zu (one per finger)\n",
+                world.description().tools.size(), tools);
+  }
 
   net::DdsDomain domain(args.domain, HAPSIM_DEFAULT_DDS_CONFIG);
   net::Participant participant(args.domain, args.session);
-  net::TopicWriter<hapsim_msg_LocalModel> models_out(participant);
-  net::TopicReader<hapsim_msg_DeviceState> states_in(participant);
-  net::DeviceStateGate gate(device_id, hash);
-  const LocalModelBuilder builder(world.model());
-  std::vector<LocalContactModel> models(tools);
+  net::RemoteDevice remote(participant, device_id, hash, *setup.device);
+  net::LocalModelPublisher publisher(participant, world, remote, device_id, hash, tools);
+  ServeMonitor monitor(participant, world, hash, serve_id, remote, args.view_rate_hz);
 
-  std::printf("serve        %s, %zu tool(s), scene hash %016" PRIx64 "\n", args.scene.c_str(),
-              tools, hash);
+  // What this host serves, once: reliable and transient-local, so a late joiner gets it.
+  net::SceneInfoSample info;
+  info.scene_hash = hash;
+  info.serve_id = serve_id;
+  info.rate_hz = args.rate_hz;
+  info.device_id = device_id;
+  info.tool_count = static_cast<std::uint16_t>(tools);
+  for (std::size_t t = 0; t < tools; ++t) {
+    info.tool_finger[t] = static_cast<std::int16_t>(world.description().tools[t].finger);
+  }
+  info.scene_file = args.scene;
+  info.scene_json = read_text(args.scene);
+  info.data_dir = args.data_dir;
+  net::TopicWriter<hapsim_msg_SceneInfo> info_out(participant);
+  if (!info_out.write(net::scene_info_message(info))) {
+    throw CommandError("could not publish the scene on DDS");
+  }
+
+  std::printf("serve        %s, %zu tool(s), scene hash %016" PRIx64 ", at %.0f Hz\n",
+              args.scene.c_str(), tools, hash, args.rate_hz);
   std::printf("dds          domain %d, session '%s' (partition %s), config %s\n", args.domain,
               args.session.c_str(), participant.partition().c_str(), domain.config().c_str());
   std::fflush(stdout);
 
   std::signal(SIGINT, request_stop);
   std::signal(SIGTERM, request_stop);
-  const double dt_s = 1.0 / args.rate_hz;
-  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / args.rate_hz));
-  const std::int64_t steps_max =
-      std::isnan(args.duration_s)
-          ? std::numeric_limits<std::int64_t>::max()
-          : static_cast<std::int64_t>(std::llround(args.duration_s * args.rate_hz));
-  DeadlineClock clock(period_ns, 0);
-  LatencyHistogram step_cost;
-  net::DeviceStateSample host_state;
-  std::int64_t host_seen_ns = std::numeric_limits<std::int64_t>::min() / 2;
-  bool host_driving = false;
-  std::uint64_t host_cycles = 0;
-  std::uint64_t published = 0;
-  std::uint64_t late_cycles = 0;
-  std::int64_t steps = 0;
-  clock.start();
-  std::int64_t previous_wake_ns = monotonic_ns();
-  for (; steps < steps_max && g_stop == 0; ++steps) {
-    const std::int64_t wake_ns = clock.wait_next();
-    late_cycles += wake_ns - previous_wake_ns > 2 * period_ns ? 1 : 0;
-    previous_wake_ns = wake_ns;
-    const double t_s = static_cast<double>(steps) * dt_s;
-    states_in.take([&](const hapsim_msg_DeviceState& m, const dds_sample_info_t&) {
-      if (gate.admit(m, host_state) == net::SampleVerdict::kAccepted) {
-        host_seen_ns = wake_ns;
-      }
-    });
-    const bool host_now = wake_ns - host_seen_ns < kDeviceHostTimeout_ns;
-    if (host_now != host_driving) {
-      // A transition, a few times a run at most: worth a line.
-      std::printf(
-          "device host  %s at %.3f s\n",
-          host_now ? "joined: its states drive the world" : "silent: back to the scene's script",
-          t_s);
-      std::fflush(stdout);
-      host_driving = host_now;
-      // The host's device and the script are a long way apart: the tools jump, so no velocity
-      // (no ~1000 m/s in the next local model) and no contact side or stick point is kept.
-      world.forget_tool_motion();
+  if (args.wait_for_device) {
+    std::printf("waiting      for a device host (hapsim device --session %s)\n",
+                args.session.c_str());
+    std::fflush(stdout);
+    if (!remote.wait_for_host(kUntilStopped_s, &g_stop)) {
+      std::printf("stopped      before a device host joined\n");
+      return;
     }
-    DeviceInput input = setup.device->read(t_s);
-    if (host_driving) {
-      input = host_state.input;
-      input.time_s = t_s;
-      ++host_cycles;
-    }
-    const std::int64_t step_start_ns = monotonic_ns();
-    const StepResult& result = world.step(input, dt_s);
-    setup.device->write(clamp_command(result.command, *setup.profile));
-    builder.build(world.state(), static_cast<std::uint64_t>(steps) + 1,
-                  host_driving ? host_state.sequence : 0, models);
-    for (std::size_t t = 0; t < tools; ++t) {
-      published += models_out.write(net::encode_local_model(
-                       models[t], {device_id, static_cast<std::uint16_t>(t)}, hash))
-                       ? 1
-                       : 0;
-    }
-    step_cost.record_us(static_cast<double>(monotonic_ns() - step_start_ns) * 1e-3);
   }
 
-  const LatencyPercentilesUs cost = step_cost.summary();
-  std::printf("served       %" PRId64 " steps (%.3f s simulated) at %.0f Hz, %" PRIu64
-              " late cycles; step + models p50 %.1f us, p99 %.1f us\n",
-              steps, static_cast<double>(steps) * dt_s, args.rate_hz, late_cycles, cost.p50,
-              cost.p99);
-  std::printf("published    %" PRIu64 " local models (%" PRIu64 " refused by DDS)\n", published,
-              models_out.failed_writes());
-  std::printf("device host  drove %" PRIu64 " cycles; states:", host_cycles);
+  SessionOptions options;
+  options.dt_s = 1.0 / args.rate_hz;
+  options.duration_s = std::isnan(args.duration_s) ? kUntilStopped_s : args.duration_s;
+  options.realtime = true;
+  options.observer = &publisher;
+  options.on_snapshots = [&monitor](TripleBuffer<WorldSnapshot>& s) { monitor.set_snapshots(s); };
+  options.stop = &g_stop;
+  monitor.start();
+  SessionSummary summary;
+  try {
+    summary = run_session(world, remote, options);
+  } catch (...) {
+    monitor.stop();
+    throw;
+  }
+  monitor.stop();
+
+  std::cout << format_session_summary(summary);
+  const net::VerdictCounts verdicts = remote.verdicts();
+  std::printf("published    %" PRIu64 " local models (%" PRIu64 " refused by DDS), %" PRIu64
+              " view states\n",
+              publisher.published(), publisher.refused_writes(), monitor.views_published());
+  std::printf("device host  drove %" PRIu64
+              " of %zu cycles; peak force it rendered %.3f N; "
+              "states:",
+              remote.cycles_driven(), summary.steps, publisher.peak_rendered_force_n());
   for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
     std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
-                gate.counts()[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
+                verdicts[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
+  }
+  if (json_out) {
+    nlohmann::json j =
+        session_summary_json(setup.scene, world, summary, "device host or " + setup.device_name);
+    j["serve"] = {{"session", args.session},
+                  {"domain", args.domain},
+                  {"scene_hash", hash},
+                  {"models_published", publisher.published()},
+                  {"views_published", monitor.views_published()},
+                  {"device_host_cycles", remote.cycles_driven()},
+                  {"peak_rendered_force_n", publisher.peak_rendered_force_n()}};
+    for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
+      j["serve"]["device_states"][net::verdict_name(static_cast<net::SampleVerdict>(v))] =
+          verdicts[v];
+    }
+    j["ok"] = summary.pop_throughs == 0 && summary.max_force_limit_violations == 0;
+    *json_out << j.dump(2) << '\n';
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": write failed");
+    }
+    std::printf("wrote        %s\n", args.json_path.c_str());
   }
 }
 
@@ -170,18 +272,29 @@ void serve(const ServeArgs& args) {
 void add_serve_command(CLI::App& app) {
   auto args = std::make_shared<ServeArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "serve", "Simulation host: step a scene and publish local contact models over DDS");
+      "serve",
+      "Simulation host: step a scene in real time, serve local contact models to a device host "
+      "(hapsim device) and the scene to viewers (hapsim view --connect) over DDS");
   cmd->add_option("scene", args->scene, "Scene file (JSON, see docs/scene-format.md)")->required();
   cmd->add_option("--rate", args->rate_hz, "Steps per second (default 1000)");
-  cmd->add_option("--duration", args->duration_s, "Seconds to serve (default: until stopped)")
+  cmd->add_option("--duration", args->duration_s,
+                  "Seconds to serve (default: until stopped; counted from the device host's "
+                  "first state with --wait-for-device)")
       ->check(CLI::PositiveNumber);
+  cmd->add_flag("--wait-for-device", args->wait_for_device,
+                "Step nothing until a device host's first state arrives (a served run then "
+                "covers exactly what the device did)");
   cmd->add_option("--session", args->session,
                   "Session name: a DDS partition, so sessions never see each other (default "
                   "'default')");
   cmd->add_option("--domain", args->domain, "DDS domain id (default 0)")->check(CLI::Range(0, 232));
   cmd->add_option("--device-id", args->device_id, "Device id the models are for (default 0)")
       ->check(CLI::Range(0, 65535));
+  cmd->add_option("--view-rate", args->view_rate_hz,
+                  "View states per second for viewers (default 30)");
   cmd->add_option("--data", args->data_dir, "The scene's data folder");
+  cmd->add_option("--json", args->json_path,
+                  "Write the summary as JSON (the keys of hapsim run --json, plus 'serve')");
   cmd->callback([args] {
     (void)net::session_partition(args->session);  // a bad name is one line before anything runs
     serve(*args);

@@ -1,15 +1,20 @@
 // Running the real `hapsim` binary from tests: exit status and output, scratch files, CSV output.
 #pragma once
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace hapsim::test {
@@ -34,6 +39,73 @@ inline RunResult run_hapsim(const std::string& args) {
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
 }
+
+/// `hapsim ARGS` running in the background (its own process), its output going to a file: for the
+/// multi-process tests, which start, kill and restart hosts.
+class BackgroundHapsim {
+ public:
+  /// Starts `hapsim` with `args` (split on spaces; no quoting), output to `log`.
+  BackgroundHapsim(const std::string& args, std::filesystem::path log) : log_(std::move(log)) {
+    std::vector<std::string> words{HAPSIM_BIN_PATH};
+    std::istringstream in(args);
+    for (std::string w; in >> w;) {
+      words.push_back(w);
+    }
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      std::vector<char*> argv;
+      for (std::string& w : words) {
+        argv.push_back(w.data());
+      }
+      argv.push_back(nullptr);
+      ::execv(argv[0], argv.data());
+      ::_exit(127);
+    }
+  }
+  BackgroundHapsim(const BackgroundHapsim&) = delete;
+  BackgroundHapsim& operator=(const BackgroundHapsim&) = delete;
+  ~BackgroundHapsim() {
+    if (pid_ > 0 && exit_code_ == kRunning) {
+      ::kill(pid_, SIGKILL);
+      (void)wait();
+    }
+  }
+
+  void signal(int sig) const { ::kill(pid_, sig); }
+  /// Waits for the process to end; its exit code (-1 when killed by a signal).
+  int wait() {
+    if (exit_code_ == kRunning) {
+      int status = 0;
+      ::waitpid(pid_, &status, 0);
+      exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+    return exit_code_;
+  }
+  [[nodiscard]] std::string output() const {
+    std::ifstream in(log_);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+  /// True once the output holds `text`; false after `timeout`.
+  bool wait_for(const std::string& text, std::chrono::milliseconds timeout) const {
+    const auto give_up = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < give_up) {
+      if (output().find(text) != std::string::npos) {
+        return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return false;
+  }
+
+ private:
+  static constexpr int kRunning = -2;
+  std::filesystem::path log_;
+  pid_t pid_ = -1;
+  int exit_code_ = kRunning;
+};
 
 /// A path in this test process's own scratch folder (tests run in parallel under ctest).
 inline std::filesystem::path temp_path(const std::string& name) {

@@ -42,25 +42,11 @@ LocalModelRenderer::LocalModelRenderer(LocalModelRenderOptions options) : option
   }
 }
 
-LocalModelRenderer::Affine LocalModelRenderer::affine_of(const LocalContactModel& m) noexcept {
-  if (!m.valid) {
-    return {};
-  }
-  return {
-      m.f0_world_n + m.stiffness_n_per_m * m.x0_world_m + m.damping_n_s_per_m * m.v0_world_m_per_s,
-      m.stiffness_n_per_m, m.damping_n_s_per_m};
-}
-
-LocalModelRenderer::Affine LocalModelRenderer::blended(double now_s) const noexcept {
+Vec3 LocalModelRenderer::offset(double now_s) const noexcept {
   const double since_s = now_s - received_s_;
   const double alpha =
       options_.blend_time_s > 0.0 ? std::clamp(since_s / options_.blend_time_s, 0.0, 1.0) : 1.0;
-  if (alpha >= 1.0) {
-    return to_;
-  }
-  return {(1.0 - alpha) * from_.c_n + alpha * to_.c_n,
-          (1.0 - alpha) * from_.k_n_per_m + alpha * to_.k_n_per_m,
-          (1.0 - alpha) * from_.b_n_s_per_m + alpha * to_.b_n_s_per_m};
+  return (1.0 - alpha) * offset_n_;
 }
 
 // haptic path
@@ -70,9 +56,21 @@ void LocalModelRenderer::receive(const LocalContactModel& model, double now_s) n
     return;
   }
   ++counts_.models_received;
-  // Blend from what is felt now; a stale model has faded, so start from nothing.
-  from_ = has_model_ && freshness(now_s) >= 1.0 ? blended(now_s) : Affine{};
-  to_ = affine_of(model);
+  // Start from what the old model renders now (its offset decayed to now, so a stream of
+  // agreeing models lets an offset die out at the blend's rate), or from what was last felt
+  // when the old model went stale, or from nothing before any.
+  const Vec3 x_m = has_rendered_ ? last_x_m_ : model.x0_world_m;
+  const Vec3 v_m_per_s = has_rendered_ ? last_v_m_per_s_ : model.v0_world_m_per_s;
+  Vec3 start_n = Vec3::Zero();
+  if (has_model_ && has_rendered_) {
+    start_n = freshness(now_s) < 1.0
+                  ? last_force_n_
+                  : Vec3(local_model_force(newest_, x_m, v_m_per_s) + offset(now_s));
+  }
+  offset_n_ = start_n - local_model_force(model, x_m, v_m_per_s);
+  if (!offset_n_.allFinite()) {
+    offset_n_.setZero();
+  }
   newest_ = model;
   received_s_ = now_s;
   has_model_ = true;
@@ -95,24 +93,35 @@ double LocalModelRenderer::freshness(double now_s) const noexcept {
 // haptic path
 Vec3 LocalModelRenderer::render(const Vec3& x_world_m, const Vec3& v_world_m_per_s,
                                 double now_s) noexcept {
-  if (!has_model_ || !newest_.valid) {
+  if (!has_model_) {
     return Vec3::Zero();
   }
   if (!x_world_m.allFinite() || !v_world_m_per_s.allFinite() || !std::isfinite(now_s)) {
     ++counts_.nonfinite;
     return Vec3::Zero();
   }
-  if ((x_world_m - newest_.x0_world_m).norm() > newest_.validity_radius_m) {
+  has_rendered_ = true;
+  last_x_m_ = x_world_m;
+  last_v_m_per_s_ = v_world_m_per_s;
+  last_force_n_ = shaped(x_world_m, v_world_m_per_s, now_s);
+  return last_force_n_;
+}
+
+// haptic path
+Vec3 LocalModelRenderer::shaped(const Vec3& x_world_m, const Vec3& v_world_m_per_s,
+                                double now_s) noexcept {
+  if (newest_.valid && (x_world_m - newest_.x0_world_m).norm() > newest_.validity_radius_m) {
     ++counts_.outside_radius;
     return Vec3::Zero();
   }
-  const Affine a = blended(now_s);
-  Vec3 f = a.c_n - a.k_n_per_m * x_world_m - a.b_n_s_per_m * v_world_m_per_s;
+  // An invalid (free-space) model renders zero, but for what is left of the blend from the
+  // contact before it: letting go is a ramp too.
+  Vec3 f = local_model_force(newest_, x_world_m, v_world_m_per_s) + offset(now_s);
   if (!f.allFinite()) {
     ++counts_.nonfinite;
     return Vec3::Zero();
   }
-  if (f.dot(newest_.normal_world) < 0.0) {
+  if (newest_.valid && f.dot(newest_.normal_world) < 0.0) {
     ++counts_.pull_zeroed;
     return Vec3::Zero();
   }

@@ -2,8 +2,11 @@
 // newest model at 1 kHz from the device's own fresh position and velocity, with the safety rules
 // a model from far away needs. One renderer per contact key (device, finger).
 //
-//  * A new model is blended in over `blend_time_s` (a linear blend of the two models' affine
-//    forms, so a jump in f0 between models is never felt as a step).
+//  * A new model is blended in over `blend_time_s`: at its arrival the difference between what
+//    was rendered and what the new model gives at the same place is kept as an offset that
+//    decays linearly to zero, so a jump between models is felt as a ramp, while a new model
+//    that agrees with the old one (the steady stream of a contact) is rendered as it is, with
+//    no lag: the field is always the newest model's.
 //  * Zero outside the model's validity radius around x0; push-only along its normal.
 //  * Clamped to `max_force_n` (the device profile's rating).
 //  * Stale-model fade: once the newest model is older than `stale_after_s` by the *local receive
@@ -43,7 +46,8 @@ class LocalModelRenderer {
   explicit LocalModelRenderer(LocalModelRenderOptions options = {});
 
   /// A model arrived at local time `now_s`. A model with non-finite fields, or a K or B with a
-  /// negative diagonal, is refused (counted) and the previous one kept. haptic path
+  /// negative diagonal, is refused (counted) and the previous one kept. The blend starts from
+  /// the force last rendered (zero before any). haptic path
   void receive(const LocalContactModel& model, double now_s) noexcept;
 
   /// The force for the device at local time `now_s`, at its position and velocity. haptic path
@@ -57,19 +61,21 @@ class LocalModelRenderer {
   [[nodiscard]] const LocalModelRenderOptions& options() const noexcept { return options_; }
 
  private:
-  /// F = c − K·x − B·v: a model's affine form, which blends linearly.
-  struct Affine {
-    Vec3 c_n = Vec3::Zero();
-    Mat3 k_n_per_m = Mat3::Zero();
-    Mat3 b_n_s_per_m = Mat3::Zero();
-  };
-  [[nodiscard]] static Affine affine_of(const LocalContactModel& model) noexcept;
-  [[nodiscard]] Affine blended(double now_s) const noexcept;
+  /// The force at (x, v) by every rule of the header but the non-finite input check.
+  [[nodiscard]] Vec3 shaped(const Vec3& x_world_m, const Vec3& v_world_m_per_s,
+                            double now_s) noexcept;
+  /// What is left of the blend's offset at `now_s`.
+  [[nodiscard]] Vec3 offset(double now_s) const noexcept;
 
   LocalModelRenderOptions options_;
   LocalContactModel newest_;
-  Affine from_;  ///< what was rendered when the newest model arrived
-  Affine to_;    ///< the newest model
+  /// Rendered minus the newest model's force where the device last was, when it arrived.
+  Vec3 offset_n_ = Vec3::Zero();
+  /// Where the device was at the last render() and what it got.
+  Vec3 last_x_m_ = Vec3::Zero();
+  Vec3 last_v_m_per_s_ = Vec3::Zero();
+  Vec3 last_force_n_ = Vec3::Zero();
+  bool has_rendered_ = false;
   double received_s_ = 0.0;
   bool has_model_ = false;
   LocalModelRenderCounts counts_;

@@ -30,6 +30,10 @@ class DeviceStateGate {
   }
   [[nodiscard]] const VerdictCounts& counts() const noexcept { return counts_; }
 
+  /// Accept the next state whatever its sequence: the device host went silent, and one that
+  /// comes back (or a restarted one) numbers its states afresh. haptic path
+  void forget_order() noexcept { has_newest_ = false; }
+
  private:
   [[nodiscard]] SampleVerdict check(const hapsim_msg_DeviceState& m) const noexcept;
 

@@ -27,6 +27,20 @@ struct TopicTraits<hapsim_msg_DeviceState> {
   static constexpr QosProfile kQos = QosProfile::kStream;
 };
 
+template <>
+struct TopicTraits<hapsim_msg_SceneInfo> {
+  static const dds_topic_descriptor_t& descriptor() { return hapsim_msg_SceneInfo_desc; }
+  static constexpr const char* kName = "hapsim_scene_info";
+  static constexpr QosProfile kQos = QosProfile::kState;
+};
+
+template <>
+struct TopicTraits<hapsim_msg_ViewState> {
+  static const dds_topic_descriptor_t& descriptor() { return hapsim_msg_ViewState_desc; }
+  static constexpr const char* kName = "hapsim_view_state";
+  static constexpr QosProfile kQos = QosProfile::kStream;
+};
+
 /// The topic of message type T in `participant`'s domain with `qos` (a reader's and a writer's
 /// QoS must match the topic's). Throws hapsim::Error naming the topic when Cyclone refuses.
 template <typename T>

@@ -122,7 +122,8 @@ class SessionAccountant {
       summary_.teleop.emplace();
       ball_start_z_ = world.body_pose(desc.teleop->ball_body).translation().z();
     }
-    cost_us_.reserve(steps);
+    // A served world runs until stopped: reserve a run of up to an hour, grow beyond.
+    cost_us_.reserve(std::min<std::size_t>(steps, 3'600'000));
     touched_.assign(summary_.segments.size() * desc.tools.size(), 0);
   }
 
@@ -348,9 +349,13 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
                             std::size_t steps) {
   SessionAccountant accountant(world, device.profile(), options, steps);
   WorldHapticClientOptions client_options;
-  client_options.publish_snapshots = false;
+  client_options.publish_snapshots = static_cast<bool>(options.on_snapshots);
   client_options.record_capacity = 4096;  // 4 s of slack for the bookkeeping below
+  client_options.observer = options.observer;
   WorldHapticClient client(world, client_options);
+  if (options.on_snapshots) {
+    options.on_snapshots(*client.snapshots());
+  }
   HapticLoopOptions loop_options = options.loop;
   loop_options.period_s = options.dt_s;
   loop_options.max_cycles = steps;
@@ -362,6 +367,9 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
   const auto wall_start = std::chrono::steady_clock::now();
   loop.start();
   drain_until_stopped(loop, records, [&](const CycleRecord& r) {
+    if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed)) {
+      loop.request_stop();
+    }
     accountant.account(r);
     if (++accounted % progress_every == 0) {
       report_progress(options.progress, "run (real time)",

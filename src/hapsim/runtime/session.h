@@ -10,8 +10,10 @@
 #include "hapsim/device/device.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/runtime/haptic_loop.h"
+#include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/world/world.h"
 
+#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <optional>
@@ -39,6 +41,16 @@ struct SessionOptions {
   /// summary then reports how far from it the ball ended).
   std::optional<Vec3> teleop_target_world;
   ProgressFn progress;
+  /// Real-time runs only: called on the haptic thread around every step (a served world
+  /// publishes from it). Not owned; may be null.
+  WorldCycleObserver* observer = nullptr;
+  /// Real-time runs only: also publish a viewer snapshot every cycle, and hand their buffer to
+  /// `on_snapshots` before the loop starts (on the calling thread; the buffer lives until
+  /// run_session returns).
+  std::function<void(TripleBuffer<WorldSnapshot>&)> on_snapshots;
+  /// Real-time runs only: when this becomes true the run ends after the current cycle (a
+  /// served world runs until stopped). Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
   /// Inline runs only: called after every cycle's bookkeeping with the cycle index (between
   /// cycles, on the stepping thread: may read the world, e.g. to render a snapshot).
   std::function<void(std::size_t cycle)> after_cycle;

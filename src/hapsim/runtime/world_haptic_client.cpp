@@ -86,6 +86,9 @@ const DeviceCommand& WorldHapticClient::step(const DeviceInput& input, double dt
     last_result_ = &world_.last_result();
     return zero_command_;
   }
+  if (options_.observer != nullptr) {
+    options_.observer->before_step(world_);
+  }
   last_result_ = &world_.step(input, dt_s);
   stepped_ = true;
   return last_result_->command;
@@ -117,6 +120,9 @@ void WorldHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
   }
   if (snapshots_) {
     publish_snapshot(cycle);
+  }
+  if (options_.observer != nullptr && stepped_) {
+    options_.observer->after_step(world_, cycle);
   }
   // Records of stepped cycles only, numbered by them (a paused cycle changed nothing: a replay
   // numbers the steps it takes 0, 1, 2, ...).

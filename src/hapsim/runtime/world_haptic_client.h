@@ -21,11 +21,32 @@
 
 namespace hapsim {
 
+/// Something that serves the running world from the haptic thread (`hapsim serve` publishes each
+/// step's local contact models from it). Both calls are haptic path: no allocation, no blocking.
+class WorldCycleObserver {
+ public:
+  virtual ~WorldCycleObserver() = default;
+  /// Before the world steps with this cycle's input (may e.g. make it forget the tools' motion
+  /// when the input's source changed).
+  virtual void before_step(World& /*world*/) noexcept {}
+  /// After the step and the device write: the world holds this cycle's state.
+  virtual void after_step(const World& world, const HapticCycle& cycle) noexcept = 0;
+
+ protected:
+  WorldCycleObserver() = default;
+  WorldCycleObserver(const WorldCycleObserver&) = default;
+  WorldCycleObserver& operator=(const WorldCycleObserver&) = default;
+  WorldCycleObserver(WorldCycleObserver&&) = default;
+  WorldCycleObserver& operator=(WorldCycleObserver&&) = default;
+};
+
 struct WorldHapticClientOptions {
   /// Publish a viewer snapshot every cycle (true) or not at all (a headless run).
   bool publish_snapshots = true;
   /// Capacity of the record ring in cycles (0: no records). 2048 gives the consumer 2 s of slack.
   std::size_t record_capacity = 0;
+  /// Called around every step that is taken (not while paused). Not owned; may be null.
+  WorldCycleObserver* observer = nullptr;
 };
 
 class WorldHapticClient final : public HapticClient {

@@ -1,0 +1,343 @@
+// `hapsim device`: the device host (docs/architecture.md#distribution). Owns the device and runs
+// its 1 kHz loop on the real-time haptic thread (runtime/haptic_loop.h: absolute deadlines,
+// the force watchdog, the stall supervisor); each cycle renders force from the newest local
+// contact model the simulation host sent (net/device_host_client.h) and publishes the device's
+// state. It waits for a simulation host (`hapsim serve`) in its session, follows it when it
+// restarts, and says when it goes silent and how fast the force went to zero then.
+#include "commands.h"
+#include "session_json.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/net/dds_domain.h"
+#include "hapsim/net/device_host_client.h"
+#include "hapsim/net/loaned_reader.h"
+#include "hapsim/net/participant.h"
+#include "hapsim/net/scene_hash.h"
+#include "hapsim/net/scene_info.h"
+#include "hapsim/runtime/deadline_clock.h"
+#include "hapsim/runtime/haptic_loop.h"
+#include "hapsim/scene/run_setup.h"
+#include "hapsim/scene/scene_file.h"
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace hapsim::app {
+namespace {
+
+struct DeviceArgs {
+  std::string device = "sim";
+  std::string scene;  // sim: play this scene's script instead of the served one's
+  std::string data_dir;
+  std::string session = "default";
+  int domain = 0;
+  int device_id = 0;
+  double duration_s = std::numeric_limits<double>::quiet_NaN();  // NaN: until stopped
+  std::string force_mode = "local-model";
+  std::string finger_map;
+  std::string json_path;
+};
+
+std::atomic<bool> g_stop{false};
+extern "C" void request_device_stop(int /*signal*/) {
+  g_stop.store(true, std::memory_order_relaxed);
+}
+
+// A simulation host with no model for this long is silent (its models come every millisecond).
+constexpr std::int64_t kSilentAfter_ns = 200'000'000;
+
+// "--finger-map 0:2,1:3": the scene's finger 0 drives the device's finger 2, and so on; fingers
+// not named keep their number.
+std::array<int, kMaxFingers> parse_finger_map(const std::string& text) {
+  std::array<int, kMaxFingers> map{0, 1, 2, 3, 4};
+  if (text.empty()) {
+    return map;
+  }
+  std::istringstream in(text);
+  std::string pair;
+  while (std::getline(in, pair, ',')) {
+    int from = -1;
+    int to = -1;
+    char colon = 0;
+    std::istringstream p(pair);
+    if (!(p >> from >> colon >> to) || colon != ':' || !p.eof() || from < 0 ||
+        from >= kMaxFingers || to < 0 || to >= kMaxFingers) {
+      throw CommandError("--finger-map " + text +
+                         ": expected SCENE:DEVICE pairs of finger "
+                         "numbers 0-4, e.g. 0:2,1:3");
+    }
+    map[static_cast<std::size_t>(from)] = to;
+  }
+  return map;
+}
+
+net::ServedScene served_scene(const net::SceneInfoSample& info,
+                              const std::array<int, kMaxFingers>& finger_map) {
+  net::ServedScene s;
+  s.scene_hash = info.scene_hash;
+  s.serve_id = info.serve_id;
+  s.tool_count = info.tool_count;
+  for (std::size_t t = 0; t < kMaxFingers; ++t) {
+    const int finger = info.tool_finger[t];
+    s.tool_finger[t] =
+        static_cast<std::int16_t>(finger >= 0 ? finger_map[static_cast<std::size_t>(finger)] : -1);
+  }
+  return s;
+}
+
+// The newest SceneInfo that arrived (nullopt: none since the last call); a bad one is said once.
+std::optional<net::SceneInfoSample> take_scene_info(net::LoanedReader<hapsim_msg_SceneInfo>& in) {
+  std::optional<net::SceneInfoSample> newest;
+  in.take([&](const hapsim_msg_SceneInfo& m) {
+    std::string why;
+    if (auto info = net::decode_scene_info(m, why)) {
+      newest = std::move(info);
+    } else {
+      std::printf("ignored      a scene description from a simulation host: %s\n", why.c_str());
+    }
+  });
+  return newest;
+}
+
+// The device the host drives, and what to call it.
+struct HostDevice {
+  std::unique_ptr<Device> device;
+  std::string name;
+  std::optional<RunSetup> setup;  // sim: keeps the scene's world the script was aimed on
+};
+
+HostDevice open_device(const DeviceArgs& args, const net::SceneInfoSample& info) {
+  HostDevice d;
+  if (args.device == "sim") {
+    SceneLoadOptions load_options;
+    const std::string data_dir = !args.data_dir.empty() ? args.data_dir : info.data_dir;
+    if (!data_dir.empty()) {
+      load_options.data_dir = data_dir;
+    }
+    // The script aims at the scene's surfaces: build the scene (the served one unless --scene).
+    SceneDescription scene = args.scene.empty()
+                                 ? parse_scene(info.scene_json, info.scene_file, load_options)
+                                 : load_scene(args.scene, load_options);
+    d.setup.emplace(make_run_setup(std::move(scene), DeviceChoice::scene_script()));
+    const std::uint64_t ours = net::scene_hash(d.setup->world->content_hash());
+    if (ours != info.scene_hash) {
+      std::printf("note         %s differs from the served scene (hash %016" PRIx64
+                  " vs %016" PRIx64 "): its script will touch what it was written for\n",
+                  args.scene.c_str(), ours, info.scene_hash);
+    }
+    d.name = d.setup->device_name;
+    d.device = std::move(d.setup->device);
+    return d;
+  }
+  if (args.device == "mouse") {
+    throw CommandError(
+        "--device mouse: the mouse probe lives in the viewer (hapsim view); a device host "
+        "drives sim or spacemouse");
+  }
+  throw CommandError("--device " + args.device + ": expected sim or spacemouse");
+}
+
+struct Silence {
+  double since_s = 0.0;         ///< host clock, from the device's start
+  double force_before_n = 0.0;  ///< rendered with the last model
+  double zero_after_ms = 0.0;
+};
+
+void run_device(const DeviceArgs& args) {
+  const net::ForceMode mode =
+      args.force_mode == "raw" ? net::ForceMode::kRaw : net::ForceMode::kLocalModel;
+  const std::array<int, kMaxFingers> finger_map = parse_finger_map(args.finger_map);
+  std::unique_ptr<std::ofstream> json_out;
+  if (!args.json_path.empty()) {
+    json_out = std::make_unique<std::ofstream>(args.json_path);
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": cannot open for writing");
+    }
+  }
+  net::DdsDomain domain(args.domain, HAPSIM_DEFAULT_DDS_CONFIG);
+  net::Participant participant(args.domain, args.session);
+  net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
+  std::signal(SIGINT, request_device_stop);
+  std::signal(SIGTERM, request_device_stop);
+
+  std::printf("device host  session '%s' (partition %s, domain %d), config %s\n",
+              args.session.c_str(), participant.partition().c_str(), args.domain,
+              domain.config().c_str());
+  std::printf("waiting      for a simulation host (hapsim serve SCENE --session %s)\n",
+              args.session.c_str());
+  std::fflush(stdout);
+  std::optional<net::SceneInfoSample> info;
+  while (!info && !g_stop.load(std::memory_order_relaxed)) {
+    info = take_scene_info(info_in);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (!info) {
+    std::printf("stopped      before a simulation host appeared\n");
+    return;
+  }
+  std::printf("serving      %s (hash %016" PRIx64 "), %u tool(s)\n", info->scene_file.c_str(),
+              info->scene_hash, static_cast<unsigned>(info->tool_count));
+  HostDevice host = open_device(args, *info);
+  const DeviceProfile& profile = host.device->profile();
+
+  net::DeviceHostOptions options;
+  options.device_id = static_cast<std::uint16_t>(args.device_id);
+  options.mode = mode;
+  options.render.max_force_n = profile.max_force_n;
+  net::DeviceHostClient client(participant, options);
+  client.set_scene(served_scene(*info, finger_map));
+
+  HapticLoopOptions loop_options;
+  loop_options.period_s = 0.001;
+  if (!std::isnan(args.duration_s)) {
+    loop_options.max_cycles = static_cast<std::uint64_t>(std::llround(args.duration_s * 1000.0));
+  }
+  HapticLoop loop(*host.device, client, loop_options);
+  std::printf("device       %s, rated %.1f N; force mode %s%s\n", host.name.c_str(),
+              profile.max_force_n, net::to_string(mode),
+              mode == net::ForceMode::kRaw
+                  ? " (the paper's raw forces: unsafe beyond a few ms of delay, for comparison)"
+                  : " (rendered at the device's own position)");
+  std::fflush(stdout);
+
+  const std::int64_t start_ns = monotonic_ns();
+  const auto host_s = [start_ns](std::int64_t ns) {
+    return static_cast<double>(ns - start_ns) * 1e-9;
+  };
+  loop.start();
+  bool sim_alive = false;
+  std::uint64_t serve_id = info->serve_id;
+  std::uint64_t joins = 0;
+  std::optional<Silence> pending_silence;  // silent, force not yet reported at zero
+  std::vector<Silence> silences;
+  while (loop.running() && !g_stop.load(std::memory_order_relaxed)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (auto fresh = take_scene_info(info_in); fresh && fresh->serve_id != serve_id) {
+      serve_id = fresh->serve_id;
+      std::printf("simulation   host restarted: %s (hash %016" PRIx64 ")%s\n",
+                  fresh->scene_file.c_str(), fresh->scene_hash,
+                  fresh->scene_hash != info->scene_hash ? ", another scene" : "");
+      std::fflush(stdout);
+      client.set_scene(served_scene(*fresh, finger_map));
+    }
+    const net::DeviceHostStatus s = client.status();
+    const std::int64_t now_ns = monotonic_ns();
+    const bool alive = s.last_model_ns != 0 && now_ns - s.last_model_ns < kSilentAfter_ns;
+    if (alive && !sim_alive) {
+      ++joins;
+      std::printf("simulation   host %s at %.3f s: rendering its local models\n",
+                  joins == 1 ? "answering" : "back", host_s(now_ns));
+      std::fflush(stdout);
+      pending_silence.reset();
+    } else if (!alive && sim_alive) {
+      pending_silence = Silence{host_s(s.last_model_ns), s.force_at_last_model_n, 0.0};
+    }
+    sim_alive = alive;
+    if (pending_silence && s.force_n == 0.0) {
+      // The force reached zero: how long after the last model arrived.
+      pending_silence->zero_after_ms =
+          std::max(0.0, static_cast<double>(s.last_force_ns - s.last_model_ns) * 1e-6);
+      std::printf(
+          "simulation   host silent since %.3f s: force %.3f N went to zero %.0f ms after "
+          "its last model; the device loop keeps running and waits for it\n",
+          pending_silence->since_s, pending_silence->force_before_n,
+          pending_silence->zero_after_ms);
+      std::fflush(stdout);
+      silences.push_back(*pending_silence);
+      pending_silence.reset();
+    }
+  }
+  loop.stop();
+
+  const HapticLoopStatus st = loop.status();
+  const net::DeviceHostStatus s = client.status();
+  const RealtimeSummary rt = realtime_summary(st, 0);
+  std::printf("ran          %" PRIu64 " cycles in %.3f s\n", st.cycles, st.elapsed_s);
+  std::printf("%s", format_realtime_summary(rt).c_str());
+  std::printf("rendered     peak %.3f N; %" PRIu64 " rate-limited cycles, %" PRIu64
+              " clamped by the watchdog\n",
+              s.peak_force_n, s.rate_limited_cycles, st.clamped_cycles);
+  std::printf("models       %" PRIu64 " rendered (%" PRIu64 " answering the script, not us);",
+              s.models_accepted, s.models_not_ours);
+  for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
+    std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
+                s.verdicts[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
+  }
+  std::printf("states       %" PRIu64 " published\n", s.states_published);
+  if (json_out) {
+    nlohmann::json j;
+    j["device"] = host.name;
+    j["session"] = args.session;
+    j["force_mode"] = net::to_string(mode);
+    j["cycles"] = st.cycles;
+    j["realtime"] = realtime_json(rt);
+    j["peak_force_n"] = s.peak_force_n;
+    j["rate_limited_cycles"] = s.rate_limited_cycles;
+    j["clamped_cycles"] = st.clamped_cycles;
+    j["models_rendered"] = s.models_accepted;
+    j["models_not_ours"] = s.models_not_ours;
+    for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
+      j["models"][net::verdict_name(static_cast<net::SampleVerdict>(v))] = s.verdicts[v];
+    }
+    j["states_published"] = s.states_published;
+    j["simulation_joins"] = joins;
+    j["silences"] = nlohmann::json::array();
+    for (const Silence& silence : silences) {
+      j["silences"].push_back({{"since_s", silence.since_s},
+                               {"force_before_n", silence.force_before_n},
+                               {"force_zero_after_ms", silence.zero_after_ms}});
+    }
+    *json_out << j.dump(2) << '\n';
+    std::printf("wrote        %s\n", args.json_path.c_str());
+  }
+}
+
+}  // namespace
+
+void add_device_command(CLI::App& app) {
+  auto args = std::make_shared<DeviceArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "device",
+      "Device host: run a device's 1 kHz loop, rendering force from the local contact models of "
+      "a simulation host (hapsim serve) in the same session");
+  cmd->add_option("--device", args->device,
+                  "sim (the served scene's own script, or --scene's) or spacemouse (default sim)");
+  cmd->add_option("--scene", args->scene,
+                  "sim: play this scene's script instead of the served scene's");
+  cmd->add_option("--data", args->data_dir,
+                  "sim: the scene's data folder (default: the simulation host's)");
+  cmd->add_option("--session", args->session, "Session name (default 'default')");
+  cmd->add_option("--domain", args->domain, "DDS domain id (default 0)")->check(CLI::Range(0, 232));
+  cmd->add_option("--device-id", args->device_id, "This device's id (default 0)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--duration", args->duration_s,
+                  "Seconds to run the loop (default: until stopped)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--force-mode", args->force_mode,
+                  "local-model (default) or raw (the paper's raw forces: unsafe beyond a few ms "
+                  "of delay; for comparison)")
+      ->check(CLI::IsMember({"local-model", "raw"}));
+  cmd->add_option("--finger-map", args->finger_map,
+                  "Which device finger each scene finger drives, e.g. 0:2,1:3");
+  cmd->add_option("--json", args->json_path, "Write the summary as JSON");
+  cmd->callback([args] {
+    (void)net::session_partition(args->session);
+    run_device(*args);
+  });
+}
+
+}  // namespace hapsim::app

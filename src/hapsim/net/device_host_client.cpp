@@ -1,0 +1,220 @@
+#include "hapsim/net/device_host_client.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/runtime/deadline_clock.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hapsim::net {
+
+namespace {
+
+// Tool count in the low byte, then a nibble per tool: its finger + 1 (0: the tip).
+std::uint64_t pack_layout(const ServedScene& scene) noexcept {
+  std::uint64_t packed = std::min<std::uint64_t>(scene.tool_count, kMaxFingers);
+  for (std::size_t t = 0; t < kMaxFingers; ++t) {
+    const auto nibble =
+        static_cast<std::uint64_t>(std::clamp<int>(scene.tool_finger[t] + 1, 0, 15));
+    packed |= nibble << (8 + 4 * t);
+  }
+  return packed;
+}
+
+void unpack_layout(std::uint64_t packed, ServedScene& scene) noexcept {
+  scene.tool_count = static_cast<std::uint16_t>(packed & 0xffu);
+  for (std::size_t t = 0; t < kMaxFingers; ++t) {
+    scene.tool_finger[t] = static_cast<std::int16_t>(((packed >> (8 + 4 * t)) & 0xfu)) - 1;
+  }
+}
+
+void raise_to(std::atomic<double>& peak, double value) noexcept {
+  if (value > peak.load(std::memory_order_relaxed)) {
+    peak.store(value, std::memory_order_relaxed);
+  }
+}
+
+}  // namespace
+
+const char* to_string(ForceMode mode) noexcept {
+  return mode == ForceMode::kRaw ? "raw" : "local-model";
+}
+
+DeviceHostClient::DeviceHostClient(const Participant& participant, const DeviceHostOptions& options)
+    : options_(options),
+      models_in_(participant),
+      states_out_(participant),
+      gate_(options.device_id, 0, 1, options.limits),
+      renderers_{LocalModelRenderer(options.render), LocalModelRenderer(options.render),
+                 LocalModelRenderer(options.render), LocalModelRenderer(options.render),
+                 LocalModelRenderer(options.render)} {
+  if (!(std::isfinite(options.max_force_rate_n_per_s) && options.max_force_rate_n_per_s > 0.0)) {
+    throw Error("device host", "the force rate limit must be finite and > 0 N/s");
+  }
+}
+
+void DeviceHostClient::set_scene(const ServedScene& scene) noexcept {
+  pending_hash_.store(scene.scene_hash, std::memory_order_relaxed);
+  pending_serve_id_.store(scene.serve_id, std::memory_order_relaxed);
+  pending_layout_.store(pack_layout(scene), std::memory_order_relaxed);
+  pending_version_.fetch_add(1, std::memory_order_release);
+}
+
+// haptic path
+void DeviceHostClient::apply_scene() noexcept {
+  const std::uint64_t version = pending_version_.load(std::memory_order_acquire);
+  if (version == applied_version_) {
+    return;
+  }
+  applied_version_ = version;
+  scene_.scene_hash = pending_hash_.load(std::memory_order_relaxed);
+  scene_.serve_id = pending_serve_id_.load(std::memory_order_relaxed);
+  unpack_layout(pending_layout_.load(std::memory_order_relaxed), scene_);
+  // A new simulation numbers its models from 1 again and knows nothing of the old one's: start
+  // from no model (the renderers blend the first one in from zero).
+  gate_ = LocalModelGate(options_.device_id, scene_.scene_hash, std::max<int>(1, scene_.tool_count),
+                         options_.limits);
+  for (LocalModelRenderer& r : renderers_) {
+    r = LocalModelRenderer(options_.render);  // options checked at construction: no throw
+  }
+  raw_models_ = {};
+  scene_changes_.fetch_add(1, std::memory_order_relaxed);
+}
+
+// haptic path
+void DeviceHostClient::take_models(double now_s, std::int64_t now_ns) noexcept {
+  models_in_.take([&](const hapsim_msg_LocalModel& m, const dds_sample_info_t&) {
+    LocalContactModel model;
+    const SampleVerdict verdict = gate_.admit(m, sequence_, model);
+    verdicts_[static_cast<std::size_t>(verdict)].fetch_add(1, std::memory_order_relaxed);
+    if (verdict != SampleVerdict::kAccepted) {
+      return;
+    }
+    if (model.device_sequence == 0) {
+      models_not_ours_.fetch_add(1, std::memory_order_relaxed);
+      return;
+    }
+    const auto tool = static_cast<std::size_t>(m.finger);
+    if (options_.mode == ForceMode::kRaw) {
+      raw_models_[tool] = model;
+      raw_received_s_[tool] = now_s;
+    } else {
+      renderers_[tool].receive(model, now_s);
+    }
+    models_accepted_.fetch_add(1, std::memory_order_relaxed);
+    last_model_ns_.store(now_ns, std::memory_order_relaxed);
+    took_model_ = true;
+  });
+}
+
+// haptic path
+Vec3 DeviceHostClient::tool_force(std::size_t tool, const Vec3& p_device_m, double now_s) noexcept {
+  const LocalModelRenderOptions& o = options_.render;
+  if (options_.mode == ForceMode::kRaw) {
+    const LocalContactModel& m = raw_models_[tool];
+    if (!m.valid) {
+      return Vec3::Zero();
+    }
+    // The paper's raw force, held; still faded when stale and clamped (safety is not optional).
+    const double age_s = now_s - raw_received_s_[tool];
+    const double fresh =
+        age_s <= o.stale_after_s
+            ? 1.0
+            : std::clamp(1.0 - (age_s - o.stale_after_s) / std::max(o.fade_time_s, 1e-9), 0.0, 1.0);
+    Vec3 f = m.f0_world_n * fresh;
+    const double magnitude = f.norm();
+    return magnitude > o.max_force_n ? Vec3(f * (o.max_force_n / magnitude)) : f;
+  }
+  LocalModelRenderer& renderer = renderers_[tool];
+  const LocalContactModel& m = renderer.newest();
+  // Where the tool is now: where the simulation had it, moved as the device moved since.
+  Vec3 x_tool_m = m.x0_world_m;
+  if (m.valid && m.device_sequence > 0 && sequence_ - m.device_sequence < kHistory) {
+    x_tool_m += p_device_m - p_history_m_[m.device_sequence % kHistory];
+  }
+  return renderer.render(x_tool_m, v_m_per_s_, now_s);
+}
+
+// haptic path
+const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_s) {
+  const std::int64_t now_ns = monotonic_ns();
+  const double now_s = static_cast<double>(now_ns) * 1e-9;
+  apply_scene();
+  ++sequence_;
+  const Vec3 p_m = input.p_world.allFinite() ? input.p_world : p_previous_m_;
+  v_m_per_s_ = sequence_ > 1 && dt_s > 0.0 ? Vec3((p_m - p_previous_m_) / dt_s) : Vec3::Zero();
+  p_previous_m_ = p_m;
+  p_history_m_[sequence_ % kHistory] = p_m;
+  took_model_ = false;
+  take_models(now_s, now_ns);
+
+  command_ = DeviceCommand{};
+  const double max_step_n = options_.max_force_rate_n_per_s * dt_s;
+  double largest_n = 0.0;
+  bool limited = false;
+  for (std::size_t t = 0; t < scene_.tool_count; ++t) {
+    Vec3 f = tool_force(t, p_m, now_s);
+    const Vec3 change = f - previous_force_n_[t];
+    if (change.norm() > max_step_n) {
+      f = previous_force_n_[t] + change * (max_step_n / change.norm());
+      limited = true;
+    }
+    previous_force_n_[t] = f;
+    largest_n = std::max(largest_n, f.norm());
+    const int finger = scene_.tool_finger[t];
+    if (finger >= 0 && finger < kMaxFingers) {
+      double& finger_n = command_.finger_force_n[static_cast<std::size_t>(finger)];
+      finger_n = std::max(finger_n, f.norm());
+      command_.finger_count = std::max(command_.finger_count, finger + 1);
+    } else {
+      command_.force_world_n += f;
+    }
+  }
+  rate_limited_.fetch_add(limited ? 1 : 0, std::memory_order_relaxed);
+  force_n_.store(largest_n, std::memory_order_relaxed);
+  if (took_model_) {
+    force_at_last_model_n_.store(largest_n, std::memory_order_relaxed);
+  }
+  raise_to(peak_force_n_, largest_n);
+  if (largest_n > 0.0) {
+    last_force_ns_.store(now_ns, std::memory_order_relaxed);
+  }
+  cycles_.fetch_add(1, std::memory_order_relaxed);
+  return command_;
+}
+
+// haptic path
+void DeviceHostClient::after_cycle(const HapticCycle& cycle) noexcept {
+  if (scene_.scene_hash == 0 || cycle.input == nullptr || cycle.output == nullptr) {
+    return;  // no simulation host known yet: nobody to tell
+  }
+  state_.device_id = options_.device_id;
+  state_.sequence = sequence_;
+  state_.input = *cycle.input;
+  state_.v_world_m_per_s = v_m_per_s_;
+  state_.rendered = *cycle.output;
+  if (states_out_.write(encode_device_state(state_, scene_.scene_hash))) {
+    states_published_.fetch_add(1, std::memory_order_relaxed);
+  }
+}
+
+DeviceHostStatus DeviceHostClient::status() const noexcept {
+  DeviceHostStatus s;
+  s.cycles = cycles_.load(std::memory_order_relaxed);
+  s.states_published = states_published_.load(std::memory_order_relaxed);
+  s.models_accepted = models_accepted_.load(std::memory_order_relaxed);
+  s.models_not_ours = models_not_ours_.load(std::memory_order_relaxed);
+  for (std::size_t v = 0; v < kSampleVerdicts; ++v) {
+    s.verdicts[v] = verdicts_[v].load(std::memory_order_relaxed);
+  }
+  s.last_model_ns = last_model_ns_.load(std::memory_order_relaxed);
+  s.last_force_ns = last_force_ns_.load(std::memory_order_relaxed);
+  s.force_n = force_n_.load(std::memory_order_relaxed);
+  s.force_at_last_model_n = force_at_last_model_n_.load(std::memory_order_relaxed);
+  s.peak_force_n = peak_force_n_.load(std::memory_order_relaxed);
+  s.rate_limited_cycles = rate_limited_.load(std::memory_order_relaxed);
+  s.scene_changes = scene_changes_.load(std::memory_order_relaxed);
+  return s;
+}
+
+}  // namespace hapsim::net

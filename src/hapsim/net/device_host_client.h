@@ -1,0 +1,140 @@
+// The device host's side of each haptic cycle (`hapsim device`, SPEC §8): the simulation is far
+// away, so the 1 kHz loop renders force from the newest local contact model per tool, evaluated
+// at the device's own fresh position, and tells the simulation where the device is and what it
+// rendered. One cycle, allocation-free and non-blocking:
+//   1. the device's input (the loop read it) gets the next state sequence and a velocity;
+//   2. local models that arrived are taken and gated (net/local_model_gate.h); accepted ones go
+//      to their tool's renderer (device/local_model_renderer.h: blend, validity radius,
+//      push-only, clamp, stale fade by this host's clock);
+//   3. each tool's force is rendered where the tool is now: the model's x0 moved by how far the
+//      device moved since the state the model answered (exact for a probe; for a glove's
+//      fingertip it leaves out the finger's own flexion since then);
+//   4. the force's change per cycle is limited (a step from a bad model is felt as a ramp);
+//   5. after the device write, the state (input, velocity, what was rendered after the loop's
+//      safety layer) goes out on the DeviceState topic.
+// `raw` mode renders the newest model's f0 as it came, as the knee paper sent raw forces: for
+// comparison only, unstable beyond a few ms of delay (docs/benchmarks.md).
+// Models that answer a state this host did not send (sequence 0: the simulation's own script)
+// are never rendered.
+#pragma once
+
+#include "hapsim/device/local_model_renderer.h"
+#include "hapsim/net/device_state_codec.h"
+#include "hapsim/net/local_model_gate.h"
+#include "hapsim/net/participant.h"
+#include "hapsim/net/topic_reader.h"
+#include "hapsim/net/topic_writer.h"
+#include "hapsim/runtime/haptic_loop.h"
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+
+namespace hapsim::net {
+
+enum class ForceMode { kLocalModel, kRaw };
+
+struct DeviceHostOptions {
+  std::uint16_t device_id = 0;
+  ForceMode mode = ForceMode::kLocalModel;
+  LocalModelRenderOptions render;
+  /// Largest change of a tool's force per second (N/s): 10 N in 5 ms.
+  double max_force_rate_n_per_s = 2000.0;
+  LocalModelLimits limits;
+};
+
+/// What the simulation host says it runs (from its SceneInfo): set from any thread, applied by
+/// the haptic thread at its next cycle.
+struct ServedScene {
+  std::uint64_t scene_hash = 0;
+  std::uint64_t serve_id = 0;
+  std::uint16_t tool_count = 0;
+  /// Per tool: the device finger it drives (-1: the tip force).
+  std::array<std::int16_t, kMaxFingers> tool_finger{-1, -1, -1, -1, -1};
+};
+
+/// Figures of the running host, readable from any thread.
+struct DeviceHostStatus {
+  std::uint64_t cycles = 0;
+  std::uint64_t states_published = 0;
+  std::uint64_t models_accepted = 0;
+  /// Models answering no state of this host (the simulation's script), not rendered.
+  std::uint64_t models_not_ours = 0;
+  VerdictCounts verdicts{};
+  /// monotonic_ns() of the newest accepted model and of the last cycle with a non-zero force
+  /// (0: never).
+  std::int64_t last_model_ns = 0;
+  std::int64_t last_force_ns = 0;
+  double force_n = 0.0;  ///< what this cycle rendered (largest over tools)
+  /// What the cycle that took the newest model rendered (largest over tools).
+  double force_at_last_model_n = 0.0;
+  double peak_force_n = 0.0;  ///< over the run
+  std::uint64_t rate_limited_cycles = 0;
+  std::uint64_t scene_changes = 0;
+};
+
+class DeviceHostClient final : public HapticClient {
+ public:
+  DeviceHostClient(const Participant& participant, const DeviceHostOptions& options);
+
+  /// Any thread: the served scene changed (a new simulation host, or a restarted one).
+  void set_scene(const ServedScene& scene) noexcept;
+
+  /// haptic path
+  const DeviceCommand& step(const DeviceInput& input, double dt_s) override;
+  /// haptic path
+  void after_cycle(const HapticCycle& cycle) noexcept override;
+
+  [[nodiscard]] DeviceHostStatus status() const noexcept;
+
+ private:
+  static constexpr std::size_t kHistory = 1024;  ///< > the gate's max_age_cycles
+
+  void apply_scene() noexcept;
+  void take_models(double now_s, std::int64_t now_ns) noexcept;
+  [[nodiscard]] Vec3 tool_force(std::size_t tool, const Vec3& p_device_m, double now_s) noexcept;
+
+  DeviceHostOptions options_;
+  TopicReader<hapsim_msg_LocalModel> models_in_;
+  TopicWriter<hapsim_msg_DeviceState> states_out_;
+
+  // Set by set_scene (any thread), applied by the haptic thread.
+  std::atomic<std::uint64_t> pending_hash_{0};
+  std::atomic<std::uint64_t> pending_serve_id_{0};
+  std::atomic<std::uint64_t> pending_layout_{0};  ///< tool count and fingers, packed
+  std::atomic<std::uint64_t> pending_version_{0};
+  std::uint64_t applied_version_ = 0;
+
+  // Haptic thread only.
+  ServedScene scene_;
+  LocalModelGate gate_;
+  std::array<LocalModelRenderer, kMaxFingers> renderers_;
+  std::array<LocalContactModel, kMaxFingers> raw_models_{};
+  std::array<double, kMaxFingers> raw_received_s_{};
+  std::array<Vec3, kMaxFingers> previous_force_n_{};
+  std::array<Vec3, kHistory> p_history_m_{};
+  std::uint64_t sequence_ = 0;
+  Vec3 p_previous_m_ = Vec3::Zero();
+  Vec3 v_m_per_s_ = Vec3::Zero();
+  DeviceCommand command_;
+  DeviceStateSample state_;
+
+  // Published for status().
+  std::atomic<std::uint64_t> cycles_{0};
+  std::atomic<std::uint64_t> states_published_{0};
+  std::atomic<std::uint64_t> models_accepted_{0};
+  std::atomic<std::uint64_t> models_not_ours_{0};
+  std::array<std::atomic<std::uint64_t>, kSampleVerdicts> verdicts_{};
+  std::atomic<std::int64_t> last_model_ns_{0};
+  std::atomic<std::int64_t> last_force_ns_{0};
+  std::atomic<double> force_n_{0.0};
+  std::atomic<double> force_at_last_model_n_{0.0};
+  bool took_model_ = false;  ///< this cycle accepted a model (haptic thread)
+  std::atomic<double> peak_force_n_{0.0};
+  std::atomic<std::uint64_t> rate_limited_{0};
+  std::atomic<std::uint64_t> scene_changes_{0};
+};
+
+[[nodiscard]] const char* to_string(ForceMode mode) noexcept;
+
+}  // namespace hapsim::net

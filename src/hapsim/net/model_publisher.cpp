@@ -1,0 +1,52 @@
+#include "hapsim/net/model_publisher.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hapsim::net {
+
+LocalModelPublisher::LocalModelPublisher(const Participant& participant, const World& world,
+                                         RemoteDevice& device, std::uint16_t device_id,
+                                         std::uint64_t scene_hash, std::size_t tools,
+                                         LocalModelBuildOptions options)
+    : writer_(participant),
+      builder_(world.model(), options),
+      device_(device),
+      device_id_(device_id),
+      scene_hash_(scene_hash),
+      models_(std::min<std::size_t>(tools, kMaxFingers)) {}
+
+// haptic path
+void LocalModelPublisher::before_step(World& world) noexcept {
+  if (device_.take_source_switch()) {
+    world.forget_tool_motion();
+  }
+}
+
+// haptic path
+void LocalModelPublisher::after_step(const World& world, const HapticCycle& /*cycle*/) noexcept {
+  const bool driving = device_.host_driving();
+  builder_.build(world.state(), ++sequence_, driving ? device_.host_state().sequence : 0, models_);
+  std::uint64_t written = 0;
+  for (std::size_t t = 0; t < models_.size(); ++t) {
+    written += writer_.write(encode_local_model(
+                   models_[t], {device_id_, static_cast<std::uint16_t>(t)}, scene_hash_))
+                   ? 1
+                   : 0;
+  }
+  published_.fetch_add(written, std::memory_order_relaxed);
+  refused_.fetch_add(models_.size() - written, std::memory_order_relaxed);
+  if (driving) {
+    const DeviceCommand& rendered = device_.host_state().rendered;
+    double peak = rendered.force_world_n.allFinite() ? rendered.force_world_n.norm() : 0.0;
+    for (int f = 0; f < std::min(rendered.finger_count, kMaxFingers); ++f) {
+      const double finger_n = rendered.finger_force_n[static_cast<std::size_t>(f)];
+      peak = std::isfinite(finger_n) ? std::max(peak, finger_n) : peak;
+    }
+    if (peak > peak_rendered_n_.load(std::memory_order_relaxed)) {
+      peak_rendered_n_.store(peak, std::memory_order_relaxed);
+    }
+  }
+}
+
+}  // namespace hapsim::net

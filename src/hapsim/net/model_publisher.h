@@ -1,0 +1,57 @@
+// The simulation host's side of each haptic cycle (`hapsim serve`): before the world steps, it
+// makes the world forget the tools' motion when the input's source changed (a device host joined
+// or went silent: the tools jump, and no velocity or stick point should survive that); after the
+// step, it builds each tool's local contact model (world/local_model_builder.h) and writes it on
+// the session's LocalModel topic, answering the device state the step used. Allocation-free.
+#pragma once
+
+#include "hapsim/net/local_model_codec.h"
+#include "hapsim/net/remote_device.h"
+#include "hapsim/net/topic_writer.h"
+#include "hapsim/runtime/world_haptic_client.h"
+#include "hapsim/world/local_model_builder.h"
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+namespace hapsim::net {
+
+class LocalModelPublisher final : public WorldCycleObserver {
+ public:
+  /// Models for the first `tools` tools of `world` (at most kMaxFingers: one contact key each).
+  LocalModelPublisher(const Participant& participant, const World& world, RemoteDevice& device,
+                      std::uint16_t device_id, std::uint64_t scene_hash, std::size_t tools,
+                      LocalModelBuildOptions options = {});
+
+  /// haptic path
+  void before_step(World& world) noexcept override;
+  /// haptic path
+  void after_step(const World& world, const HapticCycle& cycle) noexcept override;
+
+  // Any thread.
+  [[nodiscard]] std::uint64_t published() const noexcept {
+    return published_.load(std::memory_order_relaxed);
+  }
+  [[nodiscard]] std::uint64_t refused_writes() const noexcept {
+    return refused_.load(std::memory_order_relaxed);
+  }
+  /// Largest force the device host said it rendered (tip force, or a finger's), N.
+  [[nodiscard]] double peak_rendered_force_n() const noexcept {
+    return peak_rendered_n_.load(std::memory_order_relaxed);
+  }
+
+ private:
+  TopicWriter<hapsim_msg_LocalModel> writer_;
+  LocalModelBuilder builder_;
+  RemoteDevice& device_;
+  std::uint16_t device_id_;
+  std::uint64_t scene_hash_;
+  std::vector<LocalContactModel> models_;
+  std::uint64_t sequence_ = 0;
+  std::atomic<std::uint64_t> published_{0};
+  std::atomic<std::uint64_t> refused_{0};
+  std::atomic<double> peak_rendered_n_{0.0};
+};
+
+}  // namespace hapsim::net

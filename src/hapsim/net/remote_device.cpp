@@ -1,0 +1,77 @@
+#include "hapsim/net/remote_device.h"
+
+#include "hapsim/runtime/deadline_clock.h"
+
+#include <chrono>
+#include <limits>
+#include <thread>
+
+namespace hapsim::net {
+
+RemoteDevice::RemoteDevice(const Participant& participant, std::uint16_t device_id,
+                           std::uint64_t scene_hash, Device& fallback, double host_timeout_s)
+    : states_(participant),
+      gate_(device_id, scene_hash),
+      fallback_(fallback),
+      host_timeout_ns_(static_cast<std::int64_t>(host_timeout_s * 1e9)),
+      host_seen_ns_(std::numeric_limits<std::int64_t>::min() / 2) {}
+
+// haptic path
+void RemoteDevice::take_states(std::int64_t now_ns) noexcept {
+  states_.take([&](const hapsim_msg_DeviceState& m, const dds_sample_info_t&) {
+    const SampleVerdict verdict = gate_.admit(m, host_state_);
+    verdicts_[static_cast<std::size_t>(verdict)].fetch_add(1, std::memory_order_relaxed);
+    if (verdict == SampleVerdict::kAccepted) {
+      host_seen_ns_ = now_ns;
+    }
+  });
+}
+
+// haptic path
+DeviceInput RemoteDevice::read(double time_s) noexcept {
+  const std::int64_t now_ns = monotonic_ns();
+  take_states(now_ns);
+  const bool driving = now_ns - host_seen_ns_ < host_timeout_ns_;
+  if (driving != driving_.load(std::memory_order_relaxed)) {
+    driving_.store(driving, std::memory_order_relaxed);
+    transitions_.fetch_add(1, std::memory_order_relaxed);
+    switched_ = true;
+    if (!driving) {
+      // A host that comes back (or a restarted one) numbers its states afresh.
+      gate_.forget_order();
+    }
+  }
+  // The fallback is read every cycle, so a script keeps its own time while a host drives.
+  DeviceInput input = fallback_.read(time_s);
+  if (driving) {
+    input = host_state_.input;
+    input.time_s = time_s;
+    cycles_driven_.fetch_add(1, std::memory_order_relaxed);
+  }
+  return input;
+}
+
+bool RemoteDevice::wait_for_host(double timeout_s, const std::atomic<bool>* stop) {
+  const std::int64_t give_up_ns = monotonic_ns() + static_cast<std::int64_t>(timeout_s * 1e9);
+  for (;;) {
+    const std::int64_t now_ns = monotonic_ns();
+    take_states(now_ns);
+    if (host_seen_ns_ == now_ns) {
+      return true;
+    }
+    if (now_ns > give_up_ns || (stop != nullptr && stop->load(std::memory_order_relaxed))) {
+      return false;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+}
+
+VerdictCounts RemoteDevice::verdicts() const noexcept {
+  VerdictCounts counts{};
+  for (std::size_t v = 0; v < kSampleVerdicts; ++v) {
+    counts[v] = verdicts_[v].load(std::memory_order_relaxed);
+  }
+  return counts;
+}
+
+}  // namespace hapsim::net

@@ -1,0 +1,79 @@
+// The device a simulation host steps its world with (`hapsim serve`): the newest gated state of
+// a device host (`hapsim device`, or anything that writes the DeviceState topic) while its states
+// keep coming, else a fallback device (the scene's own script). Every received state goes
+// through the DeviceStateGate; rejections are counted by reason. Whether a host drives is decided
+// by this process's own clock (a state is fresh for `host_timeout_s` after it arrived): clocks are
+// never compared across hosts.
+#pragma once
+
+#include "hapsim/device/device.h"
+#include "hapsim/net/device_state_gate.h"
+#include "hapsim/net/participant.h"
+#include "hapsim/net/topic_reader.h"
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+
+namespace hapsim::net {
+
+class RemoteDevice final : public Device {
+ public:
+  /// `fallback` must outlive this device; its profile is this device's.
+  RemoteDevice(const Participant& participant, std::uint16_t device_id, std::uint64_t scene_hash,
+               Device& fallback, double host_timeout_s = 0.1);
+
+  /// haptic path: takes the states that arrived, then the host's newest input (stamped
+  /// `time_s`) while it drives, else the fallback's.
+  [[nodiscard]] DeviceInput read(double time_s) noexcept override;
+  /// Forwarded to the fallback (a script ignores it); the host renders from its local models.
+  void write(const DeviceCommand& command) noexcept override { fallback_.write(command); }
+  [[nodiscard]] const DeviceProfile& profile() const noexcept override {
+    return fallback_.profile();
+  }
+  [[nodiscard]] DeviceStatus status() const noexcept override { return {}; }
+
+  /// Before the loop starts (the calling thread owns the reader then): takes states until one is
+  /// accepted or `timeout_s` passes; true when a host is there.
+  bool wait_for_host(double timeout_s, const std::atomic<bool>* stop = nullptr);
+
+  /// haptic path: true once after the input's source changed (host joined or went silent): the
+  /// tools jump, so the world should forget their motion.
+  bool take_source_switch() noexcept {
+    const bool switched = switched_;
+    switched_ = false;
+    return switched;
+  }
+  /// haptic path: the newest accepted host state (what the device rendered is in it).
+  [[nodiscard]] const DeviceStateSample& host_state() const noexcept { return host_state_; }
+
+  // Any thread.
+  [[nodiscard]] bool host_driving() const noexcept {
+    return driving_.load(std::memory_order_relaxed);
+  }
+  /// Host joins plus silences so far (a monitor prints each one).
+  [[nodiscard]] std::uint64_t transitions() const noexcept {
+    return transitions_.load(std::memory_order_relaxed);
+  }
+  [[nodiscard]] std::uint64_t cycles_driven() const noexcept {
+    return cycles_driven_.load(std::memory_order_relaxed);
+  }
+  [[nodiscard]] VerdictCounts verdicts() const noexcept;
+
+ private:
+  void take_states(std::int64_t now_ns) noexcept;
+
+  TopicReader<hapsim_msg_DeviceState> states_;
+  DeviceStateGate gate_;
+  Device& fallback_;
+  std::int64_t host_timeout_ns_;
+  DeviceStateSample host_state_;
+  std::int64_t host_seen_ns_;
+  bool switched_ = false;
+  std::atomic<bool> driving_{false};
+  std::atomic<std::uint64_t> transitions_{0};
+  std::atomic<std::uint64_t> cycles_driven_{0};
+  std::array<std::atomic<std::uint64_t>, kSampleVerdicts> verdicts_{};
+};
+
+}  // namespace hapsim::net

@@ -1,0 +1,125 @@
+// The distributed palpation (issue 12) as separate processes on loopback, against the same run in
+// one process:
+//  * `hapsim serve --wait-for-device` + `hapsim device` (the simulated device playing the knee's
+//    palpation) reproduce `hapsim run`'s contacts per segment and peak forces within 5 %, and the
+//    force the device rendered from its local models peaks within 5 % of the one-process force;
+//  * killing serve mid-contact takes the device's force to zero within 150 ms of its last model,
+//    the device keeps running and renders again when a new serve comes; when the device stops,
+//    serve keeps running and says so.
+#include "apps/hapsim_process.h"
+#include "net/net_test_support.h"
+
+#include <nlohmann/json.hpp>
+
+#include <csignal>
+#include <fstream>
+#include <map>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace hapsim::net {
+namespace {
+
+using namespace std::chrono_literals;
+using hapsim::test::BackgroundHapsim;
+
+const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee.json";
+
+nlohmann::json read_json(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+// Per segment name: (tool-steps in contact, peak force).
+std::map<std::string, std::pair<double, double>> segments(const nlohmann::json& run) {
+  std::map<std::string, std::pair<double, double>> out;
+  for (const auto& s : run["segments"]) {
+    out[s["name"].get<std::string>()] = {s["contacts"].get<double>(),
+                                         s["peak_force_n"].get<double>()};
+  }
+  return out;
+}
+
+TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
+  ASSERT_TRUE(test::on_loopback_config());
+  const auto one_json = hapsim::test::temp_path("one.json");
+  const auto served_json = hapsim::test::temp_path("served.json");
+  const auto device_json = hapsim::test::temp_path("device.json");
+  const hapsim::test::RunResult one =
+      hapsim::test::run_hapsim("run " + kScene + " --quiet --json " + one_json.string());
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+
+  const std::string net = " --session three-proc --domain 75";
+  BackgroundHapsim serve(
+      "serve " + kScene + " --wait-for-device --duration 10.5 --json " + served_json.string() + net,
+      hapsim::test::temp_path("serve.log"));
+  ASSERT_TRUE(serve.wait_for("waiting", 20s)) << serve.output();
+  BackgroundHapsim device("device --duration 11" + net + " --json " + device_json.string(),
+                          hapsim::test::temp_path("device.log"));
+  EXPECT_EQ(serve.wait(), 0) << serve.output();
+  EXPECT_EQ(device.wait(), 0) << device.output();
+  std::printf("%s\n%s\n", serve.output().c_str(), device.output().c_str());
+
+  const nlohmann::json a = read_json(one_json);
+  const nlohmann::json b = read_json(served_json);
+  const nlohmann::json d = read_json(device_json);
+  const auto one_segments = segments(a);
+  const auto served_segments = segments(b);
+  ASSERT_EQ(one_segments.size(), served_segments.size());
+  for (const auto& [name, counts] : one_segments) {
+    const auto& [contacts, peak_n] = counts;
+    ASSERT_TRUE(served_segments.count(name)) << name;
+    const auto& [served_contacts, served_peak_n] = served_segments.at(name);
+    EXPECT_NEAR(served_contacts, contacts, 0.05 * contacts + 1.0) << name;
+    EXPECT_NEAR(served_peak_n, peak_n, 0.05 * peak_n + 1e-9) << name;
+  }
+  const double one_peak_n = a["tools"][0]["peak_force_n"].get<double>();
+  EXPECT_GT(one_peak_n, 5.0);  // the palpation pressed
+  EXPECT_NEAR(b["tools"][0]["peak_force_n"].get<double>(), one_peak_n, 0.05 * one_peak_n);
+  // What the device felt, rendered from its own local models at its own position.
+  EXPECT_NEAR(d["peak_force_n"].get<double>(), one_peak_n, 0.05 * one_peak_n);
+  EXPECT_EQ(b["pop_throughs"].get<int>(), 0);
+  EXPECT_EQ(b["serve"]["device_states"]["malformed"].get<int>(), 0);
+  EXPECT_GT(b["serve"]["device_host_cycles"].get<int>(), 10'000);  // the device drove it all
+  EXPECT_EQ(d["models"]["malformed"].get<int>(), 0);
+  EXPECT_GT(d["models_rendered"].get<int>(), 9'000);
+}
+
+TEST(ThreeProcesses, KillingServeFadesTheForceAndTheDeviceRendersAgainWhenItReturns) {
+  ASSERT_TRUE(test::on_loopback_config());
+  const auto device_json = hapsim::test::temp_path("device-kill.json");
+  const std::string net = " --session kill-test --domain 76";
+  auto serve = std::make_unique<BackgroundHapsim>("serve " + kScene + net,
+                                                  hapsim::test::temp_path("serve-1.log"));
+  ASSERT_TRUE(serve->wait_for("dds ", 20s)) << serve->output();
+  BackgroundHapsim device("device --duration 9" + net + " --json " + device_json.string(),
+                          hapsim::test::temp_path("device-kill.log"));
+  ASSERT_TRUE(device.wait_for("host answering", 20s)) << device.output();
+  // The palpation presses the patella hardest around 3.3 s into the device's script.
+  std::this_thread::sleep_for(3300ms);
+  serve->signal(SIGKILL);
+  serve->wait();
+  ASSERT_TRUE(device.wait_for("host silent", 3s)) << device.output();
+  std::this_thread::sleep_for(500ms);
+  serve = std::make_unique<BackgroundHapsim>("serve " + kScene + net,
+                                             hapsim::test::temp_path("serve-2.log"));
+  EXPECT_TRUE(device.wait_for("host back", 20s)) << device.output();
+  EXPECT_EQ(device.wait(), 0) << device.output();
+  // The device is gone: serve goes on with the scene's script and says so.
+  EXPECT_TRUE(serve->wait_for("device host  silent", 5s)) << serve->output();
+  serve->signal(SIGTERM);
+  EXPECT_EQ(serve->wait(), 0) << serve->output();
+  std::printf("%s\n%s\n", device.output().c_str(), serve->output().c_str());
+
+  const nlohmann::json d = read_json(device_json);
+  ASSERT_GE(d["silences"].size(), 1u);
+  const nlohmann::json& kill = d["silences"][0];
+  EXPECT_GT(kill["force_before_n"].get<double>(), 1.0) << "serve was not killed mid-contact";
+  EXPECT_LE(kill["force_zero_after_ms"].get<double>(), 150.5);
+  EXPECT_EQ(d["simulation_joins"].get<int>(), 2);
+  EXPECT_NE(serve->output().find("device host  joined"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hapsim::net
