@@ -29,10 +29,21 @@ struct ViewArgs {
   std::string first_screenshot;
   std::string json;
   bool quiet = false;
+  bool connect = false;
+  std::string session = "default";
+  int domain = 0;
 };
 
 void view(const ViewArgs& args) {
+  if (args.connect == !args.scene.empty()) {
+    throw CommandError(args.connect ? "--connect takes its scene from the simulation host: give "
+                                      "no scene file"
+                                    : "give a scene file, or --connect to a simulation host");
+  }
   ViewerOptions o;
+  o.config.connect = args.connect;
+  o.config.session = args.session;
+  o.config.domain = args.domain;
   o.config.scene = args.scene;
   o.config.data_dir = args.data_dir;
   o.config.device = args.device;
@@ -54,6 +65,10 @@ void view(const ViewArgs& args) {
   o.json = args.json;
   o.quiet = args.quiet;
   // The scene menu offers the scene files beside the one opened.
+  if (args.connect) {
+    exit_status() = run_viewer(o);
+    return;
+  }
   const std::filesystem::path folder = std::filesystem::path(args.scene).parent_path();
   std::error_code ec;
   for (const auto& entry : std::filesystem::directory_iterator(
@@ -72,8 +87,16 @@ void view(const ViewArgs& args) {
 void add_view_command(CLI::App& app) {
   auto args = std::make_shared<ViewArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "view", "Open the 3D viewer: palpate a scene with the mouse on the real-time haptic loop");
-  cmd->add_option("scene", args->scene, "Scene file (JSON)")->required()->check(CLI::ExistingFile);
+      "view",
+      "Open the 3D viewer: palpate a scene with the mouse on the real-time haptic loop, or "
+      "--connect to a served one");
+  cmd->add_option("scene", args->scene, "Scene file (JSON); none with --connect")
+      ->check(CLI::ExistingFile);
+  cmd->add_flag("--connect", args->connect,
+                "Draw the world a simulation host serves (hapsim serve) instead of running one");
+  cmd->add_option("--session", args->session, "--connect: the session (default 'default')");
+  cmd->add_option("--domain", args->domain, "--connect: the DDS domain id (default 0)")
+      ->check(CLI::Range(0, 232));
   cmd->add_option("--data", args->data_dir, "Real-data folder for scenes that use one");
   cmd->add_option("--device", args->device,
                   "mouse (the viewer's probe), sim (the scene's script), sim:FILE (a trajectory "

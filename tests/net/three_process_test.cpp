@@ -11,10 +11,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <csignal>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <string>
+#include <thread>
 
 #include <gtest/gtest.h>
 
@@ -57,9 +60,46 @@ TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
   ASSERT_TRUE(serve.wait_for("waiting", 20s)) << serve.output();
   BackgroundHapsim device("device --duration 11" + net + " --json " + device_json.string(),
                           hapsim::test::temp_path("device.log"));
+  // The third process: a viewer that joins after the palpation started, under a virtual display.
+  const auto view_json = hapsim::test::temp_path("view.json");
+  const auto view_png = hapsim::test::temp_path("view.png");
+  const bool have_xvfb = std::system("command -v xvfb-run > /dev/null 2>&1") == 0;
+  hapsim::test::RunResult viewed;
+  std::thread viewer;
+  if (have_xvfb) {
+    viewer = std::thread([&] {
+      std::this_thread::sleep_for(1500ms);
+      const std::string cmd = "xvfb-run -a -s '-screen 0 1280x720x24' " +
+                              std::string(HAPSIM_BIN_PATH) + " view --connect" + net +
+                              " --duration 5 --json " + view_json.string() + " --screenshot " +
+                              view_png.string() + " 2>&1";
+      std::FILE* pipe = popen(cmd.c_str(), "r");
+      std::array<char, 4096> buffer{};
+      while (pipe != nullptr &&
+             std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe) != nullptr) {
+        viewed.output += buffer.data();
+      }
+      const int status = pipe != nullptr ? pclose(pipe) : -1;
+      viewed.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    });
+  } else {
+    std::printf("SKIPPED the viewer: xvfb-run is not installed (scripts/setup.sh installs it)\n");
+  }
   EXPECT_EQ(serve.wait(), 0) << serve.output();
   EXPECT_EQ(device.wait(), 0) << device.output();
-  std::printf("%s\n%s\n", serve.output().c_str(), device.output().c_str());
+  if (viewer.joinable()) {
+    viewer.join();
+  }
+  std::printf("%s\n%s\n%s\n", serve.output().c_str(), device.output().c_str(),
+              viewed.output.c_str());
+  if (have_xvfb) {
+    // It drew the served palpation as it went: forces and the skin's dent, from view states only.
+    ASSERT_EQ(viewed.exit_code, 0) << viewed.output;
+    const nlohmann::json v = read_json(view_json);
+    EXPECT_GT(v["peak_force_n"][0].get<double>(), 5.0);
+    EXPECT_GT(v["max_deflection_m"].get<double>(), 0.005);
+    EXPECT_TRUE(std::filesystem::exists(view_png));
+  }
 
   const nlohmann::json a = read_json(one_json);
   const nlohmann::json b = read_json(served_json);

@@ -10,6 +10,7 @@
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/ui/force_graph.h"
 #include "hapsim/ui/mouse_probe.h"
+#include "hapsim/ui/net_viewer_session.h"
 #include "hapsim/ui/viewer_scenes.h"
 
 #define GLFW_INCLUDE_NONE
@@ -55,6 +56,9 @@ void on_scroll(GLFWwindow* window, double /*x*/, double y) {
 }
 
 std::unique_ptr<ViewerSession> make_session(const ViewerConfig& config) {
+  if (config.connect) {
+    return make_net_viewer_session(config);
+  }
   SceneLoadOptions load;
   load.data_dir = config.data_dir;
   const SceneDescription scene = load_scene(config.scene, load);
@@ -119,8 +123,8 @@ class Viewer {
     renderer_ = std::make_unique<Renderer>();
     gl_version_ = renderer_->gl_version();
     scene_choices_ = options.scene_choices;
-    if (std::find(scene_choices_.begin(), scene_choices_.end(), config_.scene) ==
-        scene_choices_.end()) {
+    if (!config_.connect && std::find(scene_choices_.begin(), scene_choices_.end(),
+                                      config_.scene) == scene_choices_.end()) {
       scene_choices_.insert(scene_choices_.begin(), config_.scene);
     }
     rebuild(config_);

@@ -1,9 +1,9 @@
-// `hapsim view SCENE` (architecture.md#viewer, issue 5): a window with the 3D view (Gouraud shading, lights,
-// point/line/face modes, rotate/pan/zoom, the floor with the tool's 'x' shadow mark), a control
-// area (display, scene, device, contact and deformation method, segments, stiffness and limits,
-// pause/reset, record), a data area (tool and device coordinates in mm, force per finger, haptic
-// rate, step cost, graphics fps) and a force column graph with a scrolling force plot, while the
-// scene runs on the real-time haptic thread.
+// `hapsim view SCENE` (architecture.md#viewer, issue 5): a window with the 3D view (Gouraud
+// shading, lights, point/line/face modes, rotate/pan/zoom, the floor with the tool's 'x' shadow
+// mark), a control area (display, scene, device, contact and deformation method, segments,
+// stiffness and limits, pause/reset, record), a data area (tool and device coordinates in mm, force
+// per finger, haptic rate, step cost, graphics fps) and a force column graph with a scrolling force
+// plot, while the scene runs on the real-time haptic thread.
 //
 // Mouse: left-drag moves the probe in the view plane, the wheel pushes it in or pulls it out;
 // right-drag rotates the view, middle-drag (or shift+right) pans, ctrl+wheel zooms.

@@ -30,6 +30,12 @@ struct ViewerConfig {
   /// Deformation method: "deflection" (vertex deflection, eq. 1, the scene's deformable bodies)
   /// or "none" (every body rigid).
   std::string deformation = "deflection";
+  /// Draw a world served by another process (hapsim serve) instead of running one: the scene
+  /// comes from the simulation host of `session` on DDS `domain`.
+  bool connect = false;
+  std::string session = "default";
+  int domain = 0;
+  double connect_timeout_s = 20.0;
 
   bool operator==(const ViewerConfig&) const = default;
 };

@@ -1,5 +1,7 @@
 #include "hapsim/ui/world_viewer_session.h"
 
+#include "hapsim/ui/world_readout.h"
+
 #include "hapsim/core/error.h"
 #include "hapsim/device/interactive_device.h"
 #include "hapsim/device/master_probe_device.h"
@@ -27,13 +29,6 @@ ContactMethod method_from(const std::string& name) {
     return *m;
   }
   throw Error("contact method", "expected exact, spheretree or knee, got '" + name + "'");
-}
-
-std::string format_mm(const Vec3& p_m) {
-  char text[96];
-  std::snprintf(text, sizeof text, "%8.1f %8.1f %8.1f", p_m.x() * 1e3, p_m.y() * 1e3,
-                p_m.z() * 1e3);
-  return text;
 }
 
 // In front of the scene from the default camera (+Y, a little −X), a finger's width clear. For a
@@ -190,38 +185,7 @@ class WorldViewerSession final : public ViewerSession {
       update_rig(s, *s.teleop);
       return;
     }
-    const WorldDescription& d = world_->description();
-    readout_.time_s = s.time_s;
-    readout_.cycle = s.cycle;
-    readout_.tools.resize(s.tools.size());
-    readout_.bars.clear();
-    readout_.lines.clear();
-    for (std::size_t t = 0; t < s.tools.size(); ++t) {
-      ToolReadout& r = readout_.tools[t];
-      r.name = d.tools[t].name;
-      r.p_world = s.tools[t].p_world;
-      r.proxy_world = s.tools[t].proxy_world;
-      r.force_n = s.tool_force_n[t];
-      r.contacts = s.tools[t].contact_count;
-      readout_.bars.emplace_back(r.name, r.force_n);
-    }
-    readout_.contact_count = s.contact_count;
-    readout_.max_deflection_m = 0.0;
-    for (const double x : s.deflection_m) {
-      readout_.max_deflection_m = std::max(readout_.max_deflection_m, x);
-    }
-    // What is touched now.
-    std::string touched;
-    for (std::size_t i = 0; i < s.contact_count; ++i) {
-      const WorldContact& c = s.contacts[i];
-      const std::string& label = view_->segment_label(world_->flat_segment(
-          static_cast<std::size_t>(c.body), static_cast<std::size_t>(c.segment)));
-      if (touched.find(label) == std::string::npos) {
-        touched += (touched.empty() ? "" : ", ") + label;
-      }
-    }
-    readout_.lines.emplace_back("touching", touched.empty() ? "-" : touched);
-    readout_.lines.emplace_back("device pose (mm)", format_mm(s.input.p_world));
+    fill_world_readout(*world_, *view_, s, readout_);
   }
 
   RenderScene& render_scene() override {
@@ -327,32 +291,7 @@ class WorldViewerSession final : public ViewerSession {
       draw_rig_controls();
       return;
     }
-    WorldSceneOptions o = view_->options();
-    bool changed = false;
-    int colouring = static_cast<int>(o.colouring);
-    ImGui::TextUnformatted("Colours");
-    changed |= ImGui::RadioButton("tissue", &colouring, 0);
-    ImGui::SameLine();
-    changed |= ImGui::RadioButton("segments", &colouring, 1);
-    ImGui::SameLine();
-    changed |= ImGui::RadioButton("groups", &colouring, 2);
-    o.colouring = static_cast<SegmentColouring>(colouring);
-    changed |= ImGui::SliderInt("sphere-tree level", &o.sphere_tree_level, -1, 6,
-                                o.sphere_tree_level < 0 ? "off" : "%d");
-    changed |= ImGui::Checkbox("proxies", &o.show_proxies);
-    ImGui::SameLine();
-    changed |= ImGui::Checkbox("force arrows", &o.show_force_arrows);
-    if (changed) {
-      view_->set_options(o);
-    }
-    if (ImGui::CollapsingHeader("Segments", ImGuiTreeNodeFlags_DefaultOpen)) {
-      for (std::size_t i = 0; i < view_->segment_count(); ++i) {
-        bool visible = view_->segment_visible(i);
-        if (ImGui::Checkbox(view_->segment_label(i).c_str(), &visible)) {
-          view_->set_segment_visible(i, visible);
-        }
-      }
-    }
+    draw_world_display_controls(*view_);
     if (ImGui::CollapsingHeader("Stiffness and limits")) {
       if (recorder_) {
         ImGui::TextWrapped(

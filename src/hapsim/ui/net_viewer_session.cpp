@@ -1,0 +1,204 @@
+#include "hapsim/ui/net_viewer_session.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/net/dds_domain.h"
+#include "hapsim/net/loaned_reader.h"
+#include "hapsim/net/participant.h"
+#include "hapsim/net/scene_hash.h"
+#include "hapsim/net/scene_info.h"
+#include "hapsim/net/view_state_codec.h"
+#include "hapsim/render/world_scene.h"
+#include "hapsim/scene/run_setup.h"
+#include "hapsim/scene/scene_file.h"
+#include "hapsim/ui/world_readout.h"
+
+#include <imgui.h>
+
+#include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <optional>
+#include <thread>
+
+namespace hapsim {
+namespace {
+
+std::string hex(std::uint64_t value) {
+  char text[24];
+  std::snprintf(text, sizeof text, "%016" PRIx64, value);
+  return text;
+}
+
+class NetViewerSession final : public ViewerSession {
+ public:
+  explicit NetViewerSession(const ViewerConfig& config)
+      : session_(config.session),
+        domain_(config.domain, HAPSIM_DEFAULT_DDS_CONFIG),
+        participant_(config.domain, config.session),
+        info_in_(participant_),
+        views_in_(participant_) {
+    const auto give_up =
+        std::chrono::steady_clock::now() + std::chrono::duration<double>(config.connect_timeout_s);
+    std::optional<net::SceneInfoSample> info;
+    while (!info && std::chrono::steady_clock::now() < give_up) {
+      info = take_info();
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    if (!info) {
+      throw Error("--connect", "no simulation host (hapsim serve … --session " + session_ +
+                                   ") answered on DDS domain " + std::to_string(config.domain) +
+                                   " within " + std::to_string(config.connect_timeout_s) + " s");
+    }
+    info_ = *info;
+    SceneLoadOptions load;
+    load.data_dir = !config.data_dir.empty() ? config.data_dir.string() : info_.data_dir;
+    scene_ = parse_scene(info_.scene_json, info_.scene_file, load);
+    // Built as the host built it (the device's stiffness limits are part of the world).
+    setup_.emplace(make_run_setup(scene_, DeviceChoice::external()));
+    world_ = setup_->world.get();
+    const std::uint64_t ours = net::scene_hash(world_->content_hash());
+    if (ours != info_.scene_hash) {
+      throw Error("--connect", "the scene " + info_.scene_file + " built here (hash " + hex(ours) +
+                                   ") is not the one served (hash " + hex(info_.scene_hash) +
+                                   "): give this machine the host's data (--data)");
+    }
+    if (world_->rig() != nullptr) {
+      throw Error("--connect", "a teleoperation rig is not served over the network yet");
+    }
+    snapshot_ = make_world_snapshot(*world_);
+    decoder_.emplace(*world_);
+    view_ = std::make_unique<WorldScene>(*world_);
+    view_->update(snapshot_);
+    device_name_ = "simulation host '" + session_ + "' (view only)";
+    title_ =
+        std::filesystem::path(info_.scene_file).filename().string() + " — connected to " + session_;
+    connected_at_ = std::chrono::steady_clock::now();
+  }
+
+  void update() override {
+    if (auto info = take_info(); info && info->serve_id != info_.serve_id) {
+      restarts_ += 1;
+      restarted_other_scene_ = info->scene_hash != info_.scene_hash;
+      info_.serve_id = info->serve_id;
+    }
+    bool fresh = false;
+    views_in_.take([&](const hapsim_msg_ViewState& m) {
+      std::string why;
+      if (decoder_->decode(m, info_.scene_hash, snapshot_, why)) {
+        ++views_;
+        fresh = true;
+        host_driving_ = m.device_host_driving;
+        last_view_ = std::chrono::steady_clock::now();
+      } else {
+        ++refused_;
+        last_refusal_ = why;
+      }
+    });
+    if (fresh) {
+      view_->update(snapshot_);
+      fill_world_readout(*world_, *view_, snapshot_, readout_);
+    }
+    const double age_s =
+        views_ > 0
+            ? std::chrono::duration<double>(std::chrono::steady_clock::now() - last_view_).count()
+            : -1.0;
+    // The data area says where the picture comes from and whether it is live.
+    auto& lines = readout_.lines;
+    lines.erase(std::remove_if(lines.begin(), lines.end(),
+                               [](const auto& l) { return l.first.rfind("served", 0) == 0; }),
+                lines.end());
+    lines.emplace_back("served by", host_driving_ ? "serve, driven by a device host"
+                                                  : "serve, driven by its script");
+    lines.emplace_back(
+        "served views",
+        std::to_string(views_) +
+            (refused_ > 0 ? ", " + std::to_string(refused_) + " refused (" + last_refusal_ + ")"
+                          : std::string()) +
+            (age_s < 0.0   ? ", none yet"
+             : age_s > 0.5 ? ", none for " + std::to_string(static_cast<int>(age_s)) +
+                                 " s: the host is silent"
+                           : ""));
+    if (restarts_ > 0) {
+      lines.emplace_back("served restarts",
+                         std::to_string(restarts_) +
+                             (restarted_other_scene_ ? " (now another scene: reconnect)" : ""));
+    }
+  }
+
+  RenderScene& render_scene() override { return view_->scene(); }
+  Box3 bounds_world() const override { return view_->rest_bounds_world(); }
+  const SessionReadout& readout() const override { return readout_; }
+  HapticLoopStatus loop_status() const override {
+    // No loop here: the figures are the views' (the host's loop reports its own).
+    HapticLoopStatus s;
+    s.running = views_ > 0;
+    s.cycles = snapshot_.cycle;
+    s.elapsed_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - connected_at_).count();
+    s.rate_hz = s.elapsed_s > 0.0 ? static_cast<double>(views_) / s.elapsed_s : 0.0;
+    return s;
+  }
+  InteractiveDevice* mouse_device() override { return nullptr; }
+  Vec3 probe_start_world() const override { return Vec3::Zero(); }
+  const std::string& device_name() const override { return device_name_; }
+  const std::vector<std::string>& warnings() const override { return scene_.warnings; }
+  const std::string& title() const override { return title_; }
+  void set_paused(bool /*paused*/) override {}
+  void reset() override {}
+  void draw_controls() override {
+    ImGui::TextWrapped(
+        "Connected to session '%s' (scene hash %s). The simulation and the device "
+        "run elsewhere: pause, reset and recording belong to them.",
+        session_.c_str(), hex(info_.scene_hash).c_str());
+    draw_world_display_controls(*view_);
+  }
+  bool set_recording(const std::filesystem::path* /*path*/, std::string& error) override {
+    error = "a connected viewer records nothing: record on the simulation host";
+    return false;
+  }
+  bool recording() const override { return false; }
+
+ private:
+  std::optional<net::SceneInfoSample> take_info() {
+    std::optional<net::SceneInfoSample> newest;
+    info_in_.take([&](const hapsim_msg_SceneInfo& m) {
+      std::string why;
+      if (auto info = net::decode_scene_info(m, why)) {
+        newest = std::move(info);
+      }
+    });
+    return newest;
+  }
+
+  std::string session_;
+  net::DdsDomain domain_;
+  net::Participant participant_;
+  net::LoanedReader<hapsim_msg_SceneInfo> info_in_;
+  net::LoanedReader<hapsim_msg_ViewState> views_in_;
+  net::SceneInfoSample info_;
+  SceneDescription scene_;
+  std::optional<RunSetup> setup_;
+  World* world_ = nullptr;
+  WorldSnapshot snapshot_;
+  std::optional<net::ViewStateDecoder> decoder_;
+  std::unique_ptr<WorldScene> view_;
+  SessionReadout readout_;
+  std::string device_name_;
+  std::string title_;
+  std::uint64_t views_ = 0;
+  std::uint64_t refused_ = 0;
+  std::string last_refusal_;
+  bool host_driving_ = false;
+  std::uint64_t restarts_ = 0;
+  bool restarted_other_scene_ = false;
+  std::chrono::steady_clock::time_point connected_at_;
+  std::chrono::steady_clock::time_point last_view_;
+};
+
+}  // namespace
+
+std::unique_ptr<ViewerSession> make_net_viewer_session(const ViewerConfig& config) {
+  return std::make_unique<NetViewerSession>(config);
+}
+
+}  // namespace hapsim
