@@ -5,6 +5,7 @@
 // state. It waits for a simulation host (`hapsim serve`) in its session, follows it when it
 // restarts, and says when it goes silent and how fast the force went to zero then.
 #include "commands.h"
+#include "dds_options.h"
 #include "session_json.h"
 
 #include "hapsim/core/error.h"
@@ -43,8 +44,7 @@ struct DeviceArgs {
   std::string device = "sim";
   std::string scene;  // sim: play this scene's script instead of the served one's
   std::string data_dir;
-  std::string session = "default";
-  int domain = 0;
+  DdsOptions dds;
   int device_id = 0;
   double duration_s = std::numeric_limits<double>::quiet_NaN();  // NaN: until stopped
   std::string force_mode = "local-model";
@@ -168,17 +168,17 @@ void run_device(const DeviceArgs& args) {
       throw CommandError("--json " + args.json_path + ": cannot open for writing");
     }
   }
-  net::DdsDomain domain(args.domain, HAPSIM_DEFAULT_DDS_CONFIG);
-  net::Participant participant(args.domain, args.session);
+  net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
+  net::Participant participant(args.dds.domain, args.dds.session);
   net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
   std::signal(SIGINT, request_device_stop);
   std::signal(SIGTERM, request_device_stop);
 
   std::printf("device host  session '%s' (partition %s, domain %d), config %s\n",
-              args.session.c_str(), participant.partition().c_str(), args.domain,
+              args.dds.session.c_str(), participant.partition().c_str(), args.dds.domain,
               domain.config().c_str());
   std::printf("waiting      for a simulation host (hapsim serve SCENE --session %s)\n",
-              args.session.c_str());
+              args.dds.session.c_str());
   std::fflush(stdout);
   std::optional<net::SceneInfoSample> info;
   while (!info && !g_stop.load(std::memory_order_relaxed)) {
@@ -277,11 +277,14 @@ void run_device(const DeviceArgs& args) {
     std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
                 s.verdicts[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
   }
-  std::printf("states       %" PRIu64 " published\n", s.states_published);
+  std::printf("states       %" PRIu64
+              " published; round trip state -> model p50 %.0f us, p99 %.0f "
+              "us, max %.0f us\n",
+              s.states_published, s.round_trip_us.p50, s.round_trip_us.p99, s.round_trip_us.max);
   if (json_out) {
     nlohmann::json j;
     j["device"] = host.name;
-    j["session"] = args.session;
+    j["session"] = args.dds.session;
     j["force_mode"] = net::to_string(mode);
     j["cycles"] = st.cycles;
     j["realtime"] = realtime_json(rt);
@@ -294,6 +297,8 @@ void run_device(const DeviceArgs& args) {
       j["models"][net::verdict_name(static_cast<net::SampleVerdict>(v))] = s.verdicts[v];
     }
     j["states_published"] = s.states_published;
+    j["round_trip_us"] = {
+        {"p50", s.round_trip_us.p50}, {"p99", s.round_trip_us.p99}, {"max", s.round_trip_us.max}};
     j["simulation_joins"] = joins;
     j["silences"] = nlohmann::json::array();
     for (const Silence& silence : silences) {
@@ -320,8 +325,6 @@ void add_device_command(CLI::App& app) {
                   "sim: play this scene's script instead of the served scene's");
   cmd->add_option("--data", args->data_dir,
                   "sim: the scene's data folder (default: the simulation host's)");
-  cmd->add_option("--session", args->session, "Session name (default 'default')");
-  cmd->add_option("--domain", args->domain, "DDS domain id (default 0)")->check(CLI::Range(0, 232));
   cmd->add_option("--device-id", args->device_id, "This device's id (default 0)")
       ->check(CLI::Range(0, 65535));
   cmd->add_option("--duration", args->duration_s,
@@ -334,8 +337,9 @@ void add_device_command(CLI::App& app) {
   cmd->add_option("--finger-map", args->finger_map,
                   "Which device finger each scene finger drives, e.g. 0:2,1:3");
   cmd->add_option("--json", args->json_path, "Write the summary as JSON");
+  add_dds_options(cmd, args->dds);
   cmd->callback([args] {
-    (void)net::session_partition(args->session);
+    (void)net::session_partition(args->dds.session);
     run_device(*args);
   });
 }

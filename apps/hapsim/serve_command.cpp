@@ -10,6 +10,7 @@
 // forces per tool, safety) plus what went over the network, and --json writes it with the same
 // keys as `hapsim run --json`, so a served run and a one-process run compare key by key.
 #include "commands.h"
+#include "dds_options.h"
 #include "session_json.h"
 
 #include "hapsim/net/dds_domain.h"
@@ -48,8 +49,7 @@ struct ServeArgs {
   std::string scene;
   double rate_hz = 1000.0;
   double duration_s = std::numeric_limits<double>::quiet_NaN();  // NaN: until stopped
-  std::string session = "default";
-  int domain = 0;
+  DdsOptions dds;
   int device_id = 0;
   std::string data_dir;
   bool wait_for_device = false;
@@ -172,8 +172,8 @@ void serve(const ServeArgs& args) {
                 world.description().tools.size(), tools);
   }
 
-  net::DdsDomain domain(args.domain, HAPSIM_DEFAULT_DDS_CONFIG);
-  net::Participant participant(args.domain, args.session);
+  net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
+  net::Participant participant(args.dds.domain, args.dds.session);
   net::RemoteDevice remote(participant, device_id, hash, *setup.device);
   net::LocalModelPublisher publisher(participant, world, remote, device_id, hash, tools);
   ServeMonitor monitor(participant, world, hash, serve_id, remote, args.view_rate_hz);
@@ -198,15 +198,15 @@ void serve(const ServeArgs& args) {
 
   std::printf("serve        %s, %zu tool(s), scene hash %016" PRIx64 ", at %.0f Hz\n",
               args.scene.c_str(), tools, hash, args.rate_hz);
-  std::printf("dds          domain %d, session '%s' (partition %s), config %s\n", args.domain,
-              args.session.c_str(), participant.partition().c_str(), domain.config().c_str());
+  std::printf("dds          domain %d, session '%s' (partition %s), config %s\n", args.dds.domain,
+              args.dds.session.c_str(), participant.partition().c_str(), domain.config().c_str());
   std::fflush(stdout);
 
   std::signal(SIGINT, request_stop);
   std::signal(SIGTERM, request_stop);
   if (args.wait_for_device) {
     std::printf("waiting      for a device host (hapsim device --session %s)\n",
-                args.session.c_str());
+                args.dds.session.c_str());
     std::fflush(stdout);
     if (!remote.wait_for_host(kUntilStopped_s, &g_stop)) {
       std::printf("stopped      before a device host joined\n");
@@ -247,8 +247,8 @@ void serve(const ServeArgs& args) {
   if (json_out) {
     nlohmann::json j =
         session_summary_json(setup.scene, world, summary, "device host or " + setup.device_name);
-    j["serve"] = {{"session", args.session},
-                  {"domain", args.domain},
+    j["serve"] = {{"session", args.dds.session},
+                  {"domain", args.dds.domain},
                   {"scene_hash", hash},
                   {"models_published", publisher.published()},
                   {"views_published", monitor.views_published()},
@@ -284,10 +284,6 @@ void add_serve_command(CLI::App& app) {
   cmd->add_flag("--wait-for-device", args->wait_for_device,
                 "Step nothing until a device host's first state arrives (a served run then "
                 "covers exactly what the device did)");
-  cmd->add_option("--session", args->session,
-                  "Session name: a DDS partition, so sessions never see each other (default "
-                  "'default')");
-  cmd->add_option("--domain", args->domain, "DDS domain id (default 0)")->check(CLI::Range(0, 232));
   cmd->add_option("--device-id", args->device_id, "Device id the models are for (default 0)")
       ->check(CLI::Range(0, 65535));
   cmd->add_option("--view-rate", args->view_rate_hz,
@@ -295,8 +291,9 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--data", args->data_dir, "The scene's data folder");
   cmd->add_option("--json", args->json_path,
                   "Write the summary as JSON (the keys of hapsim run --json, plus 'serve')");
+  add_dds_options(cmd, args->dds);
   cmd->callback([args] {
-    (void)net::session_partition(args->session);  // a bad name is one line before anything runs
+    (void)net::session_partition(args->dds.session);  // a bad name is one line before anything runs
     serve(*args);
   });
 }

@@ -2,6 +2,7 @@
 // watch forces and deformation. Needs a display (or xvfb-run); headless machines use
 // `hapsim run SCENE --snapshot FILE.png`.
 #include "commands.h"
+#include "dds_options.h"
 
 #include "hapsim/ui/viewer.h"
 
@@ -30,8 +31,7 @@ struct ViewArgs {
   std::string json;
   bool quiet = false;
   bool connect = false;
-  std::string session = "default";
-  int domain = 0;
+  DdsOptions dds;
 };
 
 void view(const ViewArgs& args) {
@@ -42,8 +42,10 @@ void view(const ViewArgs& args) {
   }
   ViewerOptions o;
   o.config.connect = args.connect;
-  o.config.session = args.session;
-  o.config.domain = args.domain;
+  o.config.session = args.dds.session;
+  o.config.domain = args.dds.domain;
+  o.config.interface = args.dds.interface;
+  o.config.peers = args.dds.peers;
   o.config.scene = args.scene;
   o.config.data_dir = args.data_dir;
   o.config.device = args.device;
@@ -94,9 +96,7 @@ void add_view_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_flag("--connect", args->connect,
                 "Draw the world a simulation host serves (hapsim serve) instead of running one");
-  cmd->add_option("--session", args->session, "--connect: the session (default 'default')");
-  cmd->add_option("--domain", args->domain, "--connect: the DDS domain id (default 0)")
-      ->check(CLI::Range(0, 232));
+  add_dds_options(cmd, args->dds);
   cmd->add_option("--data", args->data_dir, "Real-data folder for scenes that use one");
   cmd->add_option("--device", args->device,
                   "mouse (the viewer's probe), sim (the scene's script), sim:FILE (a trajectory "

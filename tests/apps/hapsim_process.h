@@ -24,8 +24,9 @@ struct RunResult {
   std::string output;  // stdout and stderr together
 };
 
-inline RunResult run_hapsim(const std::string& args) {
-  const std::string cmd = std::string(HAPSIM_BIN_PATH) + " " + args + " 2>&1";
+/// `hapsim ARGS` run through `prefix` (e.g. "env -u NAME"), stdout and stderr together.
+inline RunResult run_hapsim_env(const std::string& prefix, const std::string& args) {
+  const std::string cmd = prefix + " " + std::string(HAPSIM_BIN_PATH) + " " + args + " 2>&1";
   RunResult result;
   std::FILE* pipe = popen(cmd.c_str(), "r");
   if (pipe == nullptr) {
@@ -38,6 +39,10 @@ inline RunResult run_hapsim(const std::string& args) {
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+inline RunResult run_hapsim(const std::string& args) {
+  return run_hapsim_env("", args);
 }
 
 /// `hapsim ARGS` running in the background (its own process), its output going to a file: for the

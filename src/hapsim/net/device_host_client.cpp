@@ -94,6 +94,13 @@ void DeviceHostClient::take_models(double now_s, std::int64_t now_ns) noexcept {
       models_not_ours_.fetch_add(1, std::memory_order_relaxed);
       return;
     }
+    // The first model that answers a state closes its round trip.
+    const std::size_t slot = model.device_sequence % kHistory;
+    if (sequence_ - model.device_sequence < kHistory && !answered_[slot] &&
+        state_sent_ns_[slot] > 0) {
+      answered_[slot] = true;
+      round_trip_us_.record_us(static_cast<double>(now_ns - state_sent_ns_[slot]) * 1e-3);
+    }
     const auto tool = static_cast<std::size_t>(m.finger);
     if (options_.mode == ForceMode::kRaw) {
       raw_models_[tool] = model;
@@ -193,6 +200,9 @@ void DeviceHostClient::after_cycle(const HapticCycle& cycle) noexcept {
   state_.input = *cycle.input;
   state_.v_world_m_per_s = v_m_per_s_;
   state_.rendered = *cycle.output;
+  const std::size_t slot = sequence_ % kHistory;
+  state_sent_ns_[slot] = monotonic_ns();
+  answered_[slot] = false;
   if (states_out_.write(encode_device_state(state_, scene_.scene_hash))) {
     states_published_.fetch_add(1, std::memory_order_relaxed);
   }
@@ -214,6 +224,7 @@ DeviceHostStatus DeviceHostClient::status() const noexcept {
   s.peak_force_n = peak_force_n_.load(std::memory_order_relaxed);
   s.rate_limited_cycles = rate_limited_.load(std::memory_order_relaxed);
   s.scene_changes = scene_changes_.load(std::memory_order_relaxed);
+  s.round_trip_us = round_trip_us_.summary();
   return s;
 }
 

@@ -25,6 +25,7 @@
 #include "hapsim/net/topic_reader.h"
 #include "hapsim/net/topic_writer.h"
 #include "hapsim/runtime/haptic_loop.h"
+#include "hapsim/runtime/latency_histogram.h"
 
 #include <array>
 #include <atomic>
@@ -71,6 +72,9 @@ struct DeviceHostStatus {
   double peak_force_n = 0.0;  ///< over the run
   std::uint64_t rate_limited_cycles = 0;
   std::uint64_t scene_changes = 0;
+  /// Device → simulation → device: from writing a state to taking the first model that
+  /// answered it (this host's clock at both ends), microseconds.
+  LatencyPercentilesUs round_trip_us;
 };
 
 class DeviceHostClient final : public HapticClient {
@@ -113,6 +117,9 @@ class DeviceHostClient final : public HapticClient {
   std::array<double, kMaxFingers> raw_received_s_{};
   std::array<Vec3, kMaxFingers> previous_force_n_{};
   std::array<Vec3, kHistory> p_history_m_{};
+  /// monotonic_ns() when each state went out (by sequence), and whether a model answered it.
+  std::array<std::int64_t, kHistory> state_sent_ns_{};
+  std::array<bool, kHistory> answered_{};
   std::uint64_t sequence_ = 0;
   Vec3 p_previous_m_ = Vec3::Zero();
   Vec3 v_m_per_s_ = Vec3::Zero();
@@ -133,6 +140,7 @@ class DeviceHostClient final : public HapticClient {
   std::atomic<double> peak_force_n_{0.0};
   std::atomic<std::uint64_t> rate_limited_{0};
   std::atomic<std::uint64_t> scene_changes_{0};
+  LatencyHistogram round_trip_us_;
 };
 
 [[nodiscard]] const char* to_string(ForceMode mode) noexcept;

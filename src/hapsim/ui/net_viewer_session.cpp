@@ -33,7 +33,7 @@ class NetViewerSession final : public ViewerSession {
  public:
   explicit NetViewerSession(const ViewerConfig& config)
       : session_(config.session),
-        domain_(config.domain, HAPSIM_DEFAULT_DDS_CONFIG),
+        domain_(config.domain, HAPSIM_DEFAULT_DDS_CONFIG, {config.interface, config.peers}),
         participant_(config.domain, config.session),
         info_in_(participant_),
         views_in_(participant_) {

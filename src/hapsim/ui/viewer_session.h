@@ -35,6 +35,9 @@ struct ViewerConfig {
   bool connect = false;
   std::string session = "default";
   int domain = 0;
+  /// Not loopback: the interface and the unicast peers (net/dds_domain.h).
+  std::string interface;
+  std::vector<std::string> peers;
   double connect_timeout_s = 20.0;
 
   bool operator==(const ViewerConfig&) const = default;
