@@ -138,6 +138,7 @@ class NetViewerSession final : public ViewerSession {
     s.rate_hz = s.elapsed_s > 0.0 ? static_cast<double>(views_) / s.elapsed_s : 0.0;
     return s;
   }
+  bool runs_haptic_loop() const override { return false; }
   InteractiveDevice* mouse_device() override { return nullptr; }
   Vec3 probe_start_world() const override { return Vec3::Zero(); }
   const std::string& device_name() const override { return device_name_; }

@@ -570,6 +570,12 @@ class Viewer {
     }
     ImGui::Text("contacts %zu, deflection %.2f mm", r.contact_count, r.max_deflection_m * 1e3);
     ImGui::Separator();
+    if (!session_->runs_haptic_loop()) {
+      // The haptic loop runs on the device host; this viewer only receives the served views.
+      ImGui::Text("served views %.1f Hz", st.rate_hz);
+      ImGui::Text("graphics %.1f fps (draw %.1f ms)", stats_.fps_recent, stats_.draw_ms_recent);
+      return;
+    }
     ImGui::Text("haptic %.1f Hz (%s)", st.rate_hz, st.realtime_priority ? "SCHED_FIFO" : "normal");
     ImGui::Text("step cost p50 %.1f us  p99 %.1f us", st.cycle_cost_us.p50, st.cycle_cost_us.p99);
     ImGui::Text("period jitter p99 %.1f us, missed %llu", st.period_jitter_us.p99,
@@ -597,13 +603,20 @@ class Viewer {
       std::printf("viewer       %s, %s\n", session_->title().c_str(), gl_version_.c_str());
       std::printf("graphics     %zu frames in %.2f s: %.1f fps (frame p50 %.1f ms, p99 %.1f ms)\n",
                   stats_.frames, wall_s, fps, frame_p50, frame_p99);
-      std::printf(
-          "haptic       %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f "
-          "us; missed deadlines %llu; cycle cost p50 %.1f us, p99 %.1f us\n",
-          st.rate_hz, st.realtime_priority ? "SCHED_FIFO" : "normal scheduling",
-          st.period_jitter_us.p50, st.period_jitter_us.p99, st.period_jitter_us.max,
-          static_cast<unsigned long long>(st.missed_deadlines), st.cycle_cost_us.p50,
-          st.cycle_cost_us.p99);
+      if (session_->runs_haptic_loop()) {
+        std::printf(
+            "haptic       %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f "
+            "us; missed deadlines %llu; cycle cost p50 %.1f us, p99 %.1f us\n",
+            st.rate_hz, st.realtime_priority ? "SCHED_FIFO" : "normal scheduling",
+            st.period_jitter_us.p50, st.period_jitter_us.p99, st.period_jitter_us.max,
+            static_cast<unsigned long long>(st.missed_deadlines), st.cycle_cost_us.p50,
+            st.cycle_cost_us.p99);
+      } else {
+        std::printf(
+            "served       %.1f views/s from the simulation host (the haptic loop is the "
+            "device host's)\n",
+            st.rate_hz);
+      }
       std::printf(
           "forces       peak shown %.3f N (device rating %.1f N); largest deflection "
           "%.2f mm\n",

@@ -77,6 +77,9 @@ class ViewerSession {
   [[nodiscard]] virtual Box3 bounds_world() const = 0;
   [[nodiscard]] virtual const SessionReadout& readout() const = 0;
   [[nodiscard]] virtual HapticLoopStatus loop_status() const = 0;
+  /// False for a session that draws a world stepped elsewhere (view --connect): loop_status()
+  /// then counts the views received (rate_hz: views per second), not haptic cycles.
+  [[nodiscard]] virtual bool runs_haptic_loop() const { return true; }
   /// The probe's device when the config asked for the mouse (null otherwise).
   [[nodiscard]] virtual InteractiveDevice* mouse_device() = 0;
   /// Where the probe starts (in front of the scene, as seen from the default camera).
