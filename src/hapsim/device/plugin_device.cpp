@@ -209,7 +209,7 @@ PluginDevice::PluginDevice(const std::filesystem::path& path, const std::string&
   device_ = table_->open(config.c_str(), error.data(), error.size());
   if (device_ == nullptr) {
     error.back() = '\0';
-    const std::string message = one_line(error.data());
+    const std::string message = one_line(error.data(), error.size());
     throw Error(where, "open() failed: " + (message.empty() ? "(no message)" : message));
   }
   try {
