@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+"""Writes the committed seed corpus of the fuzz targets (fuzz/corpus/<target>/, docs/fuzzing.md).
+
+Small on purpose: one valid input per target and the crash-prone shapes around it (empty, short,
+long, NaN, infinities, huge values, negative and out-of-range integers, wrong keys). The layouts
+follow the harnesses' FieldReader order (fuzz/*_fuzz.cpp): a control byte, then the message's
+fields in IDL order, little-endian.
+
+    python3 fuzz/make_seed_corpus.py        # rewrites fuzz/corpus/
+"""
+import math
+import pathlib
+import shutil
+import struct
+
+HERE = pathlib.Path(__file__).resolve().parent
+CORPUS = HERE / "corpus"
+NAN = float("nan")
+INF = float("inf")
+DEVICE = 3
+SCENE = 0x68617073696D2121
+
+
+def write(target, name, data):
+    folder = CORPUS / target
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / name).write_bytes(bytes(data))
+
+
+# --- legacy_packet: raw datagrams (also read as a length-prefixed stream by the harness) ------
+def legacy(*values):
+    return struct.pack(">4i", *values)
+
+
+def legacy_seeds():
+    t = "legacy_packet"
+    write(t, "empty", b"")
+    write(t, "one_byte", b"\x10")
+    write(t, "short_15", legacy(0, 2500, 5000, 10000)[:15])
+    write(t, "valid_quarters", legacy(0, 2500, 5000, 10000))
+    write(t, "valid_full_scale", legacy(10000, 10000, 10000, 10000))
+    write(t, "over_full_scale", legacy(0, 0, 0, 10001))
+    write(t, "negative", legacy(-1, 0, 0, 0))
+    write(t, "int32_min", legacy(-(2**31), 0, 0, 0))
+    write(t, "int32_max", legacy(2**31 - 1, 0, 0, 0))
+    write(t, "long_17", legacy(1, 2, 3, 4) + b"\x00")
+    write(t, "long_64", legacy(1, 2, 3, 4) * 4)
+    # A stream: [16][valid] [5][junk] [16][out of range] [16][valid] [0][] [23][long]
+    stream = (b"\x10" + legacy(100, 200, 300, 400) + b"\x05" + b"junk!" + b"\x10" +
+              legacy(0, 99999, 0, 0) + b"\x10" + legacy(4000, 3000, 2000, 1000) + b"\x00" +
+              b"\x17" + bytes(range(23)))
+    write(t, "stream_mixed", stream)
+    # Forces as doubles for the round trip (4 forces, then the maximum).
+    write(t, "doubles_nan_inf", struct.pack("<5d", NAN, INF, -INF, -1.0, 4.0))
+    write(t, "doubles_huge_max", struct.pack("<5d", 1.0, 2.0, 1e308, 0.0, 1e308))
+    write(t, "doubles_tiny_max", struct.pack("<5d", 1e-320, 1.0, 0.0, 1e-310, 5e-324))
+
+
+# --- local_model: control, hapsim_msg_LocalModel fields, device sequence now, probe ----------
+def local_model(control=0b11, device=DEVICE, finger=0, model_seq=2, device_seq=5, scene=SCENE,
+                sim_time=0.005, x0=(0.0, 0.0, -0.002), v0=(0.0, 0.0, 0.0), f0=(0.0, 0.0, 2.0),
+                k=(800.0, 0, 0, 0, 800.0, 0, 0, 0, 800.0), b=(0.5, 0, 0, 0, 0.5, 0, 0, 0, 0.5),
+                normal=(0.0, 0.0, 1.0), radius=0.01, valid=1, now=5, probe=(0.0, 0.0, -0.003)):
+    return (struct.pack("<BHHQQQd", control, device, finger, model_seq, device_seq, scene,
+                        sim_time) +
+            struct.pack("<3d3d3d9d9d3dd", *x0, *v0, *f0, *k, *b, *normal, radius) +
+            struct.pack("<BQ3d", valid, now, *probe))
+
+
+def local_model_seeds():
+    t = "local_model"
+    full = local_model()
+    write(t, "empty", b"")
+    write(t, "control_only", b"\x03")
+    write(t, "short_half", full[: len(full) // 2])
+    write(t, "valid_press", full)
+    write(t, "valid_free_space", local_model(normal=(0.0, 0.0, 0.0), valid=0))
+    write(t, "nan_f0", local_model(f0=(0.0, NAN, 2.0)))
+    write(t, "inf_stiffness", local_model(k=(INF, 0, 0, 0, 1, 0, 0, 0, 1)))
+    write(t, "huge_x0", local_model(x0=(1e308, 0.0, 0.0)))
+    write(t, "huge_within_limits", local_model(x0=(99.0, -99.0, 99.0),
+                                               k=(1e6, 0, 0, 0, 1e6, 0, 0, 0, 1e6),
+                                               f0=(0.0, 0.0, 999.0), radius=1.0,
+                                               probe=(99.0, -99.0, 98.5)))
+    write(t, "negative_diagonal", local_model(k=(-1.0, 0, 0, 0, 800.0, 0, 0, 0, 800.0)))
+    write(t, "asymmetric_stiffness", local_model(k=(800.0, 5e5, 0, -5e5, 800.0, 0, 0, 0, 800.0)))
+    write(t, "non_unit_normal", local_model(normal=(0.0, 0.0, 2.0)))
+    write(t, "negative_radius", local_model(radius=-0.01))
+    write(t, "finger_out_of_range", local_model(finger=7))
+    write(t, "other_scene", local_model(control=0b10, scene=SCENE ^ 1))
+    write(t, "future_device_sequence", local_model(control=0, device_seq=50, now=5))
+    write(t, "stale", local_model(control=0b01, device_seq=5, now=5 + 501))
+    write(t, "nan_probe", local_model(probe=(NAN, 0.0, 0.0)))
+    write(t, "inf_probe_velocity", local_model(v0=(0.0, 0.0, 1e300), probe=(0.0, 0.0, -1e-3)))
+    write(t, "all_ones", b"\xff" * len(full))
+
+
+# --- device_state: control, hapsim_msg_DeviceState fields ------------------------------------
+def device_state(control=1, device=DEVICE, seq=10, scene=SCENE, time=0.01, p=(0.01, 0.02, 0.03),
+                 q=(1.0, 0.0, 0.0, 0.0), v=(0.0, 0.1, 0.0), fingers=(0.1, 0.2, 0.3, 0.4, 0.0),
+                 finger_count=4, buttons=1, healthy=1, force=(0.0, 0.0, 1.0),
+                 finger_force=(0.5, 0.5, 0.0, 0.0, 0.0)):
+    return (struct.pack("<BHQQd", control, device, seq, scene, time) +
+            struct.pack("<3d4d3d5d", *p, *q, *v, *fingers) +
+            struct.pack("<HIB", finger_count, buttons, healthy) +
+            struct.pack("<3d5d", *force, *finger_force))
+
+
+def device_state_seeds():
+    t = "device_state"
+    full = device_state()
+    half = math.sqrt(0.5)
+    write(t, "empty", b"")
+    write(t, "short", full[:20])
+    write(t, "valid", full)
+    write(t, "valid_rotated", device_state(q=(half, 0.0, half, 0.0)))
+    write(t, "drifted_quaternion", device_state(q=(1.0004, 0.0, 0.0, 0.0)))
+    write(t, "zero_quaternion", device_state(q=(0.0, 0.0, 0.0, 0.0)))
+    write(t, "nan_position", device_state(p=(NAN, 0.0, 0.0)))
+    write(t, "inf_velocity", device_state(v=(0.0, -INF, 0.0)))
+    write(t, "huge_position", device_state(p=(1e308, 0.0, 0.0)))
+    write(t, "too_many_fingers", device_state(finger_count=9))
+    write(t, "nan_finger_force", device_state(finger_force=(0.0, 0.0, 0.0, 0.0, NAN)))
+    write(t, "huge_rendered_force", device_state(force=(0.0, 0.0, 5e3)))
+    write(t, "other_device", device_state(control=0, device=4))
+    write(t, "all_ones", b"\xff" * len(full))
+
+
+if __name__ == "__main__":
+    if CORPUS.exists():
+        shutil.rmtree(CORPUS)
+    legacy_seeds()
+    local_model_seeds()
+    device_state_seeds()
+    for folder in sorted(CORPUS.iterdir()):
+        print(f"{folder.relative_to(HERE.parent)}: {len(list(folder.iterdir()))} seeds")
