@@ -9,6 +9,11 @@
 #include "session_json.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/device/plugin_device.h"
+#include "hapsim/net/legacy_force_udp.h"
+#if defined(HAPSIM_WITH_SPNAV)
+#include "hapsim/device/spacenav_device.h"
+#endif
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/device_host_client.h"
 #include "hapsim/net/loaned_reader.h"
@@ -50,6 +55,8 @@ struct DeviceArgs {
   std::string force_mode = "local-model";
   std::string finger_map;
   std::string json_path;
+  std::string driver_config;
+  std::string profile = "touch";
 };
 
 std::atomic<bool> g_stop{false};
@@ -143,12 +150,37 @@ HostDevice open_device(const DeviceArgs& args, const net::SceneInfoSample& info)
     d.device = std::move(d.setup->device);
     return d;
   }
+  if (const auto plugin = plugin_path_from_device_spec(args.device)) {
+    auto device = open_plugin_device(*plugin, args.driver_config);
+    d.name = "plugin " + plugin->string();
+    d.device = std::move(device);
+    return d;
+  }
+  if (args.device.rfind("legacy-glove:", 0) == 0) {
+    // An old force host in the loop: the glove renders the packets it is sent (serve
+    // --legacy-force-udp), as the knee paper's force host did.
+    auto glove = net::open_legacy_glove_udp(args.device.substr(13), device_profile("rutgers_master"),
+                                            {}, "--device legacy-glove");
+    d.name = "legacy force glove on UDP " + args.device.substr(13);
+    d.device = std::move(glove);
+    return d;
+  }
+  if (args.device == "spacemouse") {
+#if defined(HAPSIM_WITH_SPNAV)
+    d.device = std::make_unique<SpacenavDevice>(device_profile(args.profile));
+    d.name = "3D mouse (spacenavd), " + args.profile + " profile: moves, renders no force";
+    return d;
+#else
+    throw CommandError("--device spacemouse: this build has no 3D mouse support (libspnav)");
+#endif
+  }
   if (args.device == "mouse") {
     throw CommandError(
         "--device mouse: the mouse probe lives in the viewer (hapsim view); a device host "
-        "drives sim or spacemouse");
+        "drives sim, spacemouse, legacy-glove:PORT or plugin:PATH.so");
   }
-  throw CommandError("--device " + args.device + ": expected sim or spacemouse");
+  throw CommandError("--device " + args.device +
+                     ": expected sim, spacemouse, legacy-glove:PORT or plugin:PATH.so");
 }
 
 struct Silence {
@@ -320,7 +352,14 @@ void add_device_command(CLI::App& app) {
       "Device host: run a device's 1 kHz loop, rendering force from the local contact models of "
       "a simulation host (hapsim serve) in the same session");
   cmd->add_option("--device", args->device,
-                  "sim (the served scene's own script, or --scene's) or spacemouse (default sim)");
+                  "sim (the served scene's own script, or --scene's; default), spacemouse (a 3D "
+                  "mouse via spacenavd), legacy-glove:[ADDRESS:]PORT (the knee paper's force "
+                  "packets from serve --legacy-force-udp) or plugin:PATH.so (a driver, "
+                  "include/hapsim/device_driver.h)");
+  cmd->add_option("--driver-config", args->driver_config,
+                  "plugin: the string its open() gets (e.g. a serial port)");
+  cmd->add_option("--profile", args->profile,
+                  "spacemouse: the device profile whose limits apply (default touch)");
   cmd->add_option("--scene", args->scene,
                   "sim: play this scene's script instead of the served scene's");
   cmd->add_option("--data", args->data_dir,

@@ -14,6 +14,7 @@
 #include "session_json.h"
 
 #include "hapsim/net/dds_domain.h"
+#include "hapsim/net/legacy_force_udp.h"
 #include "hapsim/net/model_publisher.h"
 #include "hapsim/net/participant.h"
 #include "hapsim/net/remote_device.h"
@@ -54,6 +55,7 @@ struct ServeArgs {
   std::string data_dir;
   bool wait_for_device = false;
   double view_rate_hz = 30.0;
+  std::string legacy_force_udp;
   std::string json_path;
 };
 
@@ -176,6 +178,19 @@ void serve(const ServeArgs& args) {
   net::Participant participant(args.dds.domain, args.dds.session);
   net::RemoteDevice remote(participant, device_id, hash, *setup.device);
   net::LocalModelPublisher publisher(participant, world, remote, device_id, hash, tools);
+  std::unique_ptr<net::LegacyForceUdpSender> legacy;
+  if (!args.legacy_force_udp.empty()) {
+    const DeviceProfile& profile = *setup.profile;
+    if (profile.finger_count < 1 || !(profile.max_finger_force_n > 0.0)) {
+      throw CommandError("--legacy-force-udp: the legacy packet carries finger forces; " +
+                         args.scene + "'s device (" + profile.name + ") has no force fingers");
+    }
+    legacy = std::make_unique<net::LegacyForceUdpSender>(args.legacy_force_udp);
+    publisher.send_legacy_forces(legacy.get(), profile.max_finger_force_n);
+    std::printf("legacy       one force packet per cycle to %s:%u (4 fingers, 0-10000 = 0-%.1f N)\n",
+                legacy->destination().host.c_str(),
+                static_cast<unsigned>(legacy->destination().port), profile.max_finger_force_n);
+  }
   ServeMonitor monitor(participant, world, hash, serve_id, remote, args.view_rate_hz);
 
   // What this host serves, once: reliable and transient-local, so a late joiner gets it.
@@ -244,6 +259,12 @@ void serve(const ServeArgs& args) {
     std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
                 verdicts[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
   }
+  if (legacy) {
+    std::printf("legacy       %" PRIu64 " force packets sent, %" PRIu64
+                " not taken by the kernel, %" PRIu64 " finger values clamped to the range\n",
+                legacy->counts().sent, legacy->counts().send_failed,
+                legacy->counts().clamped_fingers);
+  }
   if (json_out) {
     nlohmann::json j =
         session_summary_json(setup.scene, world, summary, "device host or " + setup.device_name);
@@ -289,6 +310,9 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--view-rate", args->view_rate_hz,
                   "View states per second for viewers (default 30)");
   cmd->add_option("--data", args->data_dir, "The scene's data folder");
+  cmd->add_option("--legacy-force-udp", args->legacy_force_udp,
+                  "Also send the knee paper's force packet (4 fingers, 32-bit, network order) to "
+                  "HOST:PORT every cycle, for an old force host");
   cmd->add_option("--json", args->json_path,
                   "Write the summary as JSON (the keys of hapsim run --json, plus 'serve')");
   add_dds_options(cmd, args->dds);

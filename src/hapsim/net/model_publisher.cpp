@@ -24,7 +24,10 @@ void LocalModelPublisher::before_step(World& world) noexcept {
 }
 
 // haptic path
-void LocalModelPublisher::after_step(const World& world, const HapticCycle& /*cycle*/) noexcept {
+void LocalModelPublisher::after_step(const World& world, const HapticCycle& cycle) noexcept {
+  if (legacy_ != nullptr && cycle.output != nullptr) {
+    (void)legacy_->send_command(*cycle.output, legacy_finger_max_n_);  // failures are counted
+  }
   const bool driving = device_.host_driving();
   builder_.build(world.state(), ++sequence_, driving ? device_.host_state().sequence : 0, models_);
   std::uint64_t written = 0;

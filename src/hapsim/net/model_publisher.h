@@ -5,6 +5,7 @@
 // the session's LocalModel topic, answering the device state the step used. Allocation-free.
 #pragma once
 
+#include "hapsim/net/legacy_force_udp.h"
 #include "hapsim/net/local_model_codec.h"
 #include "hapsim/net/remote_device.h"
 #include "hapsim/net/topic_writer.h"
@@ -23,6 +24,13 @@ class LocalModelPublisher final : public WorldCycleObserver {
   LocalModelPublisher(const Participant& participant, const World& world, RemoteDevice& device,
                       std::uint16_t device_id, std::uint64_t scene_hash, std::size_t tools,
                       LocalModelBuildOptions options = {});
+
+  /// Also send every step's finger forces (the command after safety) as the knee paper's legacy
+  /// packet, full scale `finger_max_n` (`serve --legacy-force-udp`). Not owned.
+  void send_legacy_forces(LegacyForceUdpSender* sender, double finger_max_n) noexcept {
+    legacy_ = sender;
+    legacy_finger_max_n_ = finger_max_n;
+  }
 
   /// haptic path
   void before_step(World& world) noexcept override;
@@ -52,6 +60,8 @@ class LocalModelPublisher final : public WorldCycleObserver {
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::uint64_t> refused_{0};
   std::atomic<double> peak_rendered_n_{0.0};
+  LegacyForceUdpSender* legacy_ = nullptr;
+  double legacy_finger_max_n_ = 0.0;
 };
 
 }  // namespace hapsim::net
