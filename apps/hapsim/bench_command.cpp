@@ -1,6 +1,8 @@
 // `hapsim bench collision [--quick] [--json FILE] [--meshes ...] [--methods ...]`: point-query
 // cost of hapsim's exact BVH, sphere tree and contact-radius query against CGAL, FCL and Embree
-// on the same meshes and points (bench/collision_cases.h). Progress on stderr, the table on
+// on the same meshes and points (bench/collision_cases.h). `hapsim bench step`: the haptic step's
+// cost per contact method (bench/step_cases.h). `hapsim bench network`: raw force against the
+// local contact model over a simulated link (net/link_sweep.h). Progress on stderr, the table on
 // stdout, rows as JSON on request.
 #ifdef HAPSIM_WITH_BENCH
 
@@ -11,10 +13,14 @@
 #include "bench/step_cases.h"
 #include "hapsim/core/data_dir.h"
 #include "hapsim/core/stopwatch.h"
+#include "hapsim/net/link_sweep.h"
 
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -183,6 +189,225 @@ void run_step(const StepArgs& args) {
   }
 }
 
+struct NetworkArgs {
+  bool quick = false;
+  std::string json_path;
+  std::vector<std::string> modes;
+  std::vector<int> delays_ms;
+  std::vector<double> losses_percent;
+  std::uint64_t seed = 1;
+  double approach_ms = 300.0;
+  double blend_ms = 20.0;
+  bool no_observer = false;
+  // A `--dds` part (round trips over real Cyclone DDS on loopback) will add its options here and
+  // its rows after the in-process sweep's; the sweep itself needs no network.
+};
+
+// Seconds as milliseconds for the table; "-" when not measured (negative).
+std::string ms_or_dash(double seconds) {
+  if (seconds < 0.0) {
+    return "-";
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, "%.0f", 1e3 * seconds);
+  return text;
+}
+
+std::string format_network_table(const std::vector<net::LinkSweepRow>& rows) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%-11s %-6s %-7s %5s %4s %6s | %8s %8s %8s %7s %9s %-6s %s\n",
+                "mode", "env", "hand", "delay", "loss", "outage", "steady_N", "error_%", "ripple_N",
+                "peak_N", "energy_mJ", "stable", "zero_ms (after last model)");
+  out += line;
+  for (const net::LinkSweepRow& row : rows) {
+    const net::LinkCase& c = row.link_case;
+    const std::string zero =
+        row.is_outage() ? ms_or_dash(row.run.outage_force_zero_s) + " (" +
+                              ms_or_dash(row.run.outage_force_zero_after_last_model_s) + ")"
+                        : "-";
+    std::snprintf(line, sizeof line,
+                  "%-11s %-6s %-7s %5.0f %4.0f %6s | %8.3f %+8.2f %8.4f %7.2f %9.2f %-6s %s\n",
+                  net::force_mode_name(c.mode), net::environment_name(c.environment),
+                  net::hand_name(c.hand), 1e3 * c.delay_s, 100.0 * c.loss,
+                  row.is_outage() ? ms_or_dash(c.outage_s).c_str() : "-", row.run.steady_force_n,
+                  100.0 * row.steady_force_error, row.run.hold_ripple_rms_n, row.run.peak_force_n,
+                  1e3 * row.run.energy_generated_j, row.run.stable ? "yes" : "NO", zero.c_str());
+    out += line;
+  }
+  return out;
+}
+
+nlohmann::json null_if_negative(double value) {
+  return value < 0.0 ? nlohmann::json(nullptr) : nlohmann::json(value);
+}
+
+nlohmann::json network_rows_to_json(const std::vector<net::LinkSweepRow>& rows) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const net::LinkSweepRow& row : rows) {
+    const net::LinkCase& c = row.link_case;
+    const net::LinkRun& r = row.run;
+    out.push_back({
+        {"mode", net::force_mode_name(c.mode)},
+        {"environment", net::environment_name(c.environment)},
+        {"hand", net::hand_name(c.hand)},
+        {"delay_ms", 1e3 * c.delay_s},
+        {"jitter_max_ms", 1e3 * c.jitter_s},
+        {"loss", c.loss},
+        {"outage_ms", row.is_outage() ? 1e3 * c.outage_s : 0.0},
+        {"approach_ms", 1e3 * c.approach_s},
+        {"blend_ms", 1e3 * c.blend_s},
+        {"passivity_observer", c.mode == net::ForceMode::kLocalModel && c.passivity_observer},
+        {"seed", c.seed},
+        {"duration_s", r.duration_s},
+        {"energy_generated_j", r.energy_generated_j},
+        {"energy_out_j", r.energy_out_j},
+        {"steady_force_n", r.steady_force_n},
+        {"steady_force_error", row.steady_force_error},
+        {"reference_force_n", row.reference_force_n},
+        {"analytic_force_n", row.analytic_force_n},
+        {"hold_ripple_rms_n", r.hold_ripple_rms_n},
+        {"peak_force_n", r.peak_force_n},
+        {"hold_work_j", r.hold_work_j},
+        {"stable", r.stable},
+        {"outage_force_zero_s", null_if_negative(r.outage_force_zero_s)},
+        {"outage_force_zero_after_last_model_s",
+         null_if_negative(r.outage_force_zero_after_last_model_s)},
+        {"passivity_acted_cycles", r.observer.acted},
+        {"passivity_dissipated_j", r.observer.dissipated_j},
+        {"models_accepted", r.models_accepted},
+        {"refused_out_of_order", r.refused_out_of_order},
+        {"lost", r.lost},
+        {"reordered", r.reordered},
+    });
+  }
+  return out;
+}
+
+// The targets for the local model, checked on every local-model row; what misses is
+// printed with its figure.
+std::vector<std::string> local_model_misses(const std::vector<net::LinkSweepRow>& rows) {
+  std::vector<std::string> misses;
+  char line[256];
+  for (const net::LinkSweepRow& row : rows) {
+    const net::LinkCase& c = row.link_case;
+    if (c.mode != net::ForceMode::kLocalModel) {
+      continue;
+    }
+    std::snprintf(
+        line, sizeof line, "%s %s %.0f ms %.0f %%%s: ", net::environment_name(c.environment),
+        net::hand_name(c.hand), 1e3 * c.delay_s, 100.0 * c.loss, row.is_outage() ? " outage" : "");
+    const net::LinkRun& r = row.run;
+    std::string what;
+    if (!r.stable) {
+      what += "unstable; ";
+    }
+    char figure[96];
+    if (std::abs(row.steady_force_error) > 0.05) {
+      std::snprintf(figure, sizeof figure, "steady error %+.1f %%; ",
+                    100.0 * row.steady_force_error);
+      what += figure;
+    }
+    if (r.hold_ripple_rms_n >= 0.05) {
+      std::snprintf(figure, sizeof figure, "ripple %.3f N rms; ", r.hold_ripple_rms_n);
+      what += figure;
+    }
+    if (r.energy_generated_j >= 0.02) {
+      std::snprintf(figure, sizeof figure, "energy %.1f mJ; ", 1e3 * r.energy_generated_j);
+      what += figure;
+    }
+    if (row.is_outage() && !(r.outage_force_zero_after_last_model_s >= 0.0 &&
+                             r.outage_force_zero_after_last_model_s <= 0.150 + 1e-9)) {
+      what += "force not at zero 150 ms after the last model; ";
+    }
+    if (!what.empty()) {
+      what.resize(what.size() - 2);  // the last "; "
+      misses.push_back(line + what);
+    }
+  }
+  return misses;
+}
+
+void run_network(const NetworkArgs& args) {
+  std::unique_ptr<std::ofstream> json_out;
+  if (!args.json_path.empty()) {
+    json_out = std::make_unique<std::ofstream>(args.json_path);
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": cannot open for writing");
+    }
+  }
+  net::LinkSweepOptions options =
+      args.quick ? net::quick_link_sweep_options() : net::LinkSweepOptions{};
+  if (!args.modes.empty()) {
+    options.modes.clear();
+    for (const std::string& mode : args.modes) {
+      options.modes.push_back(mode == "raw" ? net::ForceMode::kRaw : net::ForceMode::kLocalModel);
+    }
+  }
+  if (!args.delays_ms.empty()) {
+    options.delays_ms = args.delays_ms;
+  }
+  if (!args.losses_percent.empty()) {
+    options.losses.clear();
+    for (const double percent : args.losses_percent) {
+      options.losses.push_back(percent / 100.0);
+    }
+  }
+  options.seed = args.seed;
+  options.approach_s = 1e-3 * args.approach_ms;
+  options.blend_s = 1e-3 * args.blend_ms;
+  options.passivity_observer = !args.no_observer;
+  ProgressPrinter printer;
+  options.progress = [&printer](std::string_view label, double fraction) {
+    printer(label, fraction);
+  };
+  const Stopwatch watch;
+  const std::vector<net::LinkSweepRow> rows = net::run_link_sweep(options);
+  const double elapsed_s = watch.elapsed_s();
+  std::cout << format_network_table(rows);
+  std::cout << "1-DOF press, device 0.2 kg; jitter U[0, d/2]; error: steady force against the "
+               "zero-delay run (raw: the analytic hold); ripple: rms over the last second; "
+               "energy: max over the run of the work the force did on the device plus what the "
+               "ideal environment holding that force would store; stable: ripple < 10 % of the "
+               "hold and no net work fed in over the last second; zero_ms: outage start to "
+               "|F| < 0.01 N for good ('-': raw holds its last force)\n";
+  int raw_unstable = 0;
+  int raw_rows = 0;
+  for (const net::LinkSweepRow& row : rows) {
+    if (row.link_case.mode == net::ForceMode::kRaw && row.link_case.delay_s >= 0.005 &&
+        !row.is_outage()) {
+      ++raw_rows;
+      raw_unstable += row.run.stable ? 0 : 1;
+    }
+  }
+  char summary[160];
+  std::snprintf(summary, sizeof summary, "%zu rows in %.1f s", rows.size(), elapsed_s);
+  std::cout << summary;
+  if (raw_rows > 0) {
+    std::snprintf(summary, sizeof summary, "; raw unstable in %d of %d rows from 5 ms",
+                  raw_unstable, raw_rows);
+    std::cout << summary;
+  }
+  std::cout << '\n';
+  const std::vector<std::string> misses = local_model_misses(rows);
+  if (misses.empty()) {
+    std::cout << "local model: every row stable, within 5 % of its zero-delay force, ripple < "
+                 "0.05 N rms, energy < 20 mJ, outages at zero 150 ms after the last model\n";
+  } else {
+    std::cout << "local model misses its targets in " << misses.size() << " rows:\n";
+    for (const std::string& miss : misses) {
+      std::cout << "  " << miss << '\n';
+    }
+  }
+  if (json_out) {
+    *json_out << network_rows_to_json(rows).dump(2) << '\n';
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": write failed");
+    }
+    std::cout << "wrote " << args.json_path << '\n';
+  }
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
@@ -236,6 +461,35 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   step->add_option("--json", step_args->json_path, "Write the rows as a JSON array to FILE");
   step->callback([step_args] { run_step(*step_args); });
+
+  auto network_args = std::make_shared<NetworkArgs>();
+  CLI::App* network = bench->add_subcommand(
+      "network",
+      "Raw force vs the local contact model over a simulated link: a 1-DOF press on tissue and on "
+      "a wall, delay x loss x jitter, plus a 300 ms outage (no network needed)");
+  network->add_flag("--quick", network_args->quick,
+                    "Delays 0, 20, 100 ms and losses 0, 30 % only (a few seconds)");
+  network->add_option("--json", network_args->json_path, "Write the rows as a JSON array to FILE");
+  network->add_option("--modes", network_args->modes, "raw, local-model (default: both)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"raw", "local-model"}));
+  network
+      ->add_option("--delays", network_args->delays_ms,
+                   "One-way delays, ms (default 0,5,20,50,100)")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 1000));
+  network->add_option("--losses", network_args->losses_percent, "Loss rates, % (default 0,10,30)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 100.0));
+  network->add_option("--seed", network_args->seed, "Seed of the links' draws (default 1)");
+  network->add_option(
+      "--approach", network_args->approach_ms,
+      "The hand's approach to its target, ms (minimum jerk; 0: a step; default 300)");
+  network->add_option("--blend", network_args->blend_ms,
+                      "The device's blend time for a new model, ms (default 20)");
+  network->add_flag("--no-observer", network_args->no_observer,
+                    "Run the local model without its passivity observer (for comparison)");
+  network->callback([network_args] { run_network(*network_args); });
 }
 
 }  // namespace hapsim::app

@@ -10,7 +10,7 @@
 // the whole contact has *after the tissue gives way*: the contact spring in series with the
 // tissue's own compliance. A model with the contact spring alone renders a stiffer spring than
 // the simulation settles to, and the mismatch comes back one round trip later as a delayed
-// negative stiffness: as unstable as raw force (tests/device/local_model_1dof_test.cpp).
+// negative stiffness: as unstable as raw force (tests/net/local_model_1dof_test.cpp).
 //
 // Plain fixed-size data, no network types (net/ carries it; device/ renders it).
 #pragma once
