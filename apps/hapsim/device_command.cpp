@@ -127,9 +127,10 @@ struct HostDevice {
   std::optional<RunSetup> setup;  // sim: keeps the scene's world the script was aimed on
 };
 
-HostDevice open_device(const DeviceArgs& args, const net::SceneInfoSample& info) {
+// The simulated device from the served scene (its script aims at that scene's surfaces).
+HostDevice open_sim_device(const DeviceArgs& args, const net::SceneInfoSample& info) {
   HostDevice d;
-  if (args.device == "sim") {
+  {
     SceneLoadOptions load_options;
     const std::string data_dir = !args.data_dir.empty() ? args.data_dir : info.data_dir;
     if (!data_dir.empty()) {
@@ -150,6 +151,12 @@ HostDevice open_device(const DeviceArgs& args, const net::SceneInfoSample& info)
     d.device = std::move(d.setup->device);
     return d;
   }
+}
+
+// Every other device: opened before any simulation host is looked for, so a wrong driver is
+// one line at once.
+HostDevice open_device(const DeviceArgs& args) {
+  HostDevice d;
   if (const auto plugin = plugin_path_from_device_spec(args.device)) {
     auto device = open_plugin_device(*plugin, args.driver_config);
     d.name = "plugin " + plugin->string();
@@ -159,8 +166,8 @@ HostDevice open_device(const DeviceArgs& args, const net::SceneInfoSample& info)
   if (args.device.rfind("legacy-glove:", 0) == 0) {
     // An old force host in the loop: the glove renders the packets it is sent (serve
     // --legacy-force-udp), as the knee paper's force host did.
-    auto glove = net::open_legacy_glove_udp(args.device.substr(13), device_profile("rutgers_master"),
-                                            {}, "--device legacy-glove");
+    auto glove = net::open_legacy_glove_udp(
+        args.device.substr(13), device_profile("rutgers_master"), {}, "--device legacy-glove");
     d.name = "legacy force glove on UDP " + args.device.substr(13);
     d.device = std::move(glove);
     return d;
@@ -200,6 +207,8 @@ void run_device(const DeviceArgs& args) {
       throw CommandError("--json " + args.json_path + ": cannot open for writing");
     }
   }
+  const bool sim = args.device == "sim";
+  HostDevice host = sim ? HostDevice{} : open_device(args);
   net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
   net::Participant participant(args.dds.domain, args.dds.session);
   net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
@@ -223,13 +232,18 @@ void run_device(const DeviceArgs& args) {
   }
   std::printf("serving      %s (hash %016" PRIx64 "), %u tool(s)\n", info->scene_file.c_str(),
               info->scene_hash, static_cast<unsigned>(info->tool_count));
-  HostDevice host = open_device(args, *info);
+  if (sim) {
+    host = open_sim_device(args, *info);
+  }
   const DeviceProfile& profile = host.device->profile();
 
   net::DeviceHostOptions options;
   options.device_id = static_cast<std::uint16_t>(args.device_id);
   options.mode = mode;
   options.render.max_force_n = profile.max_force_n;
+  if (profile.max_damping_n_s_per_m > 0.0) {
+    options.passivity.max_damping_n_s_per_m = profile.max_damping_n_s_per_m;
+  }
   net::DeviceHostClient client(participant, options);
   client.set_scene(served_scene(*info, finger_map));
 
@@ -301,8 +315,10 @@ void run_device(const DeviceArgs& args) {
   std::printf("ran          %" PRIu64 " cycles in %.3f s\n", st.cycles, st.elapsed_s);
   std::printf("%s", format_realtime_summary(rt).c_str());
   std::printf("rendered     peak %.3f N; %" PRIu64 " rate-limited cycles, %" PRIu64
-              " clamped by the watchdog\n",
-              s.peak_force_n, s.rate_limited_cycles, st.clamped_cycles);
+              " clamped by the watchdog; passivity controller acted in %" PRIu64
+              " cycles (%.3f mJ taken out)\n",
+              s.peak_force_n, s.rate_limited_cycles, st.clamped_cycles, s.passivity_cycles,
+              s.passivity_dissipated_j * 1e3);
   std::printf("models       %" PRIu64 " rendered (%" PRIu64 " answering the script, not us);",
               s.models_accepted, s.models_not_ours);
   for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
@@ -322,6 +338,8 @@ void run_device(const DeviceArgs& args) {
     j["realtime"] = realtime_json(rt);
     j["peak_force_n"] = s.peak_force_n;
     j["rate_limited_cycles"] = s.rate_limited_cycles;
+    j["passivity"] = {{"cycles_acted", s.passivity_cycles},
+                      {"dissipated_j", s.passivity_dissipated_j}};
     j["clamped_cycles"] = st.clamped_cycles;
     j["models_rendered"] = s.models_accepted;
     j["models_not_ours"] = s.models_not_ours;

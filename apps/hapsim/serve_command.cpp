@@ -187,9 +187,10 @@ void serve(const ServeArgs& args) {
     }
     legacy = std::make_unique<net::LegacyForceUdpSender>(args.legacy_force_udp);
     publisher.send_legacy_forces(legacy.get(), profile.max_finger_force_n);
-    std::printf("legacy       one force packet per cycle to %s:%u (4 fingers, 0-10000 = 0-%.1f N)\n",
-                legacy->destination().host.c_str(),
-                static_cast<unsigned>(legacy->destination().port), profile.max_finger_force_n);
+    std::printf(
+        "legacy       one force packet per cycle to %s:%u (4 fingers, 0-10000 = 0-%.1f N)\n",
+        legacy->destination().host.c_str(), static_cast<unsigned>(legacy->destination().port),
+        profile.max_finger_force_n);
   }
   ServeMonitor monitor(participant, world, hash, serve_id, remote, args.view_rate_hz);
 

@@ -34,6 +34,12 @@ void raise_to(std::atomic<double>& peak, double value) noexcept {
   }
 }
 
+PassivityObserverOptions passivity_options(const DeviceHostOptions& options) {
+  PassivityObserverOptions o = options.passivity;
+  o.enabled = o.enabled && options.mode == ForceMode::kLocalModel;
+  return o;
+}
+
 }  // namespace
 
 const char* to_string(ForceMode mode) noexcept {
@@ -47,7 +53,12 @@ DeviceHostClient::DeviceHostClient(const Participant& participant, const DeviceH
       gate_(options.device_id, 0, 1, options.limits),
       renderers_{LocalModelRenderer(options.render), LocalModelRenderer(options.render),
                  LocalModelRenderer(options.render), LocalModelRenderer(options.render),
-                 LocalModelRenderer(options.render)} {
+                 LocalModelRenderer(options.render)},
+      passivity_{PassivityObserver(passivity_options(options)),
+                 PassivityObserver(passivity_options(options)),
+                 PassivityObserver(passivity_options(options)),
+                 PassivityObserver(passivity_options(options)),
+                 PassivityObserver(passivity_options(options))} {
   if (!(std::isfinite(options.max_force_rate_n_per_s) && options.max_force_rate_n_per_s > 0.0)) {
     throw Error("device host", "the force rate limit must be finite and > 0 N/s");
   }
@@ -76,6 +87,9 @@ void DeviceHostClient::apply_scene() noexcept {
                          options_.limits);
   for (LocalModelRenderer& r : renderers_) {
     r = LocalModelRenderer(options_.render);  // options checked at construction: no throw
+  }
+  for (PassivityObserver& p : passivity_) {
+    p.reset();
   }
   raw_models_ = {};
   scene_changes_.fetch_add(1, std::memory_order_relaxed);
@@ -159,8 +173,18 @@ const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_
   const double max_step_n = options_.max_force_rate_n_per_s * dt_s;
   double largest_n = 0.0;
   bool limited = false;
+  std::uint64_t acted = 0;
+  double dissipated_j = 0.0;
   for (std::size_t t = 0; t < scene_.tool_count; ++t) {
     Vec3 f = tool_force(t, p_m, now_s);
+    PassivityObserver& observer = passivity_[t];
+    if (f.isZero()) {
+      observer.reset();  // free space: nothing stored, nothing owed
+    }
+    const std::uint64_t acted_before = observer.counts().acted;
+    f = observer.filter(f, v_m_per_s_, dt_s);
+    acted += observer.counts().acted - acted_before;
+    dissipated_j += observer.counts().dissipated_j;
     const Vec3 change = f - previous_force_n_[t];
     if (change.norm() > max_step_n) {
       f = previous_force_n_[t] + change * (max_step_n / change.norm());
@@ -178,6 +202,8 @@ const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_
     }
   }
   rate_limited_.fetch_add(limited ? 1 : 0, std::memory_order_relaxed);
+  passivity_cycles_.fetch_add(acted > 0 ? 1 : 0, std::memory_order_relaxed);
+  passivity_dissipated_j_.store(dissipated_j, std::memory_order_relaxed);
   force_n_.store(largest_n, std::memory_order_relaxed);
   if (took_model_) {
     force_at_last_model_n_.store(largest_n, std::memory_order_relaxed);
@@ -225,6 +251,8 @@ DeviceHostStatus DeviceHostClient::status() const noexcept {
   s.rate_limited_cycles = rate_limited_.load(std::memory_order_relaxed);
   s.scene_changes = scene_changes_.load(std::memory_order_relaxed);
   s.round_trip_us = round_trip_us_.summary();
+  s.passivity_cycles = passivity_cycles_.load(std::memory_order_relaxed);
+  s.passivity_dissipated_j = passivity_dissipated_j_.load(std::memory_order_relaxed);
   return s;
 }
 

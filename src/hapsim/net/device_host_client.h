@@ -9,8 +9,11 @@
 //   3. each tool's force is rendered where the tool is now: the model's x0 moved by how far the
 //      device moved since the state the model answered (exact for a probe; for a glove's
 //      fingertip it leaves out the finger's own flexion since then);
-//   4. the force's change per cycle is limited (a step from a bad model is felt as a ramp);
-//   5. after the device write, the state (input, velocity, what was rendered after the loop's
+//   4. a passivity observer per tool (device/passivity_observer.h, Hannaford & Ryu) adds damping
+//      once the rendered contact has given out more energy than it took in (reset in free
+//      space: a finished contact's absorbed energy licenses nothing in the next one);
+//   5. the force's change per cycle is limited (a step from a bad model is felt as a ramp);
+//   6. after the device write, the state (input, velocity, what was rendered after the loop's
 //      safety layer) goes out on the DeviceState topic.
 // `raw` mode renders the newest model's f0 as it came, as the knee paper sent raw forces: for
 // comparison only, unstable beyond a few ms of delay (docs/benchmarks.md).
@@ -19,6 +22,7 @@
 #pragma once
 
 #include "hapsim/device/local_model_renderer.h"
+#include "hapsim/device/passivity_observer.h"
 #include "hapsim/net/device_state_codec.h"
 #include "hapsim/net/local_model_gate.h"
 #include "hapsim/net/participant.h"
@@ -42,6 +46,8 @@ struct DeviceHostOptions {
   /// Largest change of a tool's force per second (N/s): 10 N in 5 ms.
   double max_force_rate_n_per_s = 2000.0;
   LocalModelLimits limits;
+  /// The last guard of the local-model mode (raw mode only observes: it is the comparison).
+  PassivityObserverOptions passivity;
 };
 
 /// What the simulation host says it runs (from its SceneInfo): set from any thread, applied by
@@ -72,6 +78,9 @@ struct DeviceHostStatus {
   double peak_force_n = 0.0;  ///< over the run
   std::uint64_t rate_limited_cycles = 0;
   std::uint64_t scene_changes = 0;
+  /// Cycles the passivity controller added damping (any tool), and the energy it took out, J.
+  std::uint64_t passivity_cycles = 0;
+  double passivity_dissipated_j = 0.0;
   /// Device → simulation → device: from writing a state to taking the first model that
   /// answered it (this host's clock at both ends), microseconds.
   LatencyPercentilesUs round_trip_us;
@@ -113,6 +122,7 @@ class DeviceHostClient final : public HapticClient {
   ServedScene scene_;
   LocalModelGate gate_;
   std::array<LocalModelRenderer, kMaxFingers> renderers_;
+  std::array<PassivityObserver, kMaxFingers> passivity_;
   std::array<LocalContactModel, kMaxFingers> raw_models_{};
   std::array<double, kMaxFingers> raw_received_s_{};
   std::array<Vec3, kMaxFingers> previous_force_n_{};
@@ -141,6 +151,8 @@ class DeviceHostClient final : public HapticClient {
   std::atomic<std::uint64_t> rate_limited_{0};
   std::atomic<std::uint64_t> scene_changes_{0};
   LatencyHistogram round_trip_us_;
+  std::atomic<std::uint64_t> passivity_cycles_{0};
+  std::atomic<double> passivity_dissipated_j_{0.0};
 };
 
 [[nodiscard]] const char* to_string(ForceMode mode) noexcept;
