@@ -26,5 +26,6 @@ void add_view_command(CLI::App& app);
 void add_kinematics_commands(CLI::App& app);
 void add_serve_command(CLI::App& app);
 void add_device_command(CLI::App& app);
+void add_watch_command(CLI::App& app);
 
 }  // namespace hapsim::app

@@ -4,6 +4,7 @@
 #include "commands.h"
 #include "progress_printer.h"
 #include "session_json.h"
+#include "snapshot_view.h"
 
 #include "hapsim/core/error.h"
 #include "hapsim/core/stopwatch.h"
@@ -136,29 +137,6 @@ class RunSnapshots final : public SnapshotSink {
   OrbitCamera camera_;
   std::size_t written_ = 0;
 };
-
-// The knee from the front (+Y) and a little medial (−X), slightly above: the patella faces the
-// camera. The teleop scene from the front-right, above: robot, ball and sheet all in view.
-constexpr double kKneeYaw = 1.95;
-constexpr double kKneePitch = 0.3;
-constexpr double kTeleopYaw = -0.9;
-constexpr double kTeleopPitch = 0.45;
-// A table-top scene (free bodies, a sheet, no rig) from the front, well above: at the knee's
-// shallow angle a sheet 5 cm over a table reads as lying behind it.
-constexpr double kTableTopPitch = 0.75;
-
-// Whether the world has bodies that move or a sheet, and no rig: a table-top scene.
-bool table_top(const World& world) {
-  if (world.rig() != nullptr) {
-    return false;
-  }
-  for (const BodyDescription& b : world.description().bodies) {
-    if (b.kind == BodyKind::kDynamic || b.deformation == BodyDeformation::kGaussianSheet) {
-      return true;
-    }
-  }
-  return false;
-}
 
 ContactMethod parse_method(const std::string& name) {
   return parse_contact_method(name).value_or(ContactMethod::kKnee);  // CLI11 has checked it
@@ -310,8 +288,7 @@ void run(const RunArgs& args) {
           o.sphere_tree_level = args.sphere_tree_level;
           return std::make_unique<WorldScene>(w, o);
         },
-        teleop ? kTeleopYaw : kKneeYaw,
-        teleop ? kTeleopPitch : (table_top(*world) ? kTableTopPitch : kKneePitch));
+        snapshot_yaw_rad(*world), snapshot_pitch_rad(*world));
   }
 
   SessionOptions options;

@@ -39,6 +39,7 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -88,7 +89,11 @@ class ServeMonitor {
         device_(device),
         period_(std::chrono::microseconds(static_cast<std::int64_t>(1e6 / view_rate_hz))) {}
 
-  void set_snapshots(TripleBuffer<WorldSnapshot>& snapshots) { snapshots_ = &snapshots; }
+  /// The loop's snapshots, or null when they go away (returns once the monitor let go of them).
+  void set_snapshots(TripleBuffer<WorldSnapshot>* snapshots) {
+    const std::lock_guard<std::mutex> lock(snapshots_mutex_);
+    snapshots_ = snapshots;
+  }
 
   void start() {
     thread_ = std::thread([this] { run(); });
@@ -119,6 +124,7 @@ class ServeMonitor {
                     t_s);
         std::fflush(stdout);
       }
+      const std::lock_guard<std::mutex> lock(snapshots_mutex_);
       if (snapshots_ != nullptr && snapshots_->update()) {
         views_ += views_out_.write(encoder_.encode(snapshots_->read_slot(), hash_, serve_id_,
                                                    device_.host_driving()))
@@ -134,6 +140,7 @@ class ServeMonitor {
   std::uint64_t serve_id_;
   const net::RemoteDevice& device_;
   std::chrono::microseconds period_;
+  std::mutex snapshots_mutex_;  // the monitor's thread and run_session's (off the haptic one)
   TripleBuffer<WorldSnapshot>* snapshots_ = nullptr;
   std::atomic<bool> done_{false};
   std::uint64_t views_ = 0;
@@ -235,7 +242,7 @@ void serve(const ServeArgs& args) {
   options.duration_s = std::isnan(args.duration_s) ? kUntilStopped_s : args.duration_s;
   options.realtime = true;
   options.observer = &publisher;
-  options.on_snapshots = [&monitor](TripleBuffer<WorldSnapshot>& s) { monitor.set_snapshots(s); };
+  options.on_snapshots = [&monitor](TripleBuffer<WorldSnapshot>* s) { monitor.set_snapshots(s); };
   options.stop = &g_stop;
   monitor.start();
   SessionSummary summary;

@@ -158,7 +158,8 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
     const hapsim_msg_BodyPose& p = m.bodies._buffer[b];
     const Quat q(p.q_wxyz[0], p.q_wxyz[1], p.q_wxyz[2], p.q_wxyz[3]);
     if (!finite3(p.p_m) || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3) {
-      why = "a body pose that is not a finite rigid motion";
+      why = "body " + std::to_string(b) +
+            "'s pose is not a finite rigid motion (|q| = " + std::to_string(q.norm()) + ")";
       return false;
     }
   }

@@ -354,7 +354,7 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
   client_options.observer = options.observer;
   WorldHapticClient client(world, client_options);
   if (options.on_snapshots) {
-    options.on_snapshots(*client.snapshots());
+    options.on_snapshots(client.snapshots());
   }
   HapticLoopOptions loop_options = options.loop;
   loop_options.period_s = options.dt_s;
@@ -377,6 +377,9 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
     }
   });
   loop.wait();
+  if (options.on_snapshots) {
+    options.on_snapshots(nullptr);  // the buffer goes with the client
+  }
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   for (std::size_t flat = 0; flat < world.flat_segment_count(); ++flat) {

@@ -44,10 +44,10 @@ struct SessionOptions {
   /// Real-time runs only: called on the haptic thread around every step (a served world
   /// publishes from it). Not owned; may be null.
   WorldCycleObserver* observer = nullptr;
-  /// Real-time runs only: also publish a viewer snapshot every cycle, and hand their buffer to
-  /// `on_snapshots` before the loop starts (on the calling thread; the buffer lives until
-  /// run_session returns).
-  std::function<void(TripleBuffer<WorldSnapshot>&)> on_snapshots;
+  /// Real-time runs only: also publish a viewer snapshot every cycle; `on_snapshots` gets their
+  /// buffer before the loop starts and null once the loop has stopped, before the buffer goes
+  /// (both calls on the calling thread: a reader elsewhere must be done with it on return).
+  std::function<void(TripleBuffer<WorldSnapshot>*)> on_snapshots;
   /// Real-time runs only: when this becomes true the run ends after the current cycle (a
   /// served world runs until stopped). Not owned; may be null.
   const std::atomic<bool>* stop = nullptr;

@@ -1,0 +1,211 @@
+// `hapsim watch`: a viewer of a served world with no window (docs/architecture.md#distribution).
+// It joins a session like `hapsim view --connect` (SceneInfo, the same scene built here, the hash
+// checked), decodes every ViewState it gets into the world's snapshot, and reports what it saw:
+// how many views and how fast, the largest force and dent. --snapshot draws, offscreen, the view
+// at the largest force it saw. For headless machines, tests, and the network benchmark's viewers.
+#include "commands.h"
+#include "dds_options.h"
+#include "snapshot_view.h"
+
+#include "hapsim/net/dds_domain.h"
+#include "hapsim/net/loaned_reader.h"
+#include "hapsim/net/participant.h"
+#include "hapsim/net/scene_hash.h"
+#include "hapsim/net/scene_info.h"
+#include "hapsim/net/view_state_codec.h"
+#include "hapsim/render/snapshot_writer.h"
+#include "hapsim/render/world_scene.h"
+#include "hapsim/scene/run_setup.h"
+#include "hapsim/scene/scene_file.h"
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cinttypes>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+
+namespace hapsim::app {
+namespace {
+
+struct WatchArgs {
+  DdsOptions dds;
+  std::string data_dir;
+  double duration_s = std::numeric_limits<double>::quiet_NaN();  // NaN: until stopped
+  double wait_s = 20.0;
+  std::string snapshot_path;
+  std::string json_path;
+};
+
+std::atomic<bool> g_stop{false};
+extern "C" void request_watch_stop(int /*signal*/) {
+  g_stop.store(true, std::memory_order_relaxed);
+}
+
+double peak_tool_force_n(const WorldSnapshot& s) {
+  double peak = 0.0;
+  for (const double f : s.tool_force_n) {
+    peak = std::max(peak, f);
+  }
+  return peak;
+}
+
+void watch(const WatchArgs& args) {
+  using Clock = std::chrono::steady_clock;
+  std::unique_ptr<std::ofstream> json_out;
+  if (!args.json_path.empty()) {
+    json_out = std::make_unique<std::ofstream>(args.json_path);
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": cannot open for writing");
+    }
+  }
+  net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
+  net::Participant participant(args.dds.domain, args.dds.session);
+  net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
+  net::LoanedReader<hapsim_msg_ViewState> views_in(participant);
+  std::signal(SIGINT, request_watch_stop);
+  std::signal(SIGTERM, request_watch_stop);
+
+  std::optional<net::SceneInfoSample> info;
+  const auto give_up = Clock::now() + std::chrono::duration<double>(args.wait_s);
+  while (!info && Clock::now() < give_up && !g_stop.load(std::memory_order_relaxed)) {
+    info_in.take([&](const hapsim_msg_SceneInfo& m) {
+      std::string why;
+      info = net::decode_scene_info(m, why);
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (!info) {
+    throw CommandError("no simulation host (hapsim serve … --session " + args.dds.session +
+                       ") answered within " + std::to_string(args.wait_s) + " s");
+  }
+  SceneLoadOptions load;
+  const std::string data_dir = !args.data_dir.empty() ? args.data_dir : info->data_dir;
+  if (!data_dir.empty()) {
+    load.data_dir = data_dir;
+  }
+  RunSetup setup = make_run_setup(parse_scene(info->scene_json, info->scene_file, load),
+                                  DeviceChoice::external());
+  const World& world = *setup.world;
+  if (net::scene_hash(world.content_hash()) != info->scene_hash) {
+    throw CommandError("the scene " + info->scene_file +
+                       " built here is not the one served: give this machine the host's data "
+                       "(--data)");
+  }
+  if (world.rig() != nullptr) {
+    throw CommandError("a teleoperation rig is not served over the network yet");
+  }
+  std::printf("watching     %s in session '%s' (%s)\n", info->scene_file.c_str(),
+              args.dds.session.c_str(), domain.config().c_str());
+  std::fflush(stdout);
+
+  WorldSnapshot snapshot = make_world_snapshot(world);
+  std::optional<WorldSnapshot> at_peak;
+  net::ViewStateDecoder decoder(world);
+  std::uint64_t views = 0;
+  std::uint64_t refused = 0;
+  std::string last_refusal;
+  double peak_force_n = 0.0;
+  double max_deflection_m = 0.0;
+  std::uint64_t first_cycle = 0;
+  std::uint64_t last_cycle = 0;
+  const auto start = Clock::now();
+  const auto end = std::isnan(args.duration_s)
+                       ? Clock::time_point::max()
+                       : start + std::chrono::duration_cast<Clock::duration>(
+                                     std::chrono::duration<double>(args.duration_s));
+  while (Clock::now() < end && !g_stop.load(std::memory_order_relaxed)) {
+    views_in.take([&](const hapsim_msg_ViewState& m) {
+      std::string why;
+      if (!decoder.decode(m, info->scene_hash, snapshot, why)) {
+        ++refused;
+        last_refusal = why;
+        return;
+      }
+      first_cycle = views == 0 ? snapshot.cycle : first_cycle;
+      last_cycle = snapshot.cycle;
+      ++views;
+      for (const double d : snapshot.deflection_m) {
+        max_deflection_m = std::max(max_deflection_m, d);
+      }
+      const double force_n = peak_tool_force_n(snapshot);
+      if (force_n > peak_force_n || !at_peak) {
+        peak_force_n = std::max(peak_force_n, force_n);
+        at_peak = snapshot;  // a copy now and then, off any haptic path
+      }
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  const double wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  const double rate_hz = wall_s > 0.0 ? static_cast<double>(views) / wall_s : 0.0;
+  std::printf("views        %" PRIu64 " in %.2f s (%.1f per second), %" PRIu64 " refused%s%s\n",
+              views, wall_s, rate_hz, refused, refused > 0 ? ": " : "", last_refusal.c_str());
+  std::printf(
+      "saw          peak tool force %.3f N, largest deflection %.2f mm, simulation "
+      "cycles %" PRIu64 " to %" PRIu64 "\n",
+      peak_force_n, max_deflection_m * 1e3, first_cycle, last_cycle);
+  if (!args.snapshot_path.empty()) {
+    if (!at_peak) {
+      throw CommandError("--snapshot: no view arrived to draw");
+    }
+    WorldScene scene(world);
+    scene.update(*at_peak);
+    SnapshotWriter writer(1280, 720);
+    const OrbitCamera camera = framed_camera(scene.rest_bounds_world(), 1280.0 / 720.0,
+                                             snapshot_yaw_rad(world), snapshot_pitch_rad(world));
+    writer.write_png(scene.scene(), camera, args.snapshot_path);
+    std::printf("snapshot     %s (the view at the largest force, %.3f N, t = %.3f s)\n",
+                args.snapshot_path.c_str(), peak_force_n, at_peak->time_s);
+  }
+  if (json_out) {
+    nlohmann::json j;
+    j["session"] = args.dds.session;
+    j["scene"] = info->scene_file;
+    j["views"] = views;
+    j["refused"] = refused;
+    j["wall_s"] = wall_s;
+    j["views_per_s"] = rate_hz;
+    j["peak_force_n"] = peak_force_n;
+    j["max_deflection_m"] = max_deflection_m;
+    j["cycles"] = {first_cycle, last_cycle};
+    *json_out << j.dump(2) << '\n';
+    std::printf("wrote        %s\n", args.json_path.c_str());
+  }
+  if (views == 0) {
+    std::printf("FAILED: no view arrived\n");
+    exit_status() = 1;
+  }
+}
+
+}  // namespace
+
+void add_watch_command(CLI::App& app) {
+  auto args = std::make_shared<WatchArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "watch",
+      "A viewer of a served world with no window: report what the simulation host serves "
+      "(hapsim serve), and draw it offscreen with --snapshot");
+  add_dds_options(cmd, args->dds);
+  cmd->add_option("--data", args->data_dir, "The scene's data folder (default: the host's)");
+  cmd->add_option("--duration", args->duration_s, "Seconds to watch (default: until stopped)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--wait", args->wait_s, "Seconds to wait for a simulation host (default 20)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--snapshot", args->snapshot_path,
+                  "Write the view at the largest force seen to FILE.png (offscreen)");
+  cmd->add_option("--json", args->json_path, "Write what was seen as JSON");
+  cmd->callback([args] {
+    (void)net::session_partition(args->dds.session);
+    watch(*args);
+  });
+}
+
+}  // namespace hapsim::app
