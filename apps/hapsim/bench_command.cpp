@@ -7,6 +7,7 @@
 #ifdef HAPSIM_WITH_BENCH
 
 #include "commands.h"
+#include "network_dds_bench.h"
 #include "progress_printer.h"
 
 #include "bench/collision_cases.h"
@@ -199,8 +200,10 @@ struct NetworkArgs {
   double approach_ms = 300.0;
   double blend_ms = 20.0;
   bool no_observer = false;
-  // A `--dds` part (round trips over real Cyclone DDS on loopback) will add its options here and
-  // its rows after the in-process sweep's; the sweep itself needs no network.
+  // --dds: instead of the in-process sweep, the palpation over real Cyclone DDS on loopback
+  // (network_dds_bench.h).
+  bool dds = false;
+  NetworkDdsArgs dds_args;
 };
 
 // Seconds as milliseconds for the table; "-" when not measured (negative).
@@ -329,6 +332,12 @@ std::vector<std::string> local_model_misses(const std::vector<net::LinkSweepRow>
 }
 
 void run_network(const NetworkArgs& args) {
+  if (args.dds) {
+    NetworkDdsArgs dds = args.dds_args;
+    dds.json_path = args.json_path;
+    run_network_dds(dds);
+    return;
+  }
   std::unique_ptr<std::ofstream> json_out;
   if (!args.json_path.empty()) {
     json_out = std::make_unique<std::ofstream>(args.json_path);
@@ -489,6 +498,21 @@ void add_bench_command(CLI::App& app) {
                       "The device's blend time for a new model, ms (default 20)");
   network->add_flag("--no-observer", network_args->no_observer,
                     "Run the local model without its passivity observer (for comparison)");
+  network->add_flag("--dds", network_args->dds,
+                    "Instead: serve, device and viewers as processes over real Cyclone DDS on "
+                    "loopback (round trip, loop timing with and without --viewers)");
+  network
+      ->add_option("--viewers", network_args->dds_args.viewers,
+                   "--dds: viewers (hapsim watch) in the second run (default 8)")
+      ->check(CLI::Range(0, 24));
+  network
+      ->add_option("--duration", network_args->dds_args.duration_s,
+                   "--dds: seconds per run (default 10.5: the knee's palpation)")
+      ->check(CLI::Range(1.0, 600.0));
+  network->add_option("--scene", network_args->dds_args.scene,
+                      "--dds: the scene served (default scenes/knee.json)");
+  network->add_option("--domain", network_args->dds_args.domain, "--dds: DDS domain id")
+      ->check(CLI::Range(0, 232));
   network->callback([network_args] { run_network(*network_args); });
 }
 

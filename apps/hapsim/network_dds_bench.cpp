@@ -1,0 +1,217 @@
+#include "network_dds_bench.h"
+
+#include "commands.h"
+
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace hapsim::app {
+namespace {
+
+// One child process of this binary, its output to `log`.
+class Child {
+ public:
+  Child(const std::vector<std::string>& args, const std::filesystem::path& log) {
+    // This very binary, whatever it was started as.
+    const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+    std::vector<std::string> words{self};
+    words.insert(words.end(), args.begin(), args.end());
+    std::vector<char*> argv;
+    for (std::string& w : words) {
+      argv.push_back(w.data());
+    }
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    const int rc = posix_spawn(&pid_, self.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (rc != 0) {
+      throw CommandError("bench network --dds: could not start " + args.front());
+    }
+  }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+  Child(Child&& other) noexcept : pid_(other.pid_) { other.pid_ = -1; }
+  Child& operator=(Child&&) = delete;
+  ~Child() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGKILL);
+      (void)wait();
+    }
+  }
+  int wait() {
+    int status = 0;
+    if (pid_ > 0 && ::waitpid(pid_, &status, 0) == pid_) {
+      pid_ = -1;
+      return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+    return -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+nlohmann::json read_json(const std::filesystem::path& path, const std::filesystem::path& log) {
+  std::ifstream in(path);
+  if (!in) {
+    std::ifstream l(log);
+    const std::string output{std::istreambuf_iterator<char>(l), std::istreambuf_iterator<char>()};
+    throw CommandError("bench network --dds: no " + path.filename().string() + "; its output:\n" +
+                       output);
+  }
+  return nlohmann::json::parse(in);
+}
+
+struct DdsRun {
+  int viewers = 0;
+  nlohmann::json serve;
+  nlohmann::json device;
+  std::vector<nlohmann::json> views;
+};
+
+DdsRun run_once(const NetworkDdsArgs& args, int viewers, const std::filesystem::path& dir) {
+  const std::string session =
+      "bench-dds-" + std::to_string(::getpid()) + "-" + std::to_string(viewers);
+  const std::vector<std::string> net{"--session", session, "--domain", std::to_string(args.domain)};
+  const auto with_net = [&net](std::vector<std::string> a) {
+    a.insert(a.end(), net.begin(), net.end());
+    return a;
+  };
+  const auto file = [&dir, viewers](const std::string& name) {
+    return dir / (name + "-" + std::to_string(viewers));
+  };
+  Child serve(with_net({"serve", args.scene, "--wait-for-device", "--duration",
+                        std::to_string(args.duration_s), "--json", file("serve.json").string()}),
+              file("serve.log"));
+  std::vector<Child> watchers;
+  for (int v = 0; v < viewers; ++v) {
+    const std::string name = "watch" + std::to_string(v);
+    watchers.emplace_back(with_net({"watch", "--duration", std::to_string(args.duration_s + 3.0),
+                                    "--json", file(name + ".json").string()}),
+                          file(name + ".log"));
+  }
+  // Viewers and serve find each other first; then the device starts the palpation.
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  Child device(with_net({"device", "--duration", std::to_string(args.duration_s + 0.5), "--json",
+                         file("device.json").string()}),
+               file("device.log"));
+  const int device_rc = device.wait();
+  const int serve_rc = serve.wait();
+  DdsRun run;
+  run.viewers = viewers;
+  if (device_rc != 0 || serve_rc != 0) {
+    throw CommandError("bench network --dds: serve exited " + std::to_string(serve_rc) +
+                       ", device " + std::to_string(device_rc) + " (logs in " + dir.string() + ")");
+  }
+  run.device = read_json(file("device.json"), file("device.log"));
+  run.serve = read_json(file("serve.json"), file("serve.log"));
+  for (int v = 0; v < viewers; ++v) {
+    const std::string name = "watch" + std::to_string(v);
+    watchers[static_cast<std::size_t>(v)].wait();
+    run.views.push_back(read_json(file(name + ".json"), file(name + ".log")));
+  }
+  return run;
+}
+
+nlohmann::json row_of(const DdsRun& r) {
+  const nlohmann::json& d = r.device;
+  const nlohmann::json& s = r.serve;
+  double min_views_per_s = -1.0;
+  double sum_views_per_s = 0.0;
+  for (const nlohmann::json& v : r.views) {
+    const double rate = v["views_per_s"].get<double>();
+    min_views_per_s = min_views_per_s < 0.0 ? rate : std::min(min_views_per_s, rate);
+    sum_views_per_s += rate;
+  }
+  return {{"viewers", r.viewers},
+          {"round_trip_us", d["round_trip_us"]},
+          {"device_rate_hz", d["realtime"]["rate_hz"]},
+          {"device_jitter_us", d["realtime"]["period_jitter_us"]},
+          {"device_missed_deadlines", d["realtime"]["missed_deadlines"]},
+          {"device_scheduling", d["realtime"]["scheduling"]},
+          {"device_peak_force_n", d["peak_force_n"]},
+          {"serve_rate_hz", s["realtime"]["rate_hz"]},
+          {"serve_step_us", s["step_us"]},
+          {"serve_missed_deadlines", s["realtime"]["missed_deadlines"]},
+          {"serve_peak_force_n", s["tools"][0]["peak_force_n"]},
+          {"views_per_s_min", r.views.empty() ? 0.0 : min_views_per_s},
+          {"views_per_s_mean",
+           r.views.empty() ? 0.0 : sum_views_per_s / static_cast<double>(r.views.size())}};
+}
+
+}  // namespace
+
+void run_network_dds(const NetworkDdsArgs& args) {
+  if (!std::filesystem::is_regular_file(args.scene)) {
+    throw CommandError("--scene " + args.scene + ": no such scene file (run from the checkout)");
+  }
+  std::unique_ptr<std::ofstream> json_out;
+  if (!args.json_path.empty()) {
+    json_out = std::make_unique<std::ofstream>(args.json_path);
+    if (!*json_out) {
+      throw CommandError("--json " + args.json_path + ": cannot open for writing");
+    }
+  }
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("hapsim_bench_dds_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  nlohmann::json rows = nlohmann::json::array();
+  for (const int viewers : {0, args.viewers}) {
+    std::printf("[dds] serve + device%s, %.1f s of %s ...\n",
+                viewers > 0 ? (" + " + std::to_string(viewers) + " viewers").c_str() : "",
+                args.duration_s, args.scene.c_str());
+    std::fflush(stdout);
+    rows.push_back(row_of(run_once(args, viewers, dir)));
+    if (args.viewers == 0) {
+      break;
+    }
+  }
+  std::printf("\nover Cyclone DDS on loopback, separate processes (serve, device, viewers)\n");
+  std::printf("%-8s %-26s %-34s %-22s %-14s\n", "viewers", "round trip us p50/p99/max",
+              "device loop Hz, jitter p99 us, missed", "serve Hz, step p99 us", "views/s min");
+  for (const nlohmann::json& r : rows) {
+    char rt[64];
+    std::snprintf(rt, sizeof rt, "%.0f / %.0f / %.0f", r["round_trip_us"]["p50"].get<double>(),
+                  r["round_trip_us"]["p99"].get<double>(), r["round_trip_us"]["max"].get<double>());
+    char dev[64];
+    std::snprintf(dev, sizeof dev, "%.2f, %.1f, %d (%s)", r["device_rate_hz"].get<double>(),
+                  r["device_jitter_us"]["p99"].get<double>(),
+                  r["device_missed_deadlines"].get<int>(),
+                  r["device_scheduling"].get<std::string>().c_str());
+    char srv[64];
+    std::snprintf(srv, sizeof srv, "%.2f, %.1f", r["serve_rate_hz"].get<double>(),
+                  r["serve_step_us"]["p99"].get<double>());
+    std::printf("%-8d %-26s %-34s %-22s %-14.1f\n", r["viewers"].get<int>(), rt, dev, srv,
+                r["views_per_s_min"].get<double>());
+  }
+  std::printf(
+      "round trip: from the device writing a state to its loop taking the first model "
+      "that answered it (both ends on the device's clock); it includes serve waiting for "
+      "its next 1 ms cycle and the device waiting for its own\n");
+  if (json_out) {
+    *json_out << rows.dump(2) << '\n';
+    std::printf("wrote %s\n", args.json_path.c_str());
+  }
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+}
+
+}  // namespace hapsim::app

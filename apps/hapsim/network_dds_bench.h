@@ -1,0 +1,21 @@
+// `hapsim bench network --dds`: the distributed palpation over real Cyclone DDS on loopback, as
+// separate processes of this binary (serve --wait-for-device, device, and N `watch` viewers),
+// once with no viewer and once with N: the device's round trip (a state to the first model
+// answering it), how its 1 kHz loop kept time, serve's loop, and the views each viewer got.
+#pragma once
+
+#include <string>
+
+namespace hapsim::app {
+
+struct NetworkDdsArgs {
+  std::string scene = "scenes/knee.json";
+  int viewers = 8;
+  double duration_s = 10.5;
+  int domain = 0;
+  std::string json_path;
+};
+
+void run_network_dds(const NetworkDdsArgs& args);
+
+}  // namespace hapsim::app
