@@ -7,6 +7,7 @@
 #include "commands.h"
 #include "dds_options.h"
 #include "session_json.h"
+#include "stop_signal.h"
 
 #include "hapsim/core/error.h"
 #include "hapsim/device/plugin_device.h"
@@ -20,6 +21,7 @@
 #include "hapsim/net/participant.h"
 #include "hapsim/net/scene_hash.h"
 #include "hapsim/net/scene_info.h"
+#include "hapsim/net/served_scene.h"
 #include "hapsim/runtime/deadline_clock.h"
 #include "hapsim/runtime/haptic_loop.h"
 #include "hapsim/scene/run_setup.h"
@@ -58,11 +60,6 @@ struct DeviceArgs {
   std::string driver_config;
   std::string profile = "touch";
 };
-
-std::atomic<bool> g_stop{false};
-extern "C" void request_device_stop(int /*signal*/) {
-  g_stop.store(true, std::memory_order_relaxed);
-}
 
 // A simulation host with no model for this long is silent (its models come every millisecond).
 constexpr std::int64_t kSilentAfter_ns = 200'000'000;
@@ -107,17 +104,13 @@ net::ServedScene served_scene(const net::SceneInfoSample& info,
 }
 
 // The newest SceneInfo that arrived (nullopt: none since the last call); a bad one is said once.
-std::optional<net::SceneInfoSample> take_scene_info(net::LoanedReader<hapsim_msg_SceneInfo>& in) {
-  std::optional<net::SceneInfoSample> newest;
-  in.take([&](const hapsim_msg_SceneInfo& m) {
-    std::string why;
-    if (auto info = net::decode_scene_info(m, why)) {
-      newest = std::move(info);
-    } else {
-      std::printf("ignored      a scene description from a simulation host: %s\n", why.c_str());
-    }
-  });
-  return newest;
+std::optional<net::SceneInfoSample> take_said(net::LoanedReader<hapsim_msg_SceneInfo>& in) {
+  std::string refused;
+  auto info = net::take_scene_info(in, &refused);
+  if (!refused.empty()) {
+    std::printf("ignored      a scene description from a simulation host: %s\n", refused.c_str());
+  }
+  return info;
 }
 
 // The device the host drives, and what to call it.
@@ -131,16 +124,20 @@ struct HostDevice {
 HostDevice open_sim_device(const DeviceArgs& args, const net::SceneInfoSample& info) {
   HostDevice d;
   {
+    if (args.scene.empty()) {
+      d.setup.emplace(net::build_served_scene(info, DeviceChoice::scene_script(), args.data_dir));
+      d.name = d.setup->device_name;
+      d.device = std::move(d.setup->device);
+      return d;
+    }
+    // Another scene's script, as asked: said once, then played.
     SceneLoadOptions load_options;
     const std::string data_dir = !args.data_dir.empty() ? args.data_dir : info.data_dir;
     if (!data_dir.empty()) {
       load_options.data_dir = data_dir;
     }
-    // The script aims at the scene's surfaces: build the scene (the served one unless --scene).
-    SceneDescription scene = args.scene.empty()
-                                 ? parse_scene(info.scene_json, info.scene_file, load_options)
-                                 : load_scene(args.scene, load_options);
-    d.setup.emplace(make_run_setup(std::move(scene), DeviceChoice::scene_script()));
+    d.setup.emplace(
+        make_run_setup(load_scene(args.scene, load_options), DeviceChoice::scene_script()));
     const std::uint64_t ours = net::scene_hash(d.setup->world->content_hash());
     if (ours != info.scene_hash) {
       std::printf("note         %s differs from the served scene (hash %016" PRIx64
@@ -212,8 +209,7 @@ void run_device(const DeviceArgs& args) {
   net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
   net::Participant participant(args.dds.domain, args.dds.session);
   net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
-  std::signal(SIGINT, request_device_stop);
-  std::signal(SIGTERM, request_device_stop);
+  const std::atomic<bool>& stop = install_stop_signals();
 
   std::printf("device host  session '%s' (partition %s, domain %d), config %s\n",
               args.dds.session.c_str(), participant.partition().c_str(), args.dds.domain,
@@ -222,8 +218,8 @@ void run_device(const DeviceArgs& args) {
               args.dds.session.c_str());
   std::fflush(stdout);
   std::optional<net::SceneInfoSample> info;
-  while (!info && !g_stop.load(std::memory_order_relaxed)) {
-    info = take_scene_info(info_in);
+  while (!info && !stop.load(std::memory_order_relaxed)) {
+    info = take_said(info_in);
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   if (!info) {
@@ -270,9 +266,9 @@ void run_device(const DeviceArgs& args) {
   std::uint64_t joins = 0;
   std::optional<Silence> pending_silence;  // silent, force not yet reported at zero
   std::vector<Silence> silences;
-  while (loop.running() && !g_stop.load(std::memory_order_relaxed)) {
+  while (loop.running() && !stop.load(std::memory_order_relaxed)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    if (auto fresh = take_scene_info(info_in); fresh && fresh->serve_id != serve_id) {
+    if (auto fresh = take_said(info_in); fresh && fresh->serve_id != serve_id) {
       serve_id = fresh->serve_id;
       std::printf("simulation   host restarted: %s (hash %016" PRIx64 ")%s\n",
                   fresh->scene_file.c_str(), fresh->scene_hash,

@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "dds_options.h"
 #include "session_json.h"
+#include "stop_signal.h"
 
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/legacy_force_udp.h"
@@ -59,11 +60,6 @@ struct ServeArgs {
   std::string legacy_force_udp;
   std::string json_path;
 };
-
-std::atomic<bool> g_stop{false};
-extern "C" void request_stop(int /*signal*/) {
-  g_stop.store(true, std::memory_order_relaxed);
-}
 
 // Longest a served run may be asked to last; "until stopped" is this long.
 constexpr double kUntilStopped_s = 365.0 * 24.0 * 3600.0;
@@ -225,13 +221,12 @@ void serve(const ServeArgs& args) {
               args.dds.session.c_str(), participant.partition().c_str(), domain.config().c_str());
   std::fflush(stdout);
 
-  std::signal(SIGINT, request_stop);
-  std::signal(SIGTERM, request_stop);
+  const std::atomic<bool>& stop = install_stop_signals();
   if (args.wait_for_device) {
     std::printf("waiting      for a device host (hapsim device --session %s)\n",
                 args.dds.session.c_str());
     std::fflush(stdout);
-    if (!remote.wait_for_host(kUntilStopped_s, &g_stop)) {
+    if (!remote.wait_for_host(kUntilStopped_s, &stop)) {
       std::printf("stopped      before a device host joined\n");
       return;
     }
@@ -243,7 +238,7 @@ void serve(const ServeArgs& args) {
   options.realtime = true;
   options.observer = &publisher;
   options.on_snapshots = [&monitor](TripleBuffer<WorldSnapshot>* s) { monitor.set_snapshots(s); };
-  options.stop = &g_stop;
+  options.stop = &stop;
   monitor.start();
   SessionSummary summary;
   try {

@@ -6,17 +6,15 @@
 #include "commands.h"
 #include "dds_options.h"
 #include "snapshot_view.h"
+#include "stop_signal.h"
 
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/loaned_reader.h"
 #include "hapsim/net/participant.h"
-#include "hapsim/net/scene_hash.h"
-#include "hapsim/net/scene_info.h"
+#include "hapsim/net/served_scene.h"
 #include "hapsim/net/view_state_codec.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
-#include "hapsim/scene/run_setup.h"
-#include "hapsim/scene/scene_file.h"
 
 #include <nlohmann/json.hpp>
 
@@ -45,11 +43,6 @@ struct WatchArgs {
   std::string json_path;
 };
 
-std::atomic<bool> g_stop{false};
-extern "C" void request_watch_stop(int /*signal*/) {
-  g_stop.store(true, std::memory_order_relaxed);
-}
-
 double peak_tool_force_n(const WorldSnapshot& s) {
   double peak = 0.0;
   for (const double f : s.tool_force_n) {
@@ -71,38 +64,15 @@ void watch(const WatchArgs& args) {
   net::Participant participant(args.dds.domain, args.dds.session);
   net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
   net::LoanedReader<hapsim_msg_ViewState> views_in(participant);
-  std::signal(SIGINT, request_watch_stop);
-  std::signal(SIGTERM, request_watch_stop);
-
-  std::optional<net::SceneInfoSample> info;
-  const auto give_up = Clock::now() + std::chrono::duration<double>(args.wait_s);
-  while (!info && Clock::now() < give_up && !g_stop.load(std::memory_order_relaxed)) {
-    info_in.take([&](const hapsim_msg_SceneInfo& m) {
-      std::string why;
-      info = net::decode_scene_info(m, why);
-    });
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
+  const std::atomic<bool>& stop = install_stop_signals();
+  const std::optional<net::SceneInfoSample> info =
+      net::wait_for_scene_info(info_in, args.wait_s, &stop);
   if (!info) {
     throw CommandError("no simulation host (hapsim serve … --session " + args.dds.session +
                        ") answered within " + std::to_string(args.wait_s) + " s");
   }
-  SceneLoadOptions load;
-  const std::string data_dir = !args.data_dir.empty() ? args.data_dir : info->data_dir;
-  if (!data_dir.empty()) {
-    load.data_dir = data_dir;
-  }
-  RunSetup setup = make_run_setup(parse_scene(info->scene_json, info->scene_file, load),
-                                  DeviceChoice::external());
+  const RunSetup setup = net::build_served_scene(*info, DeviceChoice::external(), args.data_dir);
   const World& world = *setup.world;
-  if (net::scene_hash(world.content_hash()) != info->scene_hash) {
-    throw CommandError("the scene " + info->scene_file +
-                       " built here is not the one served: give this machine the host's data "
-                       "(--data)");
-  }
-  if (world.rig() != nullptr) {
-    throw CommandError("a teleoperation rig is not served over the network yet");
-  }
   std::printf("watching     %s in session '%s' (%s)\n", info->scene_file.c_str(),
               args.dds.session.c_str(), domain.config().c_str());
   std::fflush(stdout);
@@ -122,7 +92,7 @@ void watch(const WatchArgs& args) {
                        ? Clock::time_point::max()
                        : start + std::chrono::duration_cast<Clock::duration>(
                                      std::chrono::duration<double>(args.duration_s));
-  while (Clock::now() < end && !g_stop.load(std::memory_order_relaxed)) {
+  while (Clock::now() < end && !stop.load(std::memory_order_relaxed)) {
     views_in.take([&](const hapsim_msg_ViewState& m) {
       std::string why;
       if (!decoder.decode(m, info->scene_hash, snapshot, why)) {

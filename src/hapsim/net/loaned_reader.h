@@ -20,12 +20,7 @@ class LoanedReader {
   static constexpr std::size_t kMaxTake = 4;
 
   explicit LoanedReader(const Participant& participant) {
-    Qos qos;
-    apply_profile(qos, TopicTraits<T>::kQos);
-    topic_ = create_topic<T>(participant, qos);
-    reader_ = DdsEntity(
-        check_dds(dds_create_reader(participant.subscriber(), topic_.get(), qos.get(), nullptr),
-                  std::string("creating a reader on ") + TopicTraits<T>::kName));
+    reader_ = create_reader<T>(participant, topic_);
   }
 
   /// Takes what has arrived and calls on_sample(const T&) for each sample with data, oldest

@@ -51,4 +51,16 @@ template <typename T>
                 std::string("creating topic ") + TopicTraits<T>::kName));
 }
 
+/// A reader of T's topic in `participant`'s session with the topic's QoS; `topic` receives the
+/// topic entity (the reader's owner keeps it). Throws hapsim::Error naming the topic.
+template <typename T>
+[[nodiscard]] DdsEntity create_reader(const Participant& participant, DdsEntity& topic) {
+  Qos qos;
+  apply_profile(qos, TopicTraits<T>::kQos);
+  topic = create_topic<T>(participant, qos);
+  return DdsEntity(
+      check_dds(dds_create_reader(participant.subscriber(), topic.get(), qos.get(), nullptr),
+                std::string("creating a reader on ") + TopicTraits<T>::kName));
+}
+
 }  // namespace hapsim::net

@@ -6,6 +6,7 @@
 #include "hapsim/net/participant.h"
 #include "hapsim/net/scene_hash.h"
 #include "hapsim/net/scene_info.h"
+#include "hapsim/net/served_scene.h"
 #include "hapsim/net/view_state_codec.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/scene/run_setup.h"
@@ -50,21 +51,10 @@ class NetViewerSession final : public ViewerSession {
                                    " within " + std::to_string(config.connect_timeout_s) + " s");
     }
     info_ = *info;
-    SceneLoadOptions load;
-    load.data_dir = !config.data_dir.empty() ? config.data_dir.string() : info_.data_dir;
-    scene_ = parse_scene(info_.scene_json, info_.scene_file, load);
     // Built as the host built it (the device's stiffness limits are part of the world).
-    setup_.emplace(make_run_setup(scene_, DeviceChoice::external()));
+    setup_.emplace(
+        net::build_served_scene(info_, DeviceChoice::external(), config.data_dir.string()));
     world_ = setup_->world.get();
-    const std::uint64_t ours = net::scene_hash(world_->content_hash());
-    if (ours != info_.scene_hash) {
-      throw Error("--connect", "the scene " + info_.scene_file + " built here (hash " + hex(ours) +
-                                   ") is not the one served (hash " + hex(info_.scene_hash) +
-                                   "): give this machine the host's data (--data)");
-    }
-    if (world_->rig() != nullptr) {
-      throw Error("--connect", "a teleoperation rig is not served over the network yet");
-    }
     snapshot_ = make_world_snapshot(*world_);
     decoder_.emplace(*world_);
     view_ = std::make_unique<WorldScene>(*world_);
@@ -142,7 +132,7 @@ class NetViewerSession final : public ViewerSession {
   InteractiveDevice* mouse_device() override { return nullptr; }
   Vec3 probe_start_world() const override { return Vec3::Zero(); }
   const std::string& device_name() const override { return device_name_; }
-  const std::vector<std::string>& warnings() const override { return scene_.warnings; }
+  const std::vector<std::string>& warnings() const override { return setup_->scene.warnings; }
   const std::string& title() const override { return title_; }
   void set_paused(bool /*paused*/) override {}
   void reset() override {}
@@ -160,16 +150,7 @@ class NetViewerSession final : public ViewerSession {
   bool recording() const override { return false; }
 
  private:
-  std::optional<net::SceneInfoSample> take_info() {
-    std::optional<net::SceneInfoSample> newest;
-    info_in_.take([&](const hapsim_msg_SceneInfo& m) {
-      std::string why;
-      if (auto info = net::decode_scene_info(m, why)) {
-        newest = std::move(info);
-      }
-    });
-    return newest;
-  }
+  std::optional<net::SceneInfoSample> take_info() { return net::take_scene_info(info_in_); }
 
   std::string session_;
   net::DdsDomain domain_;
@@ -177,7 +158,6 @@ class NetViewerSession final : public ViewerSession {
   net::LoanedReader<hapsim_msg_SceneInfo> info_in_;
   net::LoanedReader<hapsim_msg_ViewState> views_in_;
   net::SceneInfoSample info_;
-  SceneDescription scene_;
   std::optional<RunSetup> setup_;
   World* world_ = nullptr;
   WorldSnapshot snapshot_;
