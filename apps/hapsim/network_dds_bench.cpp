@@ -2,6 +2,14 @@
 
 #include "commands.h"
 
+#include "hapsim/net/dds_domain.h"
+#include "hapsim/net/device_state_codec.h"
+#include "hapsim/net/participant.h"
+#include "hapsim/net/served_scene.h"
+#include "hapsim/net/topic_reader.h"
+#include "hapsim/net/topic_writer.h"
+#include "hapsim/runtime/latency_histogram.h"
+
 #include <nlohmann/json.hpp>
 
 #include <fcntl.h>
@@ -9,7 +17,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <cinttypes>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -131,6 +141,81 @@ DdsRun run_once(const NetworkDdsArgs& args, int viewers, const std::filesystem::
   return run;
 }
 
+// The network's own round trip, without the device loop's wait for its next cycle: this process
+// plays the device (the served scene's script at 1 kHz), writes each state and waits on a waitset
+// for the model that answers it, timing write to arrival on its own clock. Serve steps in
+// lockstep with it (its default), so what is left is transport both ways and one step.
+LatencyPercentilesUs probe_round_trip(const NetworkDdsArgs& args,
+                                      const std::filesystem::path& dir) {
+  const std::string session = "bench-dds-probe-" + std::to_string(::getpid());
+  Child serve(
+      {"serve", args.scene, "--wait-for-device", "--duration", std::to_string(args.duration_s),
+       "--session", session, "--domain", std::to_string(args.domain)},
+      dir / "serve-probe.log");
+  net::DdsDomain domain(args.domain, HAPSIM_DEFAULT_DDS_CONFIG);
+  net::Participant participant(args.domain, session);
+  net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
+  net::TopicReader<hapsim_msg_LocalModel> models(participant);
+  net::TopicWriter<hapsim_msg_DeviceState> states(participant);
+  const std::optional<net::SceneInfoSample> info = net::wait_for_scene_info(info_in, 30.0);
+  if (!info) {
+    throw CommandError("bench network --dds: serve did not come up (" +
+                       (dir / "serve-probe.log").string() + ")");
+  }
+  RunSetup setup = net::build_served_scene(*info, DeviceChoice::scene_script());
+  const dds_entity_t waitset = dds_create_waitset(participant.participant());
+  dds_set_status_mask(models.handle(), DDS_DATA_AVAILABLE_STATUS);
+  dds_waitset_attach(waitset, models.handle(), 0);
+  // Written at 1 kHz whatever comes back, as a device does; a second thread stamps each model's
+  // arrival by the state it answers (the first one per state).
+  const auto steps = static_cast<std::uint64_t>(args.duration_s * 1000.0);
+  std::vector<std::chrono::steady_clock::time_point> sent(steps + 1);
+  std::vector<std::chrono::steady_clock::time_point> answered(steps + 1);
+  std::vector<std::atomic<bool>> done(steps + 1);
+  std::atomic<bool> writing{true};
+  std::thread receiver([&] {
+    while (writing.load(std::memory_order_relaxed)) {
+      (void)dds_waitset_wait(waitset, nullptr, 0, DDS_MSECS(5));
+      const auto now = std::chrono::steady_clock::now();
+      models.take([&](const hapsim_msg_LocalModel& m, const dds_sample_info_t&) {
+        const std::uint64_t k = m.device_sequence;
+        if (k >= 1 && k <= steps && !done[k].load(std::memory_order_acquire)) {
+          answered[k] = now;
+          done[k].store(true, std::memory_order_release);
+        }
+      });
+    }
+  });
+  auto next = std::chrono::steady_clock::now();
+  for (std::uint64_t k = 1; k <= steps; ++k) {
+    next += std::chrono::milliseconds(1);
+    std::this_thread::sleep_until(next);
+    net::DeviceStateSample state;
+    state.sequence = k;
+    state.input = setup.device->read(static_cast<double>(k - 1) * 1e-3);
+    sent[k] = std::chrono::steady_clock::now();
+    states.write(net::encode_device_state(state, info->scene_hash));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  writing.store(false, std::memory_order_relaxed);
+  receiver.join();
+  LatencyHistogram rtt_us;
+  std::uint64_t superseded = 0;
+  for (std::uint64_t k = 1; k <= steps; ++k) {
+    if (done[k].load(std::memory_order_acquire)) {
+      rtt_us.record_us(std::chrono::duration<double, std::micro>(answered[k] - sent[k]).count());
+    } else {
+      ++superseded;
+    }
+  }
+  const std::uint64_t lost = superseded;
+  dds_delete(waitset);
+  serve.wait();
+  LatencyPercentilesUs p = rtt_us.summary();
+  std::printf("[dds] probe: %" PRIu64 " states, %" PRIu64 " unanswered within 5 ms\n", steps, lost);
+  return p;
+}
+
 nlohmann::json row_of(const DdsRun& r) {
   const nlohmann::json& d = r.device;
   const nlohmann::json& s = r.serve;
@@ -184,6 +269,9 @@ void run_network_dds(const NetworkDdsArgs& args) {
       break;
     }
   }
+  std::printf("[dds] serve + this process as a probe device, %.1f s ...\n", args.duration_s);
+  std::fflush(stdout);
+  const LatencyPercentilesUs probe = probe_round_trip(args, dir);
   std::printf("\nover Cyclone DDS on loopback, separate processes (serve, device, viewers)\n");
   std::printf("%-8s %-26s %-34s %-22s %-14s\n", "viewers", "round trip us p50/p99/max",
               "device loop Hz, jitter p99 us, missed", "serve Hz, step p99 us", "views/s min");
@@ -203,11 +291,19 @@ void run_network_dds(const NetworkDdsArgs& args) {
                 r["views_per_s_min"].get<double>());
   }
   std::printf(
-      "round trip: from the device writing a state to its loop taking the first model "
-      "that answered it (both ends on the device's clock); it includes serve waiting for "
-      "its next 1 ms cycle and the device waiting for its own\n");
+      "round trip (device loop): from the device writing a state to its loop taking the first "
+      "model that answered it, both ends on the device's clock: one device cycle at least, "
+      "since the loop takes models at the start of its next cycle\n");
+  std::printf(
+      "network round trip (a state written to the model answering it arriving, serve in "
+      "lockstep): p50 %.0f us, p99 %.0f us, max %.0f us over %llu states\n",
+      probe.p50, probe.p99, probe.max, static_cast<unsigned long long>(probe.count));
   if (json_out) {
-    *json_out << rows.dump(2) << '\n';
+    nlohmann::json out;
+    out["runs"] = rows;
+    out["network_round_trip_us"] = {
+        {"p50", probe.p50}, {"p99", probe.p99}, {"max", probe.max}, {"count", probe.count}};
+    *json_out << out.dump(2) << '\n';
     std::printf("wrote %s\n", args.json_path.c_str());
   }
   std::error_code ec;

@@ -58,6 +58,7 @@ struct ServeArgs {
   bool wait_for_device = false;
   double view_rate_hz = 30.0;
   std::string legacy_force_udp;
+  double lockstep_us = 800.0;
   std::string json_path;
 };
 
@@ -180,6 +181,15 @@ void serve(const ServeArgs& args) {
   net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
   net::Participant participant(args.dds.domain, args.dds.session);
   net::RemoteDevice remote(participant, device_id, hash, *setup.device);
+  double lockstep_s = args.lockstep_us * 1e-6;
+  if (lockstep_s > 0.9 / args.rate_hz) {
+    lockstep_s = 0.9 / args.rate_hz;
+    std::printf(
+        "note         --lockstep-us %.0f is longer than the cycle allows at %.0f Hz: "
+        "%.0f us\n",
+        args.lockstep_us, args.rate_hz, lockstep_s * 1e6);
+  }
+  remote.set_lockstep_wait(lockstep_s);
   net::LocalModelPublisher publisher(participant, world, remote, device_id, hash, tools);
   std::unique_ptr<net::LegacyForceUdpSender> legacy;
   if (!args.legacy_force_udp.empty()) {
@@ -254,10 +264,10 @@ void serve(const ServeArgs& args) {
   std::printf("published    %" PRIu64 " local models (%" PRIu64 " refused by DDS), %" PRIu64
               " view states\n",
               publisher.published(), publisher.refused_writes(), monitor.views_published());
-  std::printf("device host  drove %" PRIu64
-              " of %zu cycles; peak force it rendered %.3f N; "
-              "states:",
-              remote.cycles_driven(), summary.steps, publisher.peak_rendered_force_n());
+  std::printf("device host  drove %" PRIu64 " of %zu cycles (lockstep: waited in %" PRIu64
+              ", %" PRIu64 " ran out); peak force it rendered %.3f N; states:",
+              remote.cycles_driven(), summary.steps, remote.lockstep_waits(),
+              remote.lockstep_timeouts(), publisher.peak_rendered_force_n());
   for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
     std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
                 verdicts[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
@@ -277,6 +287,8 @@ void serve(const ServeArgs& args) {
                   {"models_published", publisher.published()},
                   {"views_published", monitor.views_published()},
                   {"device_host_cycles", remote.cycles_driven()},
+                  {"lockstep_waits", remote.lockstep_waits()},
+                  {"lockstep_timeouts", remote.lockstep_timeouts()},
                   {"peak_rendered_force_n", publisher.peak_rendered_force_n()}};
     for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
       j["serve"]["device_states"][net::verdict_name(static_cast<net::SampleVerdict>(v))] =
@@ -313,6 +325,11 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--view-rate", args->view_rate_hz,
                   "View states per second for viewers (default 30)");
   cmd->add_option("--data", args->data_dir, "The scene's data folder");
+  cmd->add_option("--lockstep-us", args->lockstep_us,
+                  "While a device host drives, wait up to this long in a cycle for its next "
+                  "state and step at once (the model then reaches the device before its next "
+                  "cycle); 0: step on the deadline only (default 800)")
+      ->check(CLI::Range(0.0, 5000.0));
   cmd->add_option("--legacy-force-udp", args->legacy_force_udp,
                   "Also send the knee paper's force packet (4 fingers, 32-bit, network order) to "
                   "HOST:PORT every cycle, for an old force host");

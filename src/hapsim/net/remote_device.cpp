@@ -1,5 +1,6 @@
 #include "hapsim/net/remote_device.h"
 
+#include "hapsim/core/error.h"
 #include "hapsim/runtime/deadline_clock.h"
 
 #include <chrono>
@@ -14,23 +15,46 @@ RemoteDevice::RemoteDevice(const Participant& participant, std::uint16_t device_
       gate_(device_id, scene_hash),
       fallback_(fallback),
       host_timeout_ns_(static_cast<std::int64_t>(host_timeout_s * 1e9)),
-      host_seen_ns_(std::numeric_limits<std::int64_t>::min() / 2) {}
+      host_seen_ns_(std::numeric_limits<std::int64_t>::min() / 2) {
+  // A waitset on the state reader's data-available status, for the lockstep wait.
+  waitset_ = check_dds(dds_create_waitset(participant.participant()), "creating a waitset");
+  check_dds(dds_set_status_mask(states_.handle(), DDS_DATA_AVAILABLE_STATUS),
+            "watching device states");
+  check_dds(dds_waitset_attach(waitset_, states_.handle(), 0), "watching device states");
+}
+
+RemoteDevice::~RemoteDevice() {
+  (void)dds_delete(waitset_);
+}
 
 // haptic path
-void RemoteDevice::take_states(std::int64_t now_ns) noexcept {
+bool RemoteDevice::take_states(std::int64_t now_ns) noexcept {
+  bool accepted = false;
   states_.take([&](const hapsim_msg_DeviceState& m, const dds_sample_info_t&) {
     const SampleVerdict verdict = gate_.admit(m, host_state_);
     verdicts_[static_cast<std::size_t>(verdict)].fetch_add(1, std::memory_order_relaxed);
     if (verdict == SampleVerdict::kAccepted) {
       host_seen_ns_ = now_ns;
+      accepted = true;
     }
   });
+  return accepted;
 }
 
 // haptic path
 DeviceInput RemoteDevice::read(double time_s) noexcept {
-  const std::int64_t now_ns = monotonic_ns();
-  take_states(now_ns);
+  std::int64_t now_ns = monotonic_ns();
+  (void)take_states(now_ns);
+  if (lockstep_wait_ns_ > 0 && driving_.load(std::memory_order_relaxed)) {
+    // Step on the host's *next* state, not on one that has waited here since: the model then
+    // leaves as soon as the state arrived, and the loop's phase follows the device's.
+    lockstep_waits_.fetch_add(1, std::memory_order_relaxed);
+    const bool arrived = dds_waitset_wait(waitset_, nullptr, 0, lockstep_wait_ns_) > 0;
+    now_ns = monotonic_ns();
+    if (!arrived || !take_states(now_ns)) {
+      lockstep_timeouts_.fetch_add(1, std::memory_order_relaxed);
+    }
+  }
   const bool driving = now_ns - host_seen_ns_ < host_timeout_ns_;
   if (driving != driving_.load(std::memory_order_relaxed)) {
     driving_.store(driving, std::memory_order_relaxed);

@@ -22,6 +22,19 @@ class RemoteDevice final : public Device {
   /// `fallback` must outlive this device; its profile is this device's.
   RemoteDevice(const Participant& participant, std::uint16_t device_id, std::uint64_t scene_hash,
                Device& fallback, double host_timeout_s = 0.1);
+  ~RemoteDevice() override;
+  RemoteDevice(const RemoteDevice&) = delete;
+  RemoteDevice& operator=(const RemoteDevice&) = delete;
+  RemoteDevice(RemoteDevice&&) = delete;
+  RemoteDevice& operator=(RemoteDevice&&) = delete;
+
+  /// Lockstep with the device host: while one drives and no new state came this cycle, read()
+  /// waits up to `wait_s` for the next one (on a waitset: no spinning), so the step answers a
+  /// state as soon as it arrives instead of at the next deadline — the model then reaches the
+  /// device before its next cycle. 0 (the default): never wait. Before the loop starts.
+  void set_lockstep_wait(double wait_s) noexcept {
+    lockstep_wait_ns_ = static_cast<std::int64_t>(wait_s * 1e9);
+  }
 
   /// haptic path: takes the states that arrived, then the host's newest input (stamped
   /// `time_s`) while it drives, else the fallback's.
@@ -59,14 +72,24 @@ class RemoteDevice final : public Device {
     return cycles_driven_.load(std::memory_order_relaxed);
   }
   [[nodiscard]] VerdictCounts verdicts() const noexcept;
+  /// Cycles that waited for the host's state, and those the wait ran out.
+  [[nodiscard]] std::uint64_t lockstep_waits() const noexcept {
+    return lockstep_waits_.load(std::memory_order_relaxed);
+  }
+  [[nodiscard]] std::uint64_t lockstep_timeouts() const noexcept {
+    return lockstep_timeouts_.load(std::memory_order_relaxed);
+  }
 
  private:
-  void take_states(std::int64_t now_ns) noexcept;
+  /// True when a state was accepted.
+  bool take_states(std::int64_t now_ns) noexcept;
 
   TopicReader<hapsim_msg_DeviceState> states_;
   DeviceStateGate gate_;
   Device& fallback_;
   std::int64_t host_timeout_ns_;
+  std::int64_t lockstep_wait_ns_ = 0;
+  dds_entity_t waitset_ = 0;
   DeviceStateSample host_state_;
   std::int64_t host_seen_ns_;
   bool switched_ = false;
@@ -74,6 +97,8 @@ class RemoteDevice final : public Device {
   std::atomic<std::uint64_t> transitions_{0};
   std::atomic<std::uint64_t> cycles_driven_{0};
   std::array<std::atomic<std::uint64_t>, kSampleVerdicts> verdicts_{};
+  std::atomic<std::uint64_t> lockstep_waits_{0};
+  std::atomic<std::uint64_t> lockstep_timeouts_{0};
 };
 
 }  // namespace hapsim::net
