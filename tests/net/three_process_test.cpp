@@ -44,6 +44,11 @@ std::map<std::string, std::pair<double, double>> segments(const nlohmann::json& 
   return out;
 }
 
+// The tool's peak force in a `hapsim run --json` file.
+double a_peak_n(const std::filesystem::path& run_json) {
+  return read_json(run_json)["tools"][0]["peak_force_n"].get<double>();
+}
+
 TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
   ASSERT_TRUE(test::on_loopback_config());
   const auto one_json = hapsim::test::temp_path("one.json");
@@ -58,6 +63,12 @@ TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
       "serve " + kScene + " --wait-for-device --duration 10.5 --json " + served_json.string() + net,
       hapsim::test::temp_path("serve.log"));
   ASSERT_TRUE(serve.wait_for("waiting", 20s)) << serve.output();
+  // A headless viewer (hapsim watch) from the start, drawing the view at the largest force.
+  const auto watch_json = hapsim::test::temp_path("watch.json");
+  const auto watch_png = hapsim::test::temp_path("watch.png");
+  BackgroundHapsim watch("watch --duration 11.5 --json " + watch_json.string() + " --snapshot " +
+                             watch_png.string() + net,
+                         hapsim::test::temp_path("watch.log"));
   BackgroundHapsim device("device --duration 11" + net + " --json " + device_json.string(),
                           hapsim::test::temp_path("device.log"));
   // The third process: a viewer that joins after the palpation started, under a virtual display.
@@ -89,6 +100,15 @@ TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
   EXPECT_EQ(device.wait(), 0) << device.output();
   if (viewer.joinable()) {
     viewer.join();
+  }
+  EXPECT_EQ(watch.wait(), 0) << watch.output();
+  {
+    const nlohmann::json w = read_json(watch_json);
+    EXPECT_GT(w["views"].get<int>(), 200);  // ~30 per second
+    EXPECT_EQ(w["refused"].get<int>(), 0);
+    EXPECT_NEAR(w["peak_force_n"].get<double>(), a_peak_n(one_json), 0.05 * a_peak_n(one_json));
+    EXPECT_GT(w["max_deflection_m"].get<double>(), 0.005);
+    EXPECT_TRUE(std::filesystem::exists(watch_png));
   }
   std::printf("%s\n%s\n%s\n", serve.output().c_str(), device.output().c_str(),
               viewed.output.c_str());

@@ -3,6 +3,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/runtime/deadline_clock.h"
 
+#include <algorithm>
 #include <chrono>
 #include <limits>
 #include <thread>
@@ -44,14 +45,16 @@ bool RemoteDevice::take_states(std::int64_t now_ns) noexcept {
 // haptic path
 DeviceInput RemoteDevice::read(double time_s) noexcept {
   std::int64_t now_ns = monotonic_ns();
-  (void)take_states(now_ns);
+  bool fresh = take_states(now_ns);
   if (lockstep_wait_ns_ > 0 && driving_.load(std::memory_order_relaxed)) {
     // Step on the host's *next* state, not on one that has waited here since: the model then
     // leaves as soon as the state arrived, and the loop's phase follows the device's.
     lockstep_waits_.fetch_add(1, std::memory_order_relaxed);
     const bool arrived = dds_waitset_wait(waitset_, nullptr, 0, lockstep_wait_ns_) > 0;
     now_ns = monotonic_ns();
-    if (!arrived || !take_states(now_ns)) {
+    if (arrived && take_states(now_ns)) {
+      fresh = true;
+    } else {
       lockstep_timeouts_.fetch_add(1, std::memory_order_relaxed);
     }
   }
@@ -67,9 +70,18 @@ DeviceInput RemoteDevice::read(double time_s) noexcept {
   }
   // The fallback is read every cycle, so a script keeps its own time while a host drives.
   DeviceInput input = fallback_.read(time_s);
+  const double dt_s = std::clamp(time_s - previous_time_s_, 0.0, 0.01);
+  previous_time_s_ = time_s;
   if (driving) {
     input = host_state_.input;
     input.time_s = time_s;
+    // A cycle without a new state (late, lost) moves the device on at its reported velocity
+    // instead of holding it: held, then caught up, it would jump two cycles at once, and the
+    // world's velocity (and damping force) with it. A few cycles at most, then it holds.
+    missed_states_ = fresh ? 0 : std::min(missed_states_ + 1, kMaxDeadReckoned);
+    if (missed_states_ > 0 && host_state_.v_world_m_per_s.allFinite()) {
+      input.p_world += host_state_.v_world_m_per_s * (dt_s * missed_states_);
+    }
     cycles_driven_.fetch_add(1, std::memory_order_relaxed);
   }
   return input;

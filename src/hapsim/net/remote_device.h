@@ -89,6 +89,10 @@ class RemoteDevice final : public Device {
   Device& fallback_;
   std::int64_t host_timeout_ns_;
   std::int64_t lockstep_wait_ns_ = 0;
+  /// Cycles in a row without a new host state, dead-reckoned up to kMaxDeadReckoned.
+  static constexpr int kMaxDeadReckoned = 3;
+  int missed_states_ = 0;
+  double previous_time_s_ = 0.0;
   dds_entity_t waitset_ = 0;
   DeviceStateSample host_state_;
   std::int64_t host_seen_ns_;

@@ -1,0 +1,136 @@
+// A running world's view over the network (net/view_state_codec.h): what a viewer decodes is what
+// the simulation host had — tools, contacts, body poses and every deformed vertex, to float
+// precision — whether it joined at the start or late; a vertex back at rest is put back; a sample
+// that does not fit the viewer's world is refused whole, naming why, and changes nothing.
+#include "hapsim/net/view_state_codec.h"
+#include "hapsim/scene/run_setup.h"
+#include "hapsim/scene/scene_file.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+namespace hapsim::net {
+namespace {
+
+const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee.json";
+constexpr std::uint64_t kHash = 0x1234;
+
+struct Served {
+  RunSetup setup = make_run_setup(load_scene(kScene), DeviceChoice::scene_script());
+  World& world = *setup.world;
+  double t_s = 0.0;
+};
+
+// Steps the served world to `t_s` with its script.
+void run_to(Served& s, double t_s) {
+  const double dt = 0.001;
+  for (; s.t_s < t_s; s.t_s += dt) {
+    (void)s.world.step(s.setup.device->read(s.t_s), dt);
+  }
+}
+
+// What the haptic client publishes of the world now (runtime/world_haptic_client.cpp): the
+// surfaces, and the tools and contacts of the last step.
+WorldSnapshot snapshot_of(const World& world) {
+  WorldSnapshot s = make_world_snapshot(world);
+  const WorldState& state = world.state();
+  for (std::size_t t = 0; t < s.tools.size(); ++t) {
+    s.tools[t] = state.tool_states[t];
+    s.tool_force_n[t] = state.tool_states[t].force_world_n.norm();
+  }
+  s.contact_count = std::min(state.contact_count, s.contacts.size());
+  std::copy_n(state.contacts.begin(), s.contact_count, s.contacts.begin());
+  return s;
+}
+
+float max_vertex_error_m(const WorldSnapshot& a, const WorldSnapshot& b) {
+  float worst = 0.0f;
+  for (std::size_t flat = 0; flat < a.positions_body.size(); ++flat) {
+    for (std::size_t i = 0; i < a.positions_body[flat].size(); ++i) {
+      worst = std::max(worst, std::abs(a.positions_body[flat][i] - b.positions_body[flat][i]));
+    }
+  }
+  return worst;
+}
+
+TEST(ViewStateCodec, ALateViewerDrawsTheCurrentDentAndItsRelease) {
+  Served host;
+  ViewStateEncoder encoder(host.world);  // at rest
+  Served viewer_side;                    // the viewer's own build of the scene
+  WorldSnapshot seen = make_world_snapshot(viewer_side.world);
+  ViewStateDecoder decoder(viewer_side.world);
+  std::string why;
+
+  run_to(host, 3.27);  // the patella press: the skin is dented ~10 mm
+  WorldSnapshot truth = snapshot_of(host.world);
+  const hapsim_msg_ViewState& m = encoder.encode(truth, kHash, 7, true);
+  EXPECT_GT(m.offsets._length, 10u);
+  EXPECT_LT(m.offsets._length, 5000u);  // only what moved, not all 14 394 vertices
+  ASSERT_TRUE(decoder.decode(m, kHash, seen, why)) << why;
+  EXPECT_LE(max_vertex_error_m(seen, truth), 1e-6f);
+  ASSERT_GT(truth.contact_count, 0u);
+  ASSERT_EQ(seen.contact_count, truth.contact_count);
+  EXPECT_EQ(seen.contacts[0].segment, truth.contacts[0].segment);
+  EXPECT_NEAR(seen.contacts[0].force_n, truth.contacts[0].force_n, 1e-12);
+  EXPECT_GT(truth.tool_force_n[0], 5.0);
+  EXPECT_NEAR(seen.tool_force_n[0], truth.tool_force_n[0], 1e-12);
+  EXPECT_NEAR((seen.tools[0].p_world - truth.tools[0].p_world).norm(), 0.0, 1e-12);
+  double deepest = 0.0;
+  for (const double d : seen.deflection_m) {
+    deepest = std::max(deepest, d);
+  }
+  EXPECT_GT(deepest, 0.001);
+
+  // The finger lifts off: the vertices go back to rest in the viewer too.
+  run_to(host, 3.9);
+  truth = snapshot_of(host.world);
+  ASSERT_TRUE(decoder.decode(encoder.encode(truth, kHash, 7, true), kHash, seen, why)) << why;
+  EXPECT_LE(max_vertex_error_m(seen, truth), 1e-6f);
+}
+
+TEST(ViewStateCodec, RefusesWhatDoesNotFitTheWorldAndChangesNothing) {
+  Served host;
+  ViewStateEncoder encoder(host.world);
+  run_to(host, 3.27);
+  const WorldSnapshot truth = snapshot_of(host.world);
+  WorldSnapshot seen = make_world_snapshot(host.world);
+  const WorldSnapshot before = seen;
+  ViewStateDecoder decoder(host.world);
+  std::string why;
+
+  hapsim_msg_ViewState m = encoder.encode(truth, kHash, 7, true);
+  EXPECT_FALSE(decoder.decode(m, kHash + 1, seen, why));
+  EXPECT_NE(why.find("another scene"), std::string::npos);
+
+  ASSERT_GT(m.offsets._length, 0u);
+  const hapsim_msg_VertexOffset saved = m.offsets._buffer[0];
+  m.offsets._buffer[0].vertex = 1u << 30;
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  EXPECT_NE(why.find("vertex offset"), std::string::npos) << why;
+  m.offsets._buffer[0] = saved;
+  m.offsets._buffer[0].offset_m[1] = std::numeric_limits<float>::quiet_NaN();
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  m.offsets._buffer[0] = saved;
+
+  m.bodies._buffer[0].q_wxyz[0] = 3.0;  // not a rotation
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  EXPECT_NE(why.find("rigid motion"), std::string::npos) << why;
+  m = encoder.encode(truth, kHash, 7, true);
+  ASSERT_GT(m.contacts._length, 0u);
+  m.contacts._buffer[0].segment = 99;
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  EXPECT_NE(why.find("segment the scene does not have"), std::string::npos) << why;
+  m = encoder.encode(truth, kHash, 7, true);
+  m.tool_count = 3;
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+
+  // Nothing of the refused samples reached the snapshot.
+  EXPECT_EQ(max_vertex_error_m(seen, before), 0.0f);
+  EXPECT_EQ(seen.contact_count, before.contact_count);
+}
+
+}  // namespace
+}  // namespace hapsim::net
