@@ -210,7 +210,7 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
     s.body_poses_world[b] = X;
   }
   for (std::uint32_t i = 0; i < m.deflection_m._length; ++i) {
-    s.deflection_m[i] = m.deflection_m._buffer[i];
+    s.deflection_m[i] = static_cast<double>(m.deflection_m._buffer[i]);
   }
   // Put back what moved last time, then apply this message's offsets.
   std::vector<bool>& changed = changed_;
@@ -222,7 +222,8 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
       xyz = rest;
     }
     for (const std::uint32_t v : moved_[flat]) {
-      std::copy_n(rest.begin() + 3 * v, 3, xyz.begin() + 3 * v);
+      const auto first = static_cast<std::ptrdiff_t>(3 * static_cast<std::size_t>(v));
+      std::copy_n(rest.begin() + first, 3, xyz.begin() + first);
     }
     changed[flat] = !moved_[flat].empty();
     moved_[flat].clear();
@@ -231,8 +232,9 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
     const hapsim_msg_VertexOffset& o = m.offsets._buffer[i];
     std::vector<float>& xyz = s.positions_body[o.segment];
     const std::vector<float>& rest = rest_body_[o.segment];
+    const std::size_t first = 3 * static_cast<std::size_t>(o.vertex);
     for (std::size_t k = 0; k < 3; ++k) {
-      xyz[3 * o.vertex + k] = rest[3 * o.vertex + k] + o.offset_m[k];
+      xyz[first + k] = rest[first + k] + o.offset_m[k];
     }
     moved_[o.segment].push_back(o.vertex);
     changed[o.segment] = true;
