@@ -28,8 +28,6 @@
 #include <thread>
 #include <vector>
 
-extern char** environ;
-
 namespace hapsim::app {
 namespace {
 
@@ -42,6 +40,7 @@ class Child {
     std::vector<std::string> words{self};
     words.insert(words.end(), args.begin(), args.end());
     std::vector<char*> argv;
+    argv.reserve(words.size() + 1);
     for (std::string& w : words) {
       argv.push_back(w.data());
     }
