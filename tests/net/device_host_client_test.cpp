@@ -1,0 +1,139 @@
+// The device host's cycle (net/device_host_client.h) against a simulation side played by the test
+// over real DDS on loopback: the client publishes its states; a model answering one of them is
+// rendered at the device's own position, F = f0 + K·(x0 − x) moved by how far the device went
+// since (against the analytic value), after the blend-in; a model answering the simulation's own
+// script (device sequence 0) is never rendered; and the cycle allocates nothing.
+#include "hapsim/net/device_host_client.h"
+#include "hapsim/net/device_state_gate.h"
+#include "hapsim/net/local_model_codec.h"
+
+#include "net/net_test_support.h"
+#include "support/allocation_counter.h"
+
+#include <chrono>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+namespace hapsim::net {
+namespace {
+
+constexpr dds_domainid_t kDomain = 79;
+constexpr std::uint64_t kHash = 0xfeedULL;
+
+class DeviceHostClientTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(test::on_loopback_config());
+    ServedScene scene;
+    scene.scene_hash = kHash;
+    scene.serve_id = 1;
+    scene.tool_count = 1;
+    client.set_scene(scene);
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while ((models_out.matched_readers() == 0 || states_in.matched_writers() == 0) &&
+           std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+
+  // One loop cycle at device position p (the loop's read, step and write, without the thread).
+  const DeviceCommand& cycle(const Vec3& p_m) {
+    input.p_world = p_m;
+    const DeviceCommand& command = client.step(input, 0.001);
+    HapticCycle c;
+    c.input = &input;
+    c.output = &command;
+    client.after_cycle(c);
+    return command;
+  }
+
+  // The newest state the client published, as the simulation receives it.
+  DeviceStateSample newest_state() {
+    DeviceStateSample newest;
+    for (int tries = 0; tries < 200 && newest.sequence == 0; ++tries) {
+      states_in.take([&](const hapsim_msg_DeviceState& m, const dds_sample_info_t&) {
+        newest = decode_device_state(m);
+      });
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return newest;
+  }
+
+  // A wall below z = 0 answering the state `answered`: the device at x0, pressing 2 N, 1000 N/m.
+  LocalContactModel wall_model(std::uint64_t sequence, std::uint64_t answered, const Vec3& x0) {
+    LocalContactModel m;
+    m.x0_world_m = x0;
+    m.f0_world_n = Vec3(0.0, 0.0, 2.0);
+    m.stiffness_n_per_m = 1000.0 * Vec3::UnitZ() * Vec3::UnitZ().transpose();
+    m.normal_world = Vec3::UnitZ();
+    m.validity_radius_m = 0.01;
+    m.sequence = sequence;
+    m.device_sequence = answered;
+    m.valid = true;
+    return m;
+  }
+
+  Participant participant{kDomain, "device-host-client"};
+  DeviceHostClient client{participant, DeviceHostOptions{}};
+  TopicWriter<hapsim_msg_LocalModel> models_out{participant};
+  TopicReader<hapsim_msg_DeviceState> states_in{participant};
+  DeviceInput input;
+};
+
+TEST_F(DeviceHostClientTest, RendersTheModelAtTheDevicesOwnPositionAndOnlyOurs) {
+  const Vec3 x0(0.0, 0.0, -0.001);
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_EQ(cycle(x0).force_world_n, Vec3::Zero());  // no model yet
+  }
+  const DeviceStateSample state = newest_state();
+  ASSERT_GT(state.sequence, 0u);
+  EXPECT_EQ(state.input.p_world, x0);
+
+  // The simulation's own script: never rendered.
+  models_out.write(encode_local_model(wall_model(1, 0, x0), {0, 0}, kHash));
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  for (int k = 0; k < 30; ++k) {
+    EXPECT_EQ(cycle(x0).force_world_n, Vec3::Zero());
+  }
+  EXPECT_EQ(client.status().models_not_ours, 1u);
+
+  // A model answering our state: blended in over 20 ms, then f0 + K·(x0 − x) where the device
+  // is. The device has moved 1 mm further in since that state: 2 N + 1000 N/m × 1 mm = 3 N.
+  models_out.write(encode_local_model(wall_model(2, state.sequence, x0), {0, 0}, kHash));
+  const Vec3 deeper = x0 - Vec3(0.0, 0.0, 0.001);
+  Vec3 f = Vec3::Zero();
+  for (int k = 0; k < 60; ++k) {
+    f = cycle(deeper).force_world_n;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_NEAR(f.z(), 3.0, 1e-9);
+  EXPECT_NEAR(f.head<2>().norm(), 0.0, 1e-12);
+  const DeviceHostStatus s = client.status();
+  EXPECT_EQ(s.models_accepted, 1u);
+  EXPECT_GT(s.round_trip_us.count, 0u);
+  EXPECT_NEAR(s.peak_force_n, 3.0, 1e-9);
+}
+
+TEST_F(DeviceHostClientTest, ACycleAllocatesNothing) {
+  const Vec3 x0(0.0, 0.0, -0.001);
+  for (int k = 0; k < 5; ++k) {
+    (void)cycle(x0);
+  }
+  const DeviceStateSample state = newest_state();
+  models_out.write(encode_local_model(wall_model(1, state.sequence, x0), {0, 0}, kHash));
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  for (int k = 0; k < 30; ++k) {  // blended in (20 ms of the host's clock)
+    (void)cycle(x0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const long before = hapsim::test::thread_allocation_count();
+  for (int k = 0; k < 500; ++k) {
+    (void)cycle(x0 + Vec3(0.0, 0.0, -1e-6 * k));
+  }
+  EXPECT_EQ(hapsim::test::thread_allocation_count() - before, 0);
+  EXPECT_GT(client.status().peak_force_n, 1.0);  // it rendered the model meanwhile
+}
+
+}  // namespace
+}  // namespace hapsim::net
