@@ -12,6 +12,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/device/plugin_device.h"
 #include "hapsim/net/legacy_force_udp.h"
+#include "hapsim/net/link_shim_spec.h"
 #if defined(HAPSIM_WITH_SPNAV)
 #include "hapsim/device/spacenav_device.h"
 #endif
@@ -59,6 +60,7 @@ struct DeviceArgs {
   std::string json_path;
   std::string driver_config;
   std::string profile = "touch";
+  std::string link_shim;
 };
 
 // A simulation host with no model for this long is silent (its models come every millisecond).
@@ -197,6 +199,9 @@ void run_device(const DeviceArgs& args) {
   const net::ForceMode mode =
       args.force_mode == "raw" ? net::ForceMode::kRaw : net::ForceMode::kLocalModel;
   const std::array<int, kMaxFingers> finger_map = parse_finger_map(args.finger_map);
+  const std::optional<net::LinkShimOptions> link =
+      args.link_shim.empty() ? std::nullopt
+                             : std::optional(net::parse_link_shim(args.link_shim, "--link-shim"));
   std::unique_ptr<std::ofstream> json_out;
   if (!args.json_path.empty()) {
     json_out = std::make_unique<std::ofstream>(args.json_path);
@@ -237,6 +242,10 @@ void run_device(const DeviceArgs& args) {
   options.device_id = static_cast<std::uint16_t>(args.device_id);
   options.mode = mode;
   options.render.max_force_n = profile.max_force_n;
+  if (link) {
+    options.link = link;
+    std::printf("link shim    on the local models received: %s\n", args.link_shim.c_str());
+  }
   if (profile.max_damping_n_s_per_m > 0.0) {
     options.passivity.max_damping_n_s_per_m = profile.max_damping_n_s_per_m;
   }
@@ -389,6 +398,10 @@ void add_device_command(CLI::App& app) {
       ->check(CLI::IsMember({"local-model", "raw"}));
   cmd->add_option("--finger-map", args->finger_map,
                   "Which device finger each scene finger drives, e.g. 0:2,1:3");
+  cmd->add_option("--link-shim", args->link_shim,
+                  "Pass the local models received through a simulated link: "
+                  "delay_ms=D,jitter_ms=J,loss=L,outage_at_s=T,outage_s=S,seed=N (no root, no "
+                  "netem)");
   cmd->add_option("--json", args->json_path, "Write the summary as JSON");
   add_dds_options(cmd, args->dds);
   cmd->callback([args] {

@@ -16,6 +16,7 @@
 
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/legacy_force_udp.h"
+#include "hapsim/net/link_shim_spec.h"
 #include "hapsim/net/model_publisher.h"
 #include "hapsim/net/participant.h"
 #include "hapsim/net/remote_device.h"
@@ -41,6 +42,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -59,6 +61,7 @@ struct ServeArgs {
   double view_rate_hz = 30.0;
   std::string legacy_force_udp;
   double lockstep_us = 800.0;
+  std::string link_shim;
   std::string json_path;
 };
 
@@ -152,6 +155,9 @@ void serve(const ServeArgs& args) {
     throw CommandError("--view-rate " + std::to_string(args.view_rate_hz) +
                        ": expected 1 to 240 Hz");
   }
+  const std::optional<net::LinkShimOptions> link =
+      args.link_shim.empty() ? std::nullopt
+                             : std::optional(net::parse_link_shim(args.link_shim, "--link-shim"));
   std::unique_ptr<std::ofstream> json_out;
   if (!args.json_path.empty()) {
     json_out = std::make_unique<std::ofstream>(args.json_path);
@@ -188,6 +194,16 @@ void serve(const ServeArgs& args) {
         "note         --lockstep-us %.0f is longer than the cycle allows at %.0f Hz: "
         "%.0f us\n",
         args.lockstep_us, args.rate_hz, lockstep_s * 1e6);
+  }
+  if (link) {
+    remote.set_link_shim(*link);
+    if (lockstep_s > 0.0) {
+      lockstep_s = 0.0;
+      std::printf(
+          "note         --link-shim: no lockstep (the states it delays are the ones "
+          "lockstep would wait for)\n");
+    }
+    std::printf("link shim    on the device states received: %s\n", args.link_shim.c_str());
   }
   remote.set_lockstep_wait(lockstep_s);
   net::LocalModelPublisher publisher(participant, world, remote, device_id, hash, tools);
@@ -272,6 +288,9 @@ void serve(const ServeArgs& args) {
     std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
                 verdicts[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
   }
+  if (!args.link_shim.empty()) {
+    std::printf("link shim    lost %" PRIu64 " device states\n", remote.link_lost());
+  }
   if (legacy) {
     std::printf("legacy       %" PRIu64 " force packets sent, %" PRIu64
                 " not taken by the kernel, %" PRIu64 " finger values clamped to the range\n",
@@ -330,6 +349,10 @@ void add_serve_command(CLI::App& app) {
                   "state and step at once (the model then reaches the device before its next "
                   "cycle); 0: step on the deadline only (default 800)")
       ->check(CLI::Range(0.0, 5000.0));
+  cmd->add_option("--link-shim", args->link_shim,
+                  "Pass the device states received through a simulated link: "
+                  "delay_ms=D,jitter_ms=J,loss=L,outage_at_s=T,outage_s=S,seed=N (no root, no "
+                  "netem)");
   cmd->add_option("--legacy-force-udp", args->legacy_force_udp,
                   "Also send the knee paper's force packet (4 fingers, 32-bit, network order) to "
                   "HOST:PORT every cycle, for an old force host");

@@ -28,6 +28,13 @@ TEST(NetworkOptions, BadChoicesAreOneLineAndExitTwo) {
     EXPECT_EQ(peer_alone.exit_code, 2) << peer_alone.output;
     EXPECT_NE(peer_alone.output.find("--peer: give --interface too"), std::string::npos);
   }
+  // A link shim is checked before anything starts.
+  for (const std::string& command : {std::string("serve ") + kScene, std::string("device")}) {
+    const auto bad_shim = hapsim::test::run_hapsim(command + " --link-shim delay_ms=20,latency=3");
+    EXPECT_EQ(bad_shim.exit_code, 2) << bad_shim.output;
+    EXPECT_NE(bad_shim.output.find("--link-shim: unknown key 'latency'"), std::string::npos)
+        << bad_shim.output;
+  }
   // ctest sets CYCLONEDDS_URI: a second choice on the command line is refused, not merged.
   const auto both = hapsim::test::run_hapsim("serve " + kScene + " --interface lo --duration 0.1");
   EXPECT_EQ(both.exit_code, 2) << both.output;

@@ -62,6 +62,10 @@ DeviceHostClient::DeviceHostClient(const Participant& participant, const DeviceH
   if (!(std::isfinite(options.max_force_rate_n_per_s) && options.max_force_rate_n_per_s > 0.0)) {
     throw Error("device host", "the force rate limit must be finite and > 0 N/s");
   }
+  if (options.link) {
+    link_ = std::make_unique<LinkShim<hapsim_msg_LocalModel, kLinkCapacity>>(*options.link);
+    link_epoch_s_ = static_cast<double>(monotonic_ns()) * 1e-9;
+  }
 }
 
 void DeviceHostClient::set_scene(const ServedScene& scene) noexcept {
@@ -97,35 +101,52 @@ void DeviceHostClient::apply_scene() noexcept {
 
 // haptic path
 void DeviceHostClient::take_models(double now_s, std::int64_t now_ns) noexcept {
+  if (!link_) {
+    models_in_.take([&](const hapsim_msg_LocalModel& m, const dds_sample_info_t&) {
+      admit_model(m, now_s, now_ns);
+    });
+    return;
+  }
+  // Through the simulated link first: what arrived goes on it, what is due comes off it.
+  const double link_s = now_s - link_epoch_s_;
   models_in_.take([&](const hapsim_msg_LocalModel& m, const dds_sample_info_t&) {
-    LocalContactModel model;
-    const SampleVerdict verdict = gate_.admit(m, sequence_, model);
-    verdicts_[static_cast<std::size_t>(verdict)].fetch_add(1, std::memory_order_relaxed);
-    if (verdict != SampleVerdict::kAccepted) {
-      return;
-    }
-    if (model.device_sequence == 0) {
-      models_not_ours_.fetch_add(1, std::memory_order_relaxed);
-      return;
-    }
-    // The first model that answers a state closes its round trip.
-    const std::size_t slot = model.device_sequence % kHistory;
-    if (sequence_ - model.device_sequence < kHistory && !answered_[slot] &&
-        state_sent_ns_[slot] > 0) {
-      answered_[slot] = true;
-      round_trip_us_.record_us(static_cast<double>(now_ns - state_sent_ns_[slot]) * 1e-3);
-    }
-    const auto tool = static_cast<std::size_t>(m.finger);
-    if (options_.mode == ForceMode::kRaw) {
-      raw_models_[tool] = model;
-      raw_received_s_[tool] = now_s;
-    } else {
-      renderers_[tool].receive(model, now_s);
-    }
-    models_accepted_.fetch_add(1, std::memory_order_relaxed);
-    last_model_ns_.store(now_ns, std::memory_order_relaxed);
-    took_model_ = true;
+    link_lost_.fetch_add(link_->send(m, link_s) ? 0 : 1, std::memory_order_relaxed);
   });
+  const std::size_t delivered = link_->deliver(
+      link_s, [&](const hapsim_msg_LocalModel& m) { admit_model(m, now_s, now_ns); });
+  link_delivered_.fetch_add(delivered, std::memory_order_relaxed);
+}
+
+// haptic path
+void DeviceHostClient::admit_model(const hapsim_msg_LocalModel& m, double now_s,
+                                   std::int64_t now_ns) noexcept {
+  LocalContactModel model;
+  const SampleVerdict verdict = gate_.admit(m, sequence_, model);
+  verdicts_[static_cast<std::size_t>(verdict)].fetch_add(1, std::memory_order_relaxed);
+  if (verdict != SampleVerdict::kAccepted) {
+    return;
+  }
+  if (model.device_sequence == 0) {
+    models_not_ours_.fetch_add(1, std::memory_order_relaxed);
+    return;
+  }
+  // The first model that answers a state closes its round trip.
+  const std::size_t slot = model.device_sequence % kHistory;
+  if (sequence_ - model.device_sequence < kHistory && !answered_[slot] &&
+      state_sent_ns_[slot] > 0) {
+    answered_[slot] = true;
+    round_trip_us_.record_us(static_cast<double>(now_ns - state_sent_ns_[slot]) * 1e-3);
+  }
+  const auto tool = static_cast<std::size_t>(m.finger);
+  if (options_.mode == ForceMode::kRaw) {
+    raw_models_[tool] = model;
+    raw_received_s_[tool] = now_s;
+  } else {
+    renderers_[tool].receive(model, now_s);
+  }
+  models_accepted_.fetch_add(1, std::memory_order_relaxed);
+  last_model_ns_.store(now_ns, std::memory_order_relaxed);
+  took_model_ = true;
 }
 
 // haptic path
@@ -251,6 +272,8 @@ DeviceHostStatus DeviceHostClient::status() const noexcept {
   s.rate_limited_cycles = rate_limited_.load(std::memory_order_relaxed);
   s.scene_changes = scene_changes_.load(std::memory_order_relaxed);
   s.round_trip_us = round_trip_us_.summary();
+  s.link_lost = link_lost_.load(std::memory_order_relaxed);
+  s.link_delivered = link_delivered_.load(std::memory_order_relaxed);
   s.passivity_cycles = passivity_cycles_.load(std::memory_order_relaxed);
   s.passivity_dissipated_j = passivity_dissipated_j_.load(std::memory_order_relaxed);
   return s;

@@ -24,6 +24,7 @@
 #include "hapsim/device/local_model_renderer.h"
 #include "hapsim/device/passivity_observer.h"
 #include "hapsim/net/device_state_codec.h"
+#include "hapsim/net/link_shim.h"
 #include "hapsim/net/local_model_gate.h"
 #include "hapsim/net/participant.h"
 #include "hapsim/net/topic_reader.h"
@@ -34,6 +35,8 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <memory>
+#include <optional>
 
 namespace hapsim::net {
 
@@ -48,6 +51,9 @@ struct DeviceHostOptions {
   LocalModelLimits limits;
   /// The last guard of the local-model mode (raw mode only observes: it is the comparison).
   PassivityObserverOptions passivity;
+  /// `--link-shim`: received models go through a simulated link first (its clock: this host's
+  /// seconds since the client was made). Empty: none.
+  std::optional<LinkShimOptions> link;
 };
 
 /// What the simulation host says it runs (from its SceneInfo): set from any thread, applied by
@@ -78,6 +84,9 @@ struct DeviceHostStatus {
   double peak_force_n = 0.0;  ///< over the run
   std::uint64_t rate_limited_cycles = 0;
   std::uint64_t scene_changes = 0;
+  /// Models the receive-side link shim lost (any reason) and delivered (zero without one).
+  std::uint64_t link_lost = 0;
+  std::uint64_t link_delivered = 0;
   /// Cycles the passivity controller added damping (any tool), and the energy it took out, J.
   std::uint64_t passivity_cycles = 0;
   double passivity_dissipated_j = 0.0;
@@ -105,11 +114,17 @@ class DeviceHostClient final : public HapticClient {
 
   void apply_scene() noexcept;
   void take_models(double now_s, std::int64_t now_ns) noexcept;
+  void admit_model(const hapsim_msg_LocalModel& m, double now_s, std::int64_t now_ns) noexcept;
   [[nodiscard]] Vec3 tool_force(std::size_t tool, const Vec3& p_device_m, double now_s) noexcept;
 
   DeviceHostOptions options_;
   TopicReader<hapsim_msg_LocalModel> models_in_;
   TopicWriter<hapsim_msg_DeviceState> states_out_;
+  static constexpr std::size_t kLinkCapacity = 1024;  ///< 200 ms of 5 fingers' models
+  std::unique_ptr<LinkShim<hapsim_msg_LocalModel, kLinkCapacity>> link_;
+  double link_epoch_s_ = 0.0;
+  std::atomic<std::uint64_t> link_lost_{0};
+  std::atomic<std::uint64_t> link_delivered_{0};
 
   // Set by set_scene (any thread), applied by the haptic thread.
   std::atomic<std::uint64_t> pending_hash_{0};

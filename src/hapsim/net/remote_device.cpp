@@ -28,16 +28,37 @@ RemoteDevice::~RemoteDevice() {
   (void)dds_delete(waitset_);
 }
 
+void RemoteDevice::set_link_shim(const LinkShimOptions& options) {
+  link_ = std::make_unique<LinkShim<hapsim_msg_DeviceState, kLinkCapacity>>(options);
+  link_epoch_ns_ = monotonic_ns();
+}
+
+// haptic path
+bool RemoteDevice::admit_state(const hapsim_msg_DeviceState& m, std::int64_t now_ns) noexcept {
+  const SampleVerdict verdict = gate_.admit(m, host_state_);
+  verdicts_[static_cast<std::size_t>(verdict)].fetch_add(1, std::memory_order_relaxed);
+  if (verdict == SampleVerdict::kAccepted) {
+    host_seen_ns_ = now_ns;
+    return true;
+  }
+  return false;
+}
+
 // haptic path
 bool RemoteDevice::take_states(std::int64_t now_ns) noexcept {
   bool accepted = false;
+  if (!link_) {
+    states_.take([&](const hapsim_msg_DeviceState& m, const dds_sample_info_t&) {
+      accepted = admit_state(m, now_ns) || accepted;
+    });
+    return accepted;
+  }
+  const double link_s = static_cast<double>(now_ns - link_epoch_ns_) * 1e-9;
   states_.take([&](const hapsim_msg_DeviceState& m, const dds_sample_info_t&) {
-    const SampleVerdict verdict = gate_.admit(m, host_state_);
-    verdicts_[static_cast<std::size_t>(verdict)].fetch_add(1, std::memory_order_relaxed);
-    if (verdict == SampleVerdict::kAccepted) {
-      host_seen_ns_ = now_ns;
-      accepted = true;
-    }
+    link_lost_.fetch_add(link_->send(m, link_s) ? 0 : 1, std::memory_order_relaxed);
+  });
+  (void)link_->deliver(link_s, [&](const hapsim_msg_DeviceState& m) {
+    accepted = admit_state(m, now_ns) || accepted;
   });
   return accepted;
 }

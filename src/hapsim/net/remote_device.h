@@ -8,12 +8,14 @@
 
 #include "hapsim/device/device.h"
 #include "hapsim/net/device_state_gate.h"
+#include "hapsim/net/link_shim.h"
 #include "hapsim/net/participant.h"
 #include "hapsim/net/topic_reader.h"
 
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <memory>
 
 namespace hapsim::net {
 
@@ -27,6 +29,13 @@ class RemoteDevice final : public Device {
   RemoteDevice& operator=(const RemoteDevice&) = delete;
   RemoteDevice(RemoteDevice&&) = delete;
   RemoteDevice& operator=(RemoteDevice&&) = delete;
+
+  /// `--link-shim`: received states go through a simulated link first (its clock: seconds since
+  /// this call). Before the loop starts.
+  void set_link_shim(const LinkShimOptions& options);
+  [[nodiscard]] std::uint64_t link_lost() const noexcept {
+    return link_lost_.load(std::memory_order_relaxed);
+  }
 
   /// Lockstep with the device host: while one drives and no new state came this cycle, read()
   /// waits up to `wait_s` for the next one (on a waitset: no spinning), so the step answers a
@@ -83,12 +92,17 @@ class RemoteDevice final : public Device {
  private:
   /// True when a state was accepted.
   bool take_states(std::int64_t now_ns) noexcept;
+  bool admit_state(const hapsim_msg_DeviceState& m, std::int64_t now_ns) noexcept;
 
   TopicReader<hapsim_msg_DeviceState> states_;
   DeviceStateGate gate_;
   Device& fallback_;
   std::int64_t host_timeout_ns_;
   std::int64_t lockstep_wait_ns_ = 0;
+  static constexpr std::size_t kLinkCapacity = 512;  ///< 500 ms of states
+  std::unique_ptr<LinkShim<hapsim_msg_DeviceState, kLinkCapacity>> link_;
+  std::int64_t link_epoch_ns_ = 0;
+  std::atomic<std::uint64_t> link_lost_{0};
   /// Cycles in a row without a new host state, dead-reckoned up to kMaxDeadReckoned.
   static constexpr int kMaxDeadReckoned = 3;
   int missed_states_ = 0;
