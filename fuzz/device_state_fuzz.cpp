@@ -23,6 +23,7 @@ bool same(const hapsim::net::DeviceStateSample& a, const hapsim::net::DeviceStat
          a.input.p_world == b.input.p_world &&
          a.input.q_world.coeffs() == b.input.q_world.coeffs() &&
          a.input.finger_count == b.input.finger_count && a.input.finger_rad == b.input.finger_rad &&
+         a.input.joint_count == b.input.joint_count && a.input.joint_rad == b.input.joint_rad &&
          a.v_world_m_per_s == b.v_world_m_per_s &&
          a.rendered.force_world_n == b.rendered.force_world_n &&
          a.rendered.finger_force_n == b.rendered.finger_force_n;
@@ -48,6 +49,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   r.read_bool(m.healthy);
   r.read(m.rendered_force_n);
   r.read(m.rendered_finger_force_n);
+  r.read(m.joint_rad);  // after the older fields: the committed seeds end before them
+  r.read(m.joint_count);
   if ((control & 1U) != 0) {
     m.device_id = kDevice;
     m.scene_hash = kSceneHash;
@@ -84,6 +87,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                     "accepted finger count out of range");
   for (const double a : in.finger_rad) {
     HAPSIM_FUZZ_CHECK(std::isfinite(a), "accepted finger angle not finite");
+  }
+  HAPSIM_FUZZ_CHECK(in.joint_count >= 0 && in.joint_count <= hapsim::kMaxDeviceJoints,
+                    "accepted joint count out of range");
+  for (const double a : in.joint_rad) {
+    HAPSIM_FUZZ_CHECK(std::isfinite(a), "accepted joint angle not finite");
   }
   HAPSIM_FUZZ_CHECK(out.rendered.force_world_n.allFinite() &&
                         out.rendered.force_world_n.cwiseAbs().maxCoeff() <= limits.max_force_n,

@@ -28,6 +28,11 @@ hapsim_msg_DeviceState encode_device_state(const DeviceStateSample& s,
     m.finger_rad[i] = s.input.finger_rad[k];
     m.rendered_finger_force_n[i] = s.rendered.finger_force_n[k];
   }
+  const int joints = std::clamp(s.input.joint_count, 0, kMaxDeviceJoints);
+  m.joint_count = static_cast<std::uint16_t>(joints);
+  for (std::size_t j = 0; j < static_cast<std::size_t>(kMaxDeviceJoints); ++j) {
+    m.joint_rad[j] = s.input.joint_rad[j];
+  }
   m.buttons = s.input.buttons;
   m.healthy = s.input.healthy;
   return m;
@@ -45,6 +50,10 @@ DeviceStateSample decode_device_state(const hapsim_msg_DeviceState& m) noexcept 
   s.rendered.force_world_n =
       Vec3(m.rendered_force_n[0], m.rendered_force_n[1], m.rendered_force_n[2]);
   s.input.finger_count = std::min<int>(m.finger_count, kMaxFingers);
+  s.input.joint_count = std::min<int>(m.joint_count, kMaxDeviceJoints);
+  for (std::size_t j = 0; j < static_cast<std::size_t>(kMaxDeviceJoints); ++j) {
+    s.input.joint_rad[j] = m.joint_rad[j];
+  }
   s.rendered.finger_count = s.input.finger_count;
   for (int i = 0; i < kMaxFingers; ++i) {
     const auto k = static_cast<std::size_t>(i);

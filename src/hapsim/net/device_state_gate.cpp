@@ -11,7 +11,8 @@ namespace hapsim::net {
 SampleVerdict DeviceStateGate::check(const hapsim_msg_DeviceState& m) const noexcept {
   if (!std::isfinite(m.device_time_s) || !all_finite(m.p_m) || !all_finite(m.q_wxyz) ||
       !all_finite(m.v_m_per_s) || !all_finite(m.finger_rad) || !all_finite(m.rendered_force_n) ||
-      !all_finite(m.rendered_finger_force_n) || m.finger_count > kMaxFingers) {
+      !all_finite(m.rendered_finger_force_n) || m.finger_count > kMaxFingers ||
+      !all_finite(m.joint_rad) || m.joint_count > kMaxDeviceJoints) {
     return SampleVerdict::kMalformed;
   }
   if (m.device_id != device_id_) {
