@@ -68,6 +68,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   r.read(device_sequence_now);
   double probe[3] = {};
   r.read(probe);
+  r.read(m.max_normal_force_n);  // after the older fields: the committed seeds end before it
   if ((control & 1U) != 0) {
     m.device_id = kDevice;
     m.scene_hash = kSceneHash;

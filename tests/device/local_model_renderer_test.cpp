@@ -72,6 +72,22 @@ TEST(LocalModelRenderer, PushOnlyRadiusAndClamp) {
   EXPECT_EQ(tight.counts().clamped, 1u);
 }
 
+TEST(LocalModelRenderer, HoldsThePushAlongTheNormalToTheModelsCap) {
+  LocalModelRenderer r(no_blend());
+  LocalContactModel m = wall_model(1);
+  m.max_normal_force_n = 1.5;
+  r.receive(m, 0.0);
+  const Vec3 x0 = m.x0_world_m;
+  // 1 mm deeper: the linear model says f0 + K·1 mm; the contact saturates at 1.5 N.
+  const Vec3 deeper = x0 - Vec3(0.0, 0.0, 0.001);
+  const double linear_n = local_model_force(m, deeper, Vec3::Zero()).z();
+  EXPECT_GT(linear_n, 1.5);
+  EXPECT_NEAR(r.render(deeper, Vec3::Zero(), 0.0).z(), 1.5, 1e-12);
+  EXPECT_EQ(r.counts().capped, 1u);
+  // Shallower than the cap: the model as it is.
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.0).z(), m.f0_world_n.z(), 1e-12);
+}
+
 TEST(LocalModelRenderer, FadesToZeroWhenTheNewestModelGoesStale) {
   LocalModelRenderer r(no_blend());  // stale after 100 ms, faded out 50 ms later
   r.receive(wall_model(), 1.0);

@@ -3,6 +3,7 @@
 #include "net/net_test_support.h"
 #include "support/allocation_counter.h"
 
+#include <cmath>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -22,6 +23,14 @@ TEST(LocalModelCodec, RoundTripsEveryFieldBitForBit) {
       encode_local_model(decode_local_model(m), {kDeviceId, 0}, kSceneHash);
   EXPECT_TRUE(test::same_bits(m, again));
   EXPECT_EQ(decode_local_model(m).stiffness_n_per_m(0, 2), 2.0);  // row-major
+  // No cap travels as -1 and comes back as none; a cap as itself.
+  EXPECT_EQ(m.max_normal_force_n, -1.0);
+  EXPECT_TRUE(std::isinf(decode_local_model(m).max_normal_force_n));
+  LocalContactModel capped = test::model_for(43);
+  capped.max_normal_force_n = 9.2;
+  EXPECT_EQ(
+      decode_local_model(encode_local_model(capped, {kDeviceId, 0}, kSceneHash)).max_normal_force_n,
+      9.2);
 }
 
 TEST(LocalModelGate, AcceptsInOrderAndCountsEachReason) {
@@ -42,6 +51,10 @@ TEST(LocalModelGate, AcceptsInOrderAndCountsEachReason) {
   negative_k.stiffness_n_per_m[0] = -1.0;
   hapsim_msg_LocalModel long_normal = message_for(11);
   long_normal.normal[2] = 2.0;
+  hapsim_msg_LocalModel nan_cap = message_for(11);
+  nan_cap.max_normal_force_n = std::numeric_limits<double>::quiet_NaN();
+  hapsim_msg_LocalModel negative_cap = message_for(11);
+  negative_cap.max_normal_force_n = -2.0;  // -1 is "none"; any other negative is nonsense
   hapsim_msg_LocalModel future = message_for(11);
   future.device_sequence = kNow + 1;
   hapsim_msg_LocalModel other_scene = message_for(11);
@@ -55,6 +68,8 @@ TEST(LocalModelGate, AcceptsInOrderAndCountsEachReason) {
   EXPECT_EQ(gate.admit(nan_force, kNow, out), SampleVerdict::kMalformed);
   EXPECT_EQ(gate.admit(inf_k, kNow, out), SampleVerdict::kMalformed);
   EXPECT_EQ(gate.admit(bad_finger, kNow, out), SampleVerdict::kMalformed);
+  EXPECT_EQ(gate.admit(nan_cap, kNow, out), SampleVerdict::kMalformed);
+  EXPECT_EQ(gate.admit(negative_cap, kNow, out), SampleVerdict::kOutOfRange);
   EXPECT_EQ(gate.admit(huge_force, kNow, out), SampleVerdict::kOutOfRange);
   EXPECT_EQ(gate.admit(negative_k, kNow, out), SampleVerdict::kOutOfRange);
   EXPECT_EQ(gate.admit(long_normal, kNow, out), SampleVerdict::kOutOfRange);
@@ -70,13 +85,13 @@ TEST(LocalModelGate, AcceptsInOrderAndCountsEachReason) {
 
   EXPECT_EQ(gate.admit(message_for(11), kNow, out), SampleVerdict::kAccepted);
   EXPECT_EQ(gate.count(SampleVerdict::kAccepted), 2u);
-  EXPECT_EQ(gate.count(SampleVerdict::kMalformed), 3u);
-  EXPECT_EQ(gate.count(SampleVerdict::kOutOfRange), 4u);
+  EXPECT_EQ(gate.count(SampleVerdict::kMalformed), 4u);
+  EXPECT_EQ(gate.count(SampleVerdict::kOutOfRange), 5u);
   EXPECT_EQ(gate.count(SampleVerdict::kOtherScene), 1u);
   EXPECT_EQ(gate.count(SampleVerdict::kOtherDevice), 1u);
   EXPECT_EQ(gate.count(SampleVerdict::kOutOfOrder), 2u);
   EXPECT_EQ(gate.count(SampleVerdict::kStale), 1u);
-  EXPECT_EQ(gate.rejected(), 12u);
+  EXPECT_EQ(gate.rejected(), 14u);
   EXPECT_STREQ(verdict_name(SampleVerdict::kStale), "stale");
 }
 

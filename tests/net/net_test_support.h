@@ -58,7 +58,8 @@ inline bool same_bits(const hapsim_msg_LocalModel& a, const hapsim_msg_LocalMode
          eq(a.v0_m_per_s, b.v0_m_per_s) && eq(a.f0_n, b.f0_n) &&
          eq(a.stiffness_n_per_m, b.stiffness_n_per_m) &&
          eq(a.damping_n_s_per_m, b.damping_n_s_per_m) && eq(a.normal, b.normal) &&
-         eq(a.validity_radius_m, b.validity_radius_m) && a.valid == b.valid;
+         eq(a.validity_radius_m, b.validity_radius_m) && a.valid == b.valid &&
+         eq(a.max_normal_force_n, b.max_normal_force_n);
 }
 
 }  // namespace hapsim::net::test

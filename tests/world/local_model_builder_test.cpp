@@ -90,6 +90,38 @@ TEST(LocalModelBuilder, ASaturatedSpringHasNoStiffness) {
   builder.build(world.state(), 1, 1, models);
   EXPECT_NEAR(models[0].f0_world_n.z(), 4.0, 1e-9);
   EXPECT_EQ(models[0].stiffness_n_per_m, Mat3::Zero());
+  EXPECT_NEAR(models[0].max_normal_force_n, 4.0, 1e-9);
+}
+
+// The cap is where the contact stops pushing harder: its material's force cap (4 N) or, for a
+// material that reaches its penetration limit first, k times the limit (500 N/m x 5 mm). A
+// device a round trip deeper than x0 renders no more than the step there would.
+TEST(LocalModelBuilder, CarriesTheForceTheContactSaturatesAt) {
+  World world(box_world());
+  const LocalModelBuilder builder(world.model());
+  std::array<LocalContactModel, 1> models;
+  world.step(at(Vec3(0.0, 0.0, -0.002)), 1e-3);  // 1 N, far from saturation
+  builder.build(world.state(), 1, 1, models);
+  EXPECT_NEAR(models[0].max_normal_force_n, 4.0, 1e-9);
+  const Vec3 far_deeper(0.0, 0.0, -0.012);
+  World other(box_world());
+  const double stepped_n = other.step(at(far_deeper), 1e-3).tools[0].force_world_n.z();
+  EXPECT_NEAR(stepped_n, 4.0, 1e-9);
+  // The linear model alone says 6 N there; the cap is what the renderer holds it to.
+  EXPECT_NEAR(local_model_force(models[0], far_deeper, Vec3::Zero()).z(), 6.0, 1e-9);
+
+  WorldDescription limited = box_world();
+  limited.materials[0] = penalty_material(500.0, 0.005, 4.0);
+  World shallow(limited);
+  const LocalModelBuilder shallow_builder(shallow.model());
+  shallow.step(at(Vec3(0.0, 0.0, -0.002)), 1e-3);
+  shallow_builder.build(shallow.state(), 1, 1, models);
+  EXPECT_NEAR(models[0].max_normal_force_n, 2.5, 1e-9);
+
+  World away(box_world());
+  away.step(at(Vec3(0.0, 0.0, 0.01)), 1e-3);
+  builder.build(away.state(), 1, 1, models);
+  EXPECT_TRUE(std::isinf(models[0].max_normal_force_n));  // free space: no contact, no cap
 }
 
 TEST(LocalModelBuilder, FreeSpaceIsAValidZeroModel) {

@@ -20,6 +20,9 @@ bool usable(const LocalContactModel& m) noexcept {
       !m.normal_world.allFinite() || !finite_non_negative(m.validity_radius_m)) {
     return false;
   }
+  if (std::isnan(m.max_normal_force_n) || m.max_normal_force_n < 0.0) {
+    return false;
+  }
   for (int i = 0; i < 3; ++i) {
     // A negative diagonal would push the device away from where it is told to stay: energy out.
     if (m.stiffness_n_per_m(i, i) < 0.0 || m.damping_n_s_per_m(i, i) < 0.0) {
@@ -124,6 +127,14 @@ Vec3 LocalModelRenderer::shaped(const Vec3& x_world_m, const Vec3& v_world_m_per
   if (newest_.valid && f.dot(newest_.normal_world) < 0.0) {
     ++counts_.pull_zeroed;
     return Vec3::Zero();
+  }
+  // A saturating contact pushes no harder deeper in: its cap bounds the push along the normal.
+  if (newest_.valid && !newest_.normal_world.isZero()) {
+    const double push_n = f.dot(newest_.normal_world);
+    if (push_n > newest_.max_normal_force_n) {
+      ++counts_.capped;
+      f -= (push_n - newest_.max_normal_force_n) * newest_.normal_world;
+    }
   }
   const double fresh = freshness(now_s);
   if (fresh < 1.0) {

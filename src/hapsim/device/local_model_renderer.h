@@ -7,7 +7,8 @@
 //    decays linearly to zero, so a jump between models is felt as a ramp, while a new model
 //    that agrees with the old one (the steady stream of a contact) is rendered as it is, with
 //    no lag: the field is always the newest model's.
-//  * Zero outside the model's validity radius around x0; push-only along its normal.
+//  * Zero outside the model's validity radius around x0; push-only along its normal, and no more
+//    push along it than the model's force cap (a saturating contact).
 //  * Clamped to `max_force_n` (the device profile's rating).
 //  * Stale-model fade: once the newest model is older than `stale_after_s` by the *local receive
 //    clock* (never the simulation's: clocks are not compared across hosts), the force fades
@@ -34,6 +35,7 @@ struct LocalModelRenderCounts {
   std::uint64_t outside_radius = 0;
   std::uint64_t pull_zeroed = 0;  ///< the model would have pulled: zero instead
   std::uint64_t clamped = 0;
+  std::uint64_t capped = 0;  ///< the push along the normal bounded by the model's force cap
   std::uint64_t fading = 0;  ///< cycles rendered with a stale model (fading or faded out)
   std::uint64_t nonfinite = 0;
   std::uint64_t models_received = 0;

@@ -18,6 +18,7 @@
 #include "hapsim/core/types.h"
 
 #include <cstdint>
+#include <limits>
 
 namespace hapsim {
 
@@ -36,6 +37,10 @@ struct LocalContactModel {
   Vec3 normal_world = Vec3::Zero();
   /// Beyond this distance from x0 the linearisation is not trusted: the device renders zero.
   double validity_radius_m = 0.0;
+  /// The most the contact can push along its normal, N (the force caps of its springs, summed):
+  /// deeper in, a saturated contact pushes no harder, and the linear model must not say it does.
+  /// Infinite: no limit.
+  double max_normal_force_n = std::numeric_limits<double>::infinity();
   /// Simulation time of the step that made it (the simulation's clock; the device never compares
   /// it with its own).
   double sim_time_s = 0.0;

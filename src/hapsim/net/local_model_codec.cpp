@@ -1,5 +1,8 @@
 #include "hapsim/net/local_model_codec.h"
 
+#include <cmath>
+#include <limits>
+
 namespace hapsim::net {
 
 namespace {
@@ -52,6 +55,7 @@ hapsim_msg_LocalModel encode_local_model(const LocalContactModel& model, Contact
   put(model.normal_world, m.normal);
   m.validity_radius_m = model.validity_radius_m;
   m.valid = model.valid;
+  m.max_normal_force_n = std::isinf(model.max_normal_force_n) ? -1.0 : model.max_normal_force_n;
   return m;
 }
 
@@ -69,6 +73,8 @@ LocalContactModel decode_local_model(const hapsim_msg_LocalModel& m) noexcept {
   model.normal_world = vec(m.normal);
   model.validity_radius_m = m.validity_radius_m;
   model.valid = m.valid;
+  model.max_normal_force_n =
+      m.max_normal_force_n < 0.0 ? std::numeric_limits<double>::infinity() : m.max_normal_force_n;
   return model;
 }
 

@@ -28,7 +28,7 @@ SampleVerdict LocalModelGate::check(const hapsim_msg_LocalModel& m,
   if (m.finger >= finger_count_ || !std::isfinite(m.sim_time_s) || !all_finite(m.x0_m) ||
       !all_finite(m.v0_m_per_s) || !all_finite(m.f0_n) || !all_finite(m.stiffness_n_per_m) ||
       !all_finite(m.damping_n_s_per_m) || !all_finite(m.normal) ||
-      !std::isfinite(m.validity_radius_m)) {
+      !std::isfinite(m.validity_radius_m) || !std::isfinite(m.max_normal_force_n)) {
     return SampleVerdict::kMalformed;
   }
   if (m.device_id != device_id_) {
@@ -50,7 +50,9 @@ SampleVerdict LocalModelGate::check(const hapsim_msg_LocalModel& m,
       !within(m.damping_n_s_per_m, limits_.max_damping_n_s_per_m) ||
       !within(m.x0_m, limits_.max_position_m) || !within(m.v0_m_per_s, limits_.max_speed_m_per_s) ||
       !(m.validity_radius_m >= 0.0 && m.validity_radius_m <= limits_.max_validity_radius_m) ||
-      !diagonal_ok || !normal_ok || m.device_sequence > device_sequence_now) {
+      !diagonal_ok || !normal_ok || m.device_sequence > device_sequence_now ||
+      !(m.max_normal_force_n == -1.0 ||
+        (m.max_normal_force_n >= 0.0 && m.max_normal_force_n <= limits_.max_force_n))) {
     return SampleVerdict::kOutOfRange;
   }
   const auto finger = static_cast<std::size_t>(m.finger);

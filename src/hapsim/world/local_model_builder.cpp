@@ -1,9 +1,12 @@
 #include "hapsim/world/local_model_builder.h"
 
 #include "hapsim/deform/sheet_profile.h"
+#include "hapsim/force/penalty_force.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 
 namespace hapsim {
 
@@ -39,7 +42,9 @@ void LocalModelBuilder::build(const WorldState& state, std::uint64_t sequence,
     m.sequence = sequence;
     m.device_sequence = device_sequence;
     m.valid = state.input_usable && m.x0_world_m.allFinite() && m.v0_world_m_per_s.allFinite();
+    m.max_normal_force_n = 0.0;  // summed over the tool's contacts below; free space: none
   }
+  std::array<bool, 64> proxy_capped{};  // per tool (a world has a handful)
   for (std::size_t i = 0; i < state.contact_count; ++i) {
     const WorldContact& c = state.contacts[i];
     const auto t = static_cast<std::size_t>(c.tool);
@@ -60,16 +65,32 @@ void LocalModelBuilder::build(const WorldState& state, std::uint64_t sequence,
           nn;
     }
     m.damping_n_s_per_m += std::max(material.damping_n_s_per_m, 0.0) * nn;
+    // Each spring saturates at its material's force cap or at its penetration limit, whichever
+    // comes first; the god-object's one spring renders its first contact's material
+    // (force/god_object.h): that cap, once per tool.
+    const bool counted = t < proxy_capped.size() && proxy_capped[t];
+    if (!c.proxy || !counted) {
+      m.max_normal_force_n += penalty_force_magnitude(material, material.max_penetration_m, 0.0);
+      if (c.proxy && t < proxy_capped.size()) {
+        proxy_capped[t] = true;
+      }
+    }
     if (m.normal_world.isZero()) {
       m.normal_world = c.normal_world;
     }
   }
   // The push-only rule follows the force the step rendered where there is one.
   for (std::size_t t = 0; t < tools; ++t) {
+    if (out[t].max_normal_force_n == 0.0) {
+      out[t].max_normal_force_n = std::numeric_limits<double>::infinity();  // no contact
+    }
     const double f_n = out[t].f0_world_n.norm();
     if (f_n > 0.0) {
       out[t].normal_world = out[t].f0_world_n / f_n;
     }
+    // The springs' caps bound the spring force; the damping on top may carry this step's force
+    // a little past them (and may again): never cap below what the step itself rendered.
+    out[t].max_normal_force_n = std::max(out[t].max_normal_force_n, f_n);
   }
 }
 

@@ -7,7 +7,10 @@
 //           stiffness (already clamped to the device) in series with the segment's tissue
 //           stiffness; 0 along a contact whose spring is saturated (at its maximum penetration
 //           or force: pressing further adds nothing),
-//   B       Σ material damping · n nᵀ.
+//   B       Σ material damping · n nᵀ,
+//   cap     Σ per contact of the force its spring saturates at (force cap or penetration limit;
+//           the god-object's spring once), and never below |f0|: deeper in, a saturated contact
+//           pushes no harder, and a device a round trip ahead must not feel it push harder.
 // Tissue stiffness per segment:
 //   * a Gaussian sheet gives way under a push with its own compliance (the profile's depth per
 //     newton under the contact, the same number WorldModel checks the contact spring against):
