@@ -6,6 +6,7 @@
 // restarts, and says when it goes silent and how fast the force went to zero then.
 #include "commands.h"
 #include "dds_options.h"
+#include "json_output.h"
 #include "session_json.h"
 #include "stop_signal.h"
 
@@ -36,7 +37,6 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -202,13 +202,7 @@ void run_device(const DeviceArgs& args) {
   const std::optional<net::LinkShimOptions> link =
       args.link_shim.empty() ? std::nullopt
                              : std::optional(net::parse_link_shim(args.link_shim, "--link-shim"));
-  std::unique_ptr<std::ofstream> json_out;
-  if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
-  }
+  JsonOutput json_out(args.json_path);
   const bool sim = args.device == "sim";
   HostDevice host = sim ? HostDevice{} : open_device(args);
   net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
@@ -361,8 +355,7 @@ void run_device(const DeviceArgs& args) {
                                {"force_before_n", silence.force_before_n},
                                {"force_zero_after_ms", silence.zero_after_ms}});
     }
-    *json_out << j.dump(2) << '\n';
-    std::printf("wrote        %s\n", args.json_path.c_str());
+    json_out.write(j);
   }
 }
 

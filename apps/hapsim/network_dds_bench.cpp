@@ -1,6 +1,7 @@
 #include "network_dds_bench.h"
 
 #include "commands.h"
+#include "json_output.h"
 
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/device_state_codec.h"
@@ -247,13 +248,7 @@ void run_network_dds(const NetworkDdsArgs& args) {
   if (!std::filesystem::is_regular_file(args.scene)) {
     throw CommandError("--scene " + args.scene + ": no such scene file (run from the checkout)");
   }
-  std::unique_ptr<std::ofstream> json_out;
-  if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
-  }
+  JsonOutput json_out(args.json_path);
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("hapsim_bench_dds_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
@@ -302,8 +297,7 @@ void run_network_dds(const NetworkDdsArgs& args) {
     out["runs"] = rows;
     out["network_round_trip_us"] = {
         {"p50", probe.p50}, {"p99", probe.p99}, {"max", probe.max}, {"count", probe.count}};
-    *json_out << out.dump(2) << '\n';
-    std::printf("wrote %s\n", args.json_path.c_str());
+    json_out.write(out);
   }
   std::error_code ec;
   std::filesystem::remove_all(dir, ec);

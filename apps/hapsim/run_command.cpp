@@ -2,6 +2,7 @@
 // trajectory or palpation script, another trajectory file, or a recording to replay) at 1 kHz
 // simulated time, and reports contacts, forces, deflection, pop-throughs and the step cost.
 #include "commands.h"
+#include "json_output.h"
 #include "progress_printer.h"
 #include "session_json.h"
 #include "snapshot_view.h"
@@ -150,13 +151,7 @@ void run(const RunArgs& args) {
     }
   };
   // Open outputs first, so a bad path fails before the run.
-  std::unique_ptr<std::ofstream> json_out;
-  if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
-  }
+  JsonOutput json_out(args.json_path);
   // Options that cannot work are refused before anything is loaded or printed.
   if (!std::isnan(args.duration_s) &&
       (!(args.duration_s > 0.0) || !std::isfinite(args.duration_s))) {
@@ -375,11 +370,7 @@ void run(const RunArgs& args) {
   }
   j["ok"] = !failed;
   if (json_out) {
-    *json_out << j.dump(2) << '\n';
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": write failed");
-    }
-    std::printf("wrote        %s\n", args.json_path.c_str());
+    json_out.write(j);
   }
   if (failed) {
     exit_status() = 1;

@@ -11,6 +11,7 @@
 // keys as `hapsim run --json`, so a served run and a one-process run compare key by key.
 #include "commands.h"
 #include "dds_options.h"
+#include "json_output.h"
 #include "session_json.h"
 #include "stop_signal.h"
 
@@ -158,13 +159,7 @@ void serve(const ServeArgs& args) {
   const std::optional<net::LinkShimOptions> link =
       args.link_shim.empty() ? std::nullopt
                              : std::optional(net::parse_link_shim(args.link_shim, "--link-shim"));
-  std::unique_ptr<std::ofstream> json_out;
-  if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
-  }
+  JsonOutput json_out(args.json_path);
   SceneLoadOptions load_options;
   if (!args.data_dir.empty()) {
     load_options.data_dir = args.data_dir;
@@ -314,11 +309,7 @@ void serve(const ServeArgs& args) {
           verdicts[v];
     }
     j["ok"] = summary.pop_throughs == 0 && summary.max_force_limit_violations == 0;
-    *json_out << j.dump(2) << '\n';
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": write failed");
-    }
-    std::printf("wrote        %s\n", args.json_path.c_str());
+    json_out.write(j);
   }
 }
 

@@ -5,6 +5,7 @@
 // at the largest force it saw. For headless machines, tests, and the network benchmark's viewers.
 #include "commands.h"
 #include "dds_options.h"
+#include "json_output.h"
 #include "snapshot_view.h"
 #include "stop_signal.h"
 
@@ -24,7 +25,6 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <fstream>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -53,13 +53,7 @@ double peak_tool_force_n(const WorldSnapshot& s) {
 
 void watch(const WatchArgs& args) {
   using Clock = std::chrono::steady_clock;
-  std::unique_ptr<std::ofstream> json_out;
-  if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
-  }
+  JsonOutput json_out(args.json_path);
   net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
   net::Participant participant(args.dds.domain, args.dds.session);
   net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
@@ -146,8 +140,7 @@ void watch(const WatchArgs& args) {
     j["peak_force_n"] = peak_force_n;
     j["max_deflection_m"] = max_deflection_m;
     j["cycles"] = {first_cycle, last_cycle};
-    *json_out << j.dump(2) << '\n';
-    std::printf("wrote        %s\n", args.json_path.c_str());
+    json_out.write(j);
   }
   if (views == 0) {
     std::printf("FAILED: no view arrived\n");

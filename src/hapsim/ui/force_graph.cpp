@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 namespace hapsim {
 
@@ -63,15 +64,20 @@ void ForceGraph::draw(double full_scale_n) const {
     }
     ImGui::TextUnformatted(series_[i].label.c_str());
   }
-  char overlay[64];
-  std::snprintf(overlay, sizeof overlay, "force (N), full scale %.1f N", scale);
+  // The caption on its own line: drawn over the first plot, a trace at full scale crossed it.
+  char head[64];
+  std::snprintf(head, sizeof head, "force history (N), full scale %.1f N, top to bottom:", scale);
+  std::string caption = head;
+  for (std::size_t i = 0; i < series_.size(); ++i) {
+    caption += (i == 0 ? " " : ", ") + series_[i].label;
+  }
+  ImGui::TextWrapped("%s", caption.c_str());
   for (std::size_t i = 0; i < series_.size(); ++i) {
     const Series& s = series_[i];
     ImGui::PushID(static_cast<int>(i));
     // The oldest sample is the one after head_: the plot scrolls right to left.
-    ImGui::PlotLines("##force", s.values.data(), kHistory, (head_ + 1) % kHistory,
-                     i == 0 ? overlay : nullptr, 0.0f, static_cast<float>(scale),
-                     ImVec2(width, 60.0f));
+    ImGui::PlotLines("##force", s.values.data(), kHistory, (head_ + 1) % kHistory, nullptr, 0.0f,
+                     static_cast<float>(scale), ImVec2(width, 60.0f));
     ImGui::PopID();
   }
 }
