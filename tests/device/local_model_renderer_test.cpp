@@ -4,6 +4,7 @@
 
 #include "support/allocation_counter.h"
 
+#include <algorithm>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -97,9 +98,42 @@ TEST(LocalModelRenderer, FadesToZeroWhenTheNewestModelGoesStale) {
   EXPECT_NEAR(r.render(x0, Vec3::Zero(), 1.15).z(), 0.0, 1e-9);
   EXPECT_EQ(r.render(x0, Vec3::Zero(), 1.151).z(), 0.0);
   EXPECT_EQ(r.render(x0, Vec3::Zero(), 5.0).z(), 0.0);
-  // A fresh model brings the force back.
+  // A fresh model brings the force back, ramped in over the re-engagement (0.5 s).
   r.receive(wall_model(2), 5.0);
-  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 5.001).z(), 1.0, 1e-12);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 5.0).z(), 0.0, 1e-12);
+  EXPECT_NEAR(r.render(x0, Vec3::Zero(), 5.05).z(), 0.1, 1e-12);
+  EXPECT_EQ(r.counts().reengaged, 1u);
+}
+
+TEST(LocalModelRenderer, AfterAnOutageTheContactComesBackAsARampNotAJolt) {
+  // The device went 4 mm deeper while the force was off: the model there says 5 N. It grows
+  // linearly over the 0.5 s re-engagement, though a model arrives every millisecond (each takes
+  // the ramp over instead of restarting the 20 ms blend), and is whole at its end.
+  LocalModelRenderer r({10.0, 0.02, 0.1, 0.05, 0.5});
+  r.receive(wall_model(1), 0.0);
+  const Vec3 held(0.0, 0.0, -0.001);
+  EXPECT_NEAR(r.render(held, Vec3::Zero(), 0.05).z(), 1.0, 1e-12);
+  EXPECT_EQ(r.render(held, Vec3::Zero(), 0.3).z(), 0.0);  // stale since 0.1 s, faded by 0.15 s
+  const Vec3 deep(0.0, 0.0, -0.005);
+  EXPECT_EQ(r.render(deep, Vec3::Zero(), 0.4).z(), 0.0);
+  std::uint64_t sequence = 2;
+  for (int k = 0; k <= 600; ++k) {
+    const double t_s = 0.4 + 1e-3 * k;
+    LocalContactModel m = wall_model(sequence++);
+    m.x0_world_m = deep;
+    m.f0_world_n.z() = 5.0;
+    r.receive(m, t_s);
+    const double f_n = r.render(deep, Vec3::Zero(), t_s).z();
+    const double expected_n = 5.0 * std::min(1.0, (t_s - 0.4) / 0.5);
+    ASSERT_NEAR(f_n, expected_n, 1e-9) << "at " << t_s << " s";
+  }
+  EXPECT_EQ(r.counts().reengaged, 1u);
+  // A steady stream afterwards blends at the ordinary 20 ms again.
+  LocalContactModel harder = wall_model(sequence++);
+  harder.x0_world_m = deep;
+  harder.f0_world_n.z() = 6.0;
+  r.receive(harder, 1.05);
+  EXPECT_NEAR(r.render(deep, Vec3::Zero(), 1.07).z(), 6.0, 1e-12);
 }
 
 TEST(LocalModelRenderer, BlendsANewModelInOverTheBlendTime) {

@@ -40,16 +40,29 @@ LocalModelRenderer::LocalModelRenderer(LocalModelRenderOptions options) : option
                 "max_force_n must be finite and > 0, got " + std::to_string(options_.max_force_n));
   }
   if (!finite_non_negative(options_.blend_time_s) || !finite_non_negative(options_.stale_after_s) ||
-      !finite_non_negative(options_.fade_time_s)) {
-    throw Error("local model renderer", "blend, stale and fade times must be finite and >= 0");
+      !finite_non_negative(options_.fade_time_s) ||
+      !finite_non_negative(options_.reengage_time_s)) {
+    throw Error("local model renderer",
+                "blend, stale, fade and re-engagement times must be finite and >= 0");
   }
 }
 
+namespace {
+
+// What is left at `now_s` of an offset that decays linearly from `from_s` over `length_s`.
+Vec3 decayed(const Vec3& offset_n, double from_s, double length_s, double now_s) noexcept {
+  const double alpha = length_s > 0.0 ? std::clamp((now_s - from_s) / length_s, 0.0, 1.0) : 1.0;
+  return (1.0 - alpha) * offset_n;
+}
+
+}  // namespace
+
 Vec3 LocalModelRenderer::offset(double now_s) const noexcept {
-  const double since_s = now_s - received_s_;
-  const double alpha =
-      options_.blend_time_s > 0.0 ? std::clamp(since_s / options_.blend_time_s, 0.0, 1.0) : 1.0;
-  return (1.0 - alpha) * offset_n_;
+  return decayed(offset_n_, received_s_, options_.blend_time_s, now_s) + reengage_offset(now_s);
+}
+
+Vec3 LocalModelRenderer::reengage_offset(double now_s) const noexcept {
+  return decayed(reengage_offset_n_, reengage_from_s_, options_.reengage_time_s, now_s);
 }
 
 // haptic path
@@ -65,14 +78,24 @@ void LocalModelRenderer::receive(const LocalContactModel& model, double now_s) n
   const Vec3 x_m = has_rendered_ ? last_x_m_ : model.x0_world_m;
   const Vec3 v_m_per_s = has_rendered_ ? last_v_m_per_s_ : model.v0_world_m_per_s;
   Vec3 start_n = Vec3::Zero();
+  const bool stale = has_model_ && freshness(now_s) < 1.0;
   if (has_model_ && has_rendered_) {
-    start_n = freshness(now_s) < 1.0
-                  ? last_force_n_
-                  : Vec3(local_model_force(newest_, x_m, v_m_per_s) + offset(now_s));
+    start_n =
+        stale ? last_force_n_ : Vec3(local_model_force(newest_, x_m, v_m_per_s) + offset(now_s));
   }
-  offset_n_ = start_n - local_model_force(model, x_m, v_m_per_s);
-  if (!offset_n_.allFinite()) {
+  Vec3 total_offset_n = start_n - local_model_force(model, x_m, v_m_per_s);
+  if (!total_offset_n.allFinite()) {
+    total_offset_n.setZero();
+  }
+  if (stale && options_.reengage_time_s > options_.blend_time_s) {
+    // The whole step back to the contact ramps in slowly; the models that follow (one a cycle)
+    // leave that ramp running and blend only their own differences.
+    reengage_offset_n_ = total_offset_n;
+    reengage_from_s_ = now_s;
     offset_n_.setZero();
+    ++counts_.reengaged;
+  } else {
+    offset_n_ = total_offset_n - reengage_offset(now_s);
   }
   newest_ = model;
   received_s_ = now_s;

@@ -13,6 +13,10 @@
 //  * Stale-model fade: once the newest model is older than `stale_after_s` by the *local receive
 //    clock* (never the simulation's: clocks are not compared across hosts), the force fades
 //    linearly to zero over `fade_time_s`.
+//  * Re-engagement: a model that ends a stale spell (an outage, a restarted simulation) ramps in
+//    over `reengage_time_s` instead. The hand kept pushing while the force was off, so the
+//    device is likely deeper than where the contact last held; the contact comes back as a
+//    push that grows, not as a jolt of the force at that depth (twice the hold and more).
 // Allocation-free and non-blocking; the owner feeds it models it took without blocking.
 #pragma once
 
@@ -28,6 +32,7 @@ struct LocalModelRenderOptions {
   double blend_time_s = 0.02;
   double stale_after_s = 0.1;
   double fade_time_s = 0.05;
+  double reengage_time_s = 0.5;
 };
 
 /// What render() did to the force, counted since construction (for the device's health report).
@@ -35,8 +40,9 @@ struct LocalModelRenderCounts {
   std::uint64_t outside_radius = 0;
   std::uint64_t pull_zeroed = 0;  ///< the model would have pulled: zero instead
   std::uint64_t clamped = 0;
-  std::uint64_t capped = 0;  ///< the push along the normal bounded by the model's force cap
-  std::uint64_t fading = 0;  ///< cycles rendered with a stale model (fading or faded out)
+  std::uint64_t capped = 0;     ///< the push along the normal bounded by the model's force cap
+  std::uint64_t fading = 0;     ///< cycles rendered with a stale model (fading or faded out)
+  std::uint64_t reengaged = 0;  ///< models that ended a stale spell (ramped in slowly)
   std::uint64_t nonfinite = 0;
   std::uint64_t models_received = 0;
   std::uint64_t models_refused = 0;  ///< non-finite or negative-stiffness models
@@ -66,8 +72,9 @@ class LocalModelRenderer {
   /// The force at (x, v) by every rule of the header but the non-finite input check.
   [[nodiscard]] Vec3 shaped(const Vec3& x_world_m, const Vec3& v_world_m_per_s,
                             double now_s) noexcept;
-  /// What is left of the blend's offset at `now_s`.
+  /// What is left of the blend's and the re-engagement's offsets at `now_s`.
   [[nodiscard]] Vec3 offset(double now_s) const noexcept;
+  [[nodiscard]] Vec3 reengage_offset(double now_s) const noexcept;
 
   LocalModelRenderOptions options_;
   LocalContactModel newest_;
@@ -79,6 +86,10 @@ class LocalModelRenderer {
   Vec3 last_force_n_ = Vec3::Zero();
   bool has_rendered_ = false;
   double received_s_ = 0.0;
+  /// A re-engagement's offset (rendered minus the model's when it ended a stale spell), dying
+  /// out over reengage_time_s from reengage_from_s_, beside the blend's.
+  Vec3 reengage_offset_n_ = Vec3::Zero();
+  double reengage_from_s_ = 0.0;
   bool has_model_ = false;
   LocalModelRenderCounts counts_;
 };

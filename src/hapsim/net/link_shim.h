@@ -29,7 +29,9 @@ struct LinkShimOptions {
   /// leave it; every sample sent during a burst is lost. 0: no bursts.
   double burst_enter = 0.0;
   double burst_exit = 1.0;
-  /// Everything sent in [outage_start_s, outage_start_s + outage_s) is lost. Negative: none.
+  /// The link is down in [outage_start_s, outage_start_s + outage_s): a sample on it at any
+  /// time in that window is lost — sent during it, or sent before and still in flight at its
+  /// start (a pulled cable loses what was on the wire too). Negative: none.
   double outage_start_s = -1.0;
   double outage_s = 0.0;
   std::uint64_t seed = 1;
@@ -61,8 +63,14 @@ class LinkShim {
     const double u_burst = uniform_(rng_);
     const double u_jitter = uniform_(rng_);
     in_burst_ = in_burst_ ? !(u_burst < options_.burst_exit) : u_burst < options_.burst_enter;
-    if (options_.outage_start_s >= 0.0 && now_s >= options_.outage_start_s &&
-        now_s < options_.outage_start_s + options_.outage_s) {
+    double due_s = now_s + options_.delay_s + options_.jitter_s * u_jitter;
+    if (options_.keep_order && due_s < last_due_s_) {
+      due_s = last_due_s_;
+    }
+    // On the link from now_s to due_s: lost if that meets the outage window.
+    if (options_.outage_start_s >= 0.0 && options_.outage_s > 0.0 &&
+        now_s < options_.outage_start_s + options_.outage_s &&
+        due_s + kDueTolerance_s >= options_.outage_start_s) {
       ++counts_.lost_outage;
       return false;
     }
@@ -77,10 +85,6 @@ class LinkShim {
     if (in_flight_ == Capacity) {
       ++counts_.lost_full;
       return false;
-    }
-    double due_s = now_s + options_.delay_s + options_.jitter_s * u_jitter;
-    if (options_.keep_order && due_s < last_due_s_) {
-      due_s = last_due_s_;
     }
     last_due_s_ = std::max(last_due_s_, due_s);
     for (Slot& slot : slots_) {

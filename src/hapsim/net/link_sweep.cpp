@@ -108,8 +108,8 @@ class Session {
         up_(link_options(c, 2 * c.seed + 1)),
         down_(link_options(c, 2 * c.seed + 2)),
         raw_down_(link_options(c, 2 * c.seed + 2)),
-        renderer_(
-            LocalModelRenderOptions{c.plant.max_force_n, c.blend_s, c.stale_after_s, c.fade_s}),
+        renderer_(LocalModelRenderOptions{c.plant.max_force_n, c.blend_s, c.stale_after_s, c.fade_s,
+                                          c.reengage_s}),
         observer_(c.observer),
         model_gate_(kDeviceId, kSceneHash, 1),
         state_gate_(kDeviceId, kSceneHash) {}

@@ -124,6 +124,7 @@ struct LinkCase {
   double blend_s = 0.02;
   double stale_after_s = 0.1;
   double fade_s = 0.05;
+  double reengage_s = 0.5;
   ModelStiffness model_stiffness = ModelStiffness::kSeries;
   std::uint64_t seed = 1;
   OneDofPlant plant;
