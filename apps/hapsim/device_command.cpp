@@ -235,7 +235,15 @@ void run_device(const DeviceArgs& args) {
   net::DeviceHostOptions options;
   options.device_id = static_cast<std::uint16_t>(args.device_id);
   options.mode = mode;
-  options.render.max_force_n = profile.max_force_n;
+  // A glove has no tip actuator (its tip rating is 0): its tools are on fingers, and a tool on
+  // none is held to the finger rating too (the device's own clamp has the last word).
+  if (!(profile.max_force_n > 0.0) && !(profile.max_finger_force_n > 0.0)) {
+    throw Error("device " + host.name,
+                "its profile '" + profile.name + "' rates no force (tip and fingers 0 N)");
+  }
+  options.max_finger_force_n = profile.max_finger_force_n;
+  options.render.max_force_n =
+      profile.max_force_n > 0.0 ? profile.max_force_n : profile.max_finger_force_n;
   if (link) {
     options.link = link;
     std::printf("link shim    on the local models received: %s\n", args.link_shim.c_str());
@@ -252,8 +260,14 @@ void run_device(const DeviceArgs& args) {
     loop_options.max_cycles = static_cast<std::uint64_t>(std::llround(args.duration_s * 1000.0));
   }
   HapticLoop loop(*host.device, client, loop_options);
-  std::printf("device       %s, rated %.1f N; force mode %s%s\n", host.name.c_str(),
-              profile.max_force_n, net::to_string(mode),
+  char rating[48];
+  if (profile.max_force_n > 0.0) {
+    std::snprintf(rating, sizeof rating, "%.1f N", profile.max_force_n);
+  } else {
+    std::snprintf(rating, sizeof rating, "%.1f N per finger", profile.max_finger_force_n);
+  }
+  std::printf("device       %s, rated %s; force mode %s%s\n", host.name.c_str(), rating,
+              net::to_string(mode),
               mode == net::ForceMode::kRaw
                   ? " (the paper's raw forces: unsafe beyond a few ms of delay, for comparison)"
                   : " (rendered at the device's own position)");

@@ -11,6 +11,7 @@
 #include "support/allocation_counter.h"
 
 #include <chrono>
+#include <optional>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -23,13 +24,20 @@ constexpr std::uint64_t kHash = 0xfeedULL;
 
 class DeviceHostClientTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    ASSERT_TRUE(test::on_loopback_config());
+  // What the host is told: a fixture for another device overrides these.
+  [[nodiscard]] virtual DeviceHostOptions options() const { return {}; }
+  [[nodiscard]] virtual ServedScene scene() const {
     ServedScene scene;
     scene.scene_hash = kHash;
     scene.serve_id = 1;
     scene.tool_count = 1;
-    client.set_scene(scene);
+    return scene;
+  }
+
+  void SetUp() override {
+    ASSERT_TRUE(test::on_loopback_config());
+    client.emplace(participant, options());
+    client->set_scene(scene());
     const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while ((models_out.matched_readers() == 0 || states_in.matched_writers() == 0) &&
            std::chrono::steady_clock::now() < give_up) {
@@ -40,11 +48,11 @@ class DeviceHostClientTest : public ::testing::Test {
   // One loop cycle at device position p (the loop's read, step and write, without the thread).
   const DeviceCommand& cycle(const Vec3& p_m) {
     input.p_world = p_m;
-    const DeviceCommand& command = client.step(input, 0.001);
+    const DeviceCommand& command = client->step(input, 0.001);
     HapticCycle c;
     c.input = &input;
     c.output = &command;
-    client.after_cycle(c);
+    client->after_cycle(c);
     return command;
   }
 
@@ -75,7 +83,7 @@ class DeviceHostClientTest : public ::testing::Test {
   }
 
   Participant participant{kDomain, "device-host-client"};
-  DeviceHostClient client{participant, DeviceHostOptions{}};
+  std::optional<DeviceHostClient> client;
   TopicWriter<hapsim_msg_LocalModel> models_out{participant};
   TopicReader<hapsim_msg_DeviceState> states_in{participant};
   DeviceInput input;
@@ -96,7 +104,7 @@ TEST_F(DeviceHostClientTest, RendersTheModelAtTheDevicesOwnPositionAndOnlyOurs) 
   for (int k = 0; k < 30; ++k) {
     EXPECT_EQ(cycle(x0).force_world_n, Vec3::Zero());
   }
-  EXPECT_EQ(client.status().models_not_ours, 1u);
+  EXPECT_EQ(client->status().models_not_ours, 1u);
 
   // A model answering our state: blended in over 20 ms, then f0 + K·(x0 − x) where the device
   // is. The device has moved 1 mm further in since that state: 2 N + 1000 N/m × 1 mm = 3 N.
@@ -120,7 +128,7 @@ TEST_F(DeviceHostClientTest, RendersTheModelAtTheDevicesOwnPositionAndOnlyOurs) 
   }
   EXPECT_NEAR(f.z(), 3.0, 1e-9);
   EXPECT_NEAR(f.head<2>().norm(), 0.0, 1e-12);
-  const DeviceHostStatus s = client.status();
+  const DeviceHostStatus s = client->status();
   EXPECT_EQ(s.models_accepted, 1u);
   EXPECT_GT(s.round_trip_us.count, 0u);
   EXPECT_NEAR(s.peak_force_n, 3.0, 1e-9);
@@ -143,7 +151,52 @@ TEST_F(DeviceHostClientTest, ACycleAllocatesNothing) {
     (void)cycle(x0 + Vec3(0.0, 0.0, -1e-6 * k));
   }
   EXPECT_EQ(hapsim::test::thread_allocation_count() - before, 0);
-  EXPECT_GT(client.status().peak_force_n, 1.0);  // it rendered the model meanwhile
+  EXPECT_GT(client->status().peak_force_n, 1.0);  // it rendered the model meanwhile
+}
+
+// A tool on a finger (a force glove's) renders to the finger actuator's rating, not the tip's,
+// into that finger's slot of the command, and the simulation hears it there.
+class GloveHostTest : public DeviceHostClientTest {
+ protected:
+  [[nodiscard]] DeviceHostOptions options() const override {
+    DeviceHostOptions o;
+    o.render.max_force_n = 8.0;  // a tip rating the finger must not get
+    o.max_finger_force_n = 4.0;
+    return o;
+  }
+  [[nodiscard]] ServedScene scene() const override {
+    ServedScene s = DeviceHostClientTest::scene();
+    s.tool_finger[0] = 1;
+    return s;
+  }
+};
+
+TEST_F(GloveHostTest, AFingerToolRendersIntoItsFingerAtTheFingersRating) {
+  const Vec3 x0(0.0, 0.0, -0.001);
+  for (int k = 0; k < 5; ++k) {
+    (void)cycle(x0);
+  }
+  const DeviceStateSample state = newest_state();
+  ASSERT_GT(state.sequence, 0u);
+  // 6 mm deeper than the state answered: 2 N + 1000 N/m × 6 mm = 8 N, held to the finger's 4 N.
+  const Vec3 deeper = x0 - Vec3(0.0, 0.0, 0.006);
+  DeviceCommand command;
+  std::uint64_t sent = 0;
+  for (int k = 0; k < 60; ++k) {
+    if (k % 10 == 0) {
+      models_out.write(
+          encode_local_model(wall_model(1 + sent++, state.sequence, x0), {0, 0}, kHash));
+    }
+    command = cycle(deeper);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_GE(client->status().models_accepted, 1u);
+  EXPECT_NEAR(command.finger_force_n[1], 4.0, 1e-9);
+  EXPECT_EQ(command.finger_force_n[0], 0.0);
+  EXPECT_EQ(command.force_world_n, Vec3::Zero());  // nothing on the tip
+  // What the simulation hears it rendered, finger by finger.
+  const DeviceStateSample said = newest_state();
+  EXPECT_NEAR(said.rendered.finger_force_n[1], 4.0, 1e-9);
 }
 
 }  // namespace

@@ -42,6 +42,14 @@ PassivityObserverOptions passivity_options(const DeviceHostOptions& options) {
 
 }  // namespace
 
+LocalModelRenderOptions finger_render_options(const DeviceHostOptions& options) noexcept {
+  LocalModelRenderOptions o = options.render;
+  if (options.max_finger_force_n > 0.0) {
+    o.max_force_n = options.max_finger_force_n;
+  }
+  return o;
+}
+
 const char* to_string(ForceMode mode) noexcept {
   return mode == ForceMode::kRaw ? "raw" : "local-model";
 }
@@ -61,6 +69,12 @@ DeviceHostClient::DeviceHostClient(const Participant& participant, const DeviceH
                  PassivityObserver(passivity_options(options))} {
   if (!(std::isfinite(options.max_force_rate_n_per_s) && options.max_force_rate_n_per_s > 0.0)) {
     throw Error("device host", "the force rate limit must be finite and > 0 N/s");
+  }
+  if (!(std::isfinite(options.max_finger_force_n) && options.max_finger_force_n >= 0.0)) {
+    throw Error("device host", "the finger force rating must be finite and >= 0 N");
+  }
+  if (options.max_finger_force_n > 0.0) {
+    (void)LocalModelRenderer(finger_render_options(options));  // checked here, not in the loop
   }
   if (options.link) {
     link_ = std::make_unique<LinkShim<hapsim_msg_LocalModel, kLinkCapacity>>(*options.link);
@@ -89,8 +103,11 @@ void DeviceHostClient::apply_scene() noexcept {
   // from no model (the renderers blend the first one in from zero).
   gate_ = LocalModelGate(options_.device_id, scene_.scene_hash, std::max<int>(1, scene_.tool_count),
                          options_.limits);
-  for (LocalModelRenderer& r : renderers_) {
-    r = LocalModelRenderer(options_.render);  // options checked at construction: no throw
+  // A tool on a finger renders to the finger actuator's rating, the others to the tip's.
+  for (std::size_t t = 0; t < renderers_.size(); ++t) {
+    const bool on_finger = t < scene_.tool_count && scene_.tool_finger[t] >= 0;
+    renderers_[t] = LocalModelRenderer(on_finger ? finger_render_options(options_)
+                                                 : options_.render);  // checked: no throw
   }
   for (PassivityObserver& p : passivity_) {
     p.reset();
@@ -151,8 +168,8 @@ void DeviceHostClient::admit_model(const hapsim_msg_LocalModel& m, double now_s,
 
 // haptic path
 Vec3 DeviceHostClient::tool_force(std::size_t tool, const Vec3& p_device_m, double now_s) noexcept {
-  const LocalModelRenderOptions& o = options_.render;
   if (options_.mode == ForceMode::kRaw) {
+    const LocalModelRenderOptions& o = renderers_[tool].options();
     const LocalContactModel& m = raw_models_[tool];
     if (!m.valid) {
       return Vec3::Zero();

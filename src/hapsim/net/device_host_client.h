@@ -45,7 +45,10 @@ enum class ForceMode { kLocalModel, kRaw };
 struct DeviceHostOptions {
   std::uint16_t device_id = 0;
   ForceMode mode = ForceMode::kLocalModel;
+  /// The renderers' options; max_force_n is the tip force's rating.
   LocalModelRenderOptions render;
+  /// The rating of a finger actuator (a force glove), for the tools on a finger; 0: the tip's.
+  double max_finger_force_n = 0.0;
   /// Largest change of a tool's force per second (N/s): 10 N in 5 ms.
   double max_force_rate_n_per_s = 2000.0;
   LocalModelLimits limits;
@@ -55,6 +58,10 @@ struct DeviceHostOptions {
   /// seconds since the client was made). Empty: none.
   std::optional<LinkShimOptions> link;
 };
+
+/// `options.render` with a finger actuator's rating as its force limit (when one is given).
+[[nodiscard]] LocalModelRenderOptions finger_render_options(
+    const DeviceHostOptions& options) noexcept;
 
 /// What the simulation host says it runs (from its SceneInfo): set from any thread, applied by
 /// the haptic thread at its next cycle.

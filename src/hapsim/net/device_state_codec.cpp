@@ -54,7 +54,9 @@ DeviceStateSample decode_device_state(const hapsim_msg_DeviceState& m) noexcept 
   for (std::size_t j = 0; j < static_cast<std::size_t>(kMaxDeviceJoints); ++j) {
     s.input.joint_rad[j] = m.joint_rad[j];
   }
-  s.rendered.finger_count = s.input.finger_count;
+  // Every finger slot travels (zero where the device has no actuator): a glove whose fingers
+  // are driven by joint angles reports no finger angles, yet renders its finger forces.
+  s.rendered.finger_count = kMaxFingers;
   for (int i = 0; i < kMaxFingers; ++i) {
     const auto k = static_cast<std::size_t>(i);
     s.input.finger_rad[k] = m.finger_rad[i];

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hapsim::net {
 
@@ -14,12 +15,42 @@ LocalModelPublisher::LocalModelPublisher(const Participant& participant, const W
       device_(device),
       device_id_(device_id),
       scene_hash_(scene_hash),
-      models_(std::min<std::size_t>(tools, kMaxFingers)) {}
+      models_(std::min<std::size_t>(tools, kMaxFingers)) {
+  for (const ToolDescription& tool : world.description().tools) {
+    tool_finger_.push_back(tool.finger);
+  }
+  rendered_push_n_.assign(tool_finger_.size(), std::numeric_limits<double>::quiet_NaN());
+}
+
+// haptic path
+void rendered_push_per_tool(const DeviceCommand& rendered, std::span<const int> tool_finger,
+                            std::span<double> push_n) noexcept {
+  const std::size_t n = std::min(tool_finger.size(), push_n.size());
+  const auto tip_tools = static_cast<std::size_t>(
+      std::count_if(tool_finger.begin(), tool_finger.begin() + static_cast<std::ptrdiff_t>(n),
+                    [](int finger) { return finger < 0; }));
+  for (std::size_t t = 0; t < n; ++t) {
+    const int finger = tool_finger[t];
+    double push = std::numeric_limits<double>::quiet_NaN();
+    if (finger >= 0 && finger < std::min(rendered.finger_count, kMaxFingers)) {
+      push = rendered.finger_force_n[static_cast<std::size_t>(finger)];
+    } else if (finger < 0 && tip_tools == 1 && rendered.force_world_n.allFinite()) {
+      push = rendered.force_world_n.norm();
+    }
+    push_n[t] =
+        std::isfinite(push) && push >= 0.0 ? push : std::numeric_limits<double>::quiet_NaN();
+  }
+}
 
 // haptic path
 void LocalModelPublisher::before_step(World& world) noexcept {
   if (device_.take_source_switch()) {
     world.forget_tool_motion();
+  }
+  // SPEC §8: the tissue gives way to what the device host rendered, while it drives the tools.
+  if (device_.host_driving()) {
+    rendered_push_per_tool(device_.host_state().rendered, tool_finger_, rendered_push_n_);
+    world.set_rendered_push(rendered_push_n_);
   }
 }
 

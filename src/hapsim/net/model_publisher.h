@@ -14,9 +14,18 @@
 
 #include <atomic>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace hapsim::net {
+
+/// The push each tool's device rendered, read back from the device's command the way a device
+/// host fills it (net/device_host_client.cpp): a tool on finger f felt finger_force_n[f]; the
+/// tools on no finger share force_world_n, so it is theirs when there is exactly one. NaN where
+/// it cannot be told (a finger the command does not carry, several tip tools, non-finite).
+/// `tool_finger[t]` is tool t's finger (-1: none); writes min(sizes) entries. haptic path
+void rendered_push_per_tool(const DeviceCommand& rendered, std::span<const int> tool_finger,
+                            std::span<double> push_n) noexcept;
 
 class LocalModelPublisher final : public WorldCycleObserver {
  public:
@@ -56,6 +65,8 @@ class LocalModelPublisher final : public WorldCycleObserver {
   std::uint16_t device_id_;
   std::uint64_t scene_hash_;
   std::vector<LocalContactModel> models_;
+  std::vector<int> tool_finger_;
+  std::vector<double> rendered_push_n_;  ///< per tool, for World::set_rendered_push
   std::uint64_t sequence_ = 0;
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::uint64_t> refused_{0};

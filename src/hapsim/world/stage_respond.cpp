@@ -7,10 +7,21 @@
 #include "hapsim/world/world_state.h"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <span>
 
 namespace hapsim::stage {
 
 namespace {
+
+// Where one of a tool's sheet pushes went this step (to rescale it once the tool's force is
+// known). A tool presses a handful of sheet segments at most.
+struct SheetPushSlot {
+  SegmentState* sheet = nullptr;
+  std::size_t index = 0;
+};
+constexpr std::size_t kMaxRescaledSheetPushes = 8;
 
 void add_contact(WorldState& state, const WorldContact& contact) noexcept {
   if (state.contact_count < state.contacts.size()) {
@@ -79,6 +90,24 @@ void add_sheet_push(SegmentState& sheet, const Iso3& X_sheet_world, const Vec3& 
       SheetContact{X_sheet_world * p_world, std::max(push_n, 0.0)};
 }
 
+namespace {
+
+// SPEC §8: a sheet pressed by a tool whose device rendered `rendered_push_n` (NaN: not known)
+// gives way to that push, not to the step's `step_push_n`: its pushes scaled by their ratio.
+// haptic path
+void drive_sheets_with_rendered_push(double rendered_push_n, double step_push_n,
+                                     std::span<const SheetPushSlot> pushes) noexcept {
+  if (pushes.empty() || !std::isfinite(rendered_push_n) || !(step_push_n > 0.0)) {
+    return;
+  }
+  const double scale = std::max(rendered_push_n, 0.0) / step_push_n;
+  for (const SheetPushSlot& slot : pushes) {
+    slot.sheet->sheet_pushes[slot.index].force_n *= scale;
+  }
+}
+
+}  // namespace
+
 // haptic path
 void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexcept {
   if (state.rig) {
@@ -124,6 +153,8 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
 
     // Penalty segments, at the tool's own position: F = k·x along the entry side's normal, plus
     // friction where the material has it; the body gets the opposite.
+    std::array<SheetPushSlot, kMaxRescaledSheetPushes> sheet_pushes{};
+    std::size_t sheet_push_count = 0;
     std::size_t next = 0;  // penalty candidates come in segment order
     for (std::size_t i = 0; i < segs.size(); ++i) {
       while (next < tool.penalty_count && tool.penalty[next].segment < i) {
@@ -163,7 +194,12 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
                            f_friction, tool.v_world);
       }
       if (seg.sheet) {
-        add_sheet_push(state.segments[c.segment], body.X_body_world, c.point_world, f);
+        SegmentState& sheet = state.segments[c.segment];
+        if (sheet_push_count < sheet_pushes.size() &&
+            sheet.sheet_push_count < sheet.sheet_pushes.size()) {
+          sheet_pushes[sheet_push_count++] = {&sheet, sheet.sheet_push_count};
+        }
+        add_sheet_push(sheet, body.X_body_world, c.point_world, f);
       }
       total += f;
       add_contact(state, WorldContact{tool_index, static_cast<std::int32_t>(seg.body),
@@ -179,6 +215,8 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
       }
     }
     out.force_world_n = total;
+    drive_sheets_with_rendered_push(state.rendered_push_n[t], total.norm(),
+                                    {sheet_pushes.data(), sheet_push_count});
   }
 }
 

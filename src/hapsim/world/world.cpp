@@ -100,6 +100,12 @@ void World::forget_tool_motion() noexcept {
   }
 }
 
+// haptic path
+void World::set_rendered_push(std::span<const double> push_n) noexcept {
+  const std::size_t n = std::min(push_n.size(), state_.rendered_push_n.size());
+  std::copy_n(push_n.begin(), n, state_.rendered_push_n.begin());
+}
+
 bool World::set_material_contact(std::uint32_t material, const ContactMaterial& c) noexcept {
   const auto positive = [](double v) { return std::isfinite(v) && v > 0.0; };
   const auto non_negative = [](double v) { return std::isfinite(v) && v >= 0.0; };

@@ -19,6 +19,7 @@
 #include "hapsim/world/world_state.h"
 
 #include <cstdint>
+#include <span>
 #include <string>
 
 namespace hapsim {
@@ -49,6 +50,12 @@ class World {
   /// haptic path. The next step takes the tools' positions as new, with no velocity from where
   /// they were (after a pause, the device may have moved far: no damping spike).
   void forget_tool_motion() noexcept;
+  /// haptic path. SPEC §8, for the next step only: the push each tool's device actually rendered
+  /// (N, one per tool; NaN or a missing entry: not known). A sheet a tool presses takes that
+  /// push instead of the step's own force: when the device is on another host rendering a local
+  /// model, the tissue must give way to what the hand felt, or the model's error over the delay
+  /// comes back through the tissue. Entries beyond the tool count are ignored.
+  void set_rendered_push(std::span<const double> push_n) noexcept;
 
   /// The description the world was built from (materials as described: live edits are in
   /// material_contact()).

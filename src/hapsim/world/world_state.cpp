@@ -269,6 +269,7 @@ WorldState::WorldState(const WorldModel& model) {
     }
   }
   tool_states.resize(tool_count);
+  rendered_push_n.assign(tool_count, std::numeric_limits<double>::quiet_NaN());
   // Per tool: at most kMaxContacts proxy contacts plus one per penalty segment.
   contacts.resize(std::max<std::size_t>(
       tool_count *

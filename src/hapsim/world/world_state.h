@@ -374,6 +374,9 @@ struct WorldState {
 
   // Outputs of the step (respond and safety stages).
   std::vector<ToolState> tool_states;
+  /// Per tool, the push its device rendered (World::set_rendered_push), for this step's sheet
+  /// pushes; NaN: not known. Cleared to NaN after each step.
+  std::vector<double> rendered_push_n;
   std::vector<WorldContact> contacts;  ///< capacity fixed at construction
   std::size_t contact_count = 0;
   std::int32_t dropped_contacts = 0;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hapsim {
 
@@ -72,6 +73,8 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   stage::integrate(model, state, dt);
   stage::deform(model, state, dt);
   stage::safety(model, state);
+  std::fill(state.rendered_push_n.begin(), state.rendered_push_n.end(),
+            std::numeric_limits<double>::quiet_NaN());  // one step's input
 
   StepResult& r = state.result;
   r.time_s = state.time_s;
