@@ -69,6 +69,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   double probe[3] = {};
   r.read(probe);
   r.read(m.max_normal_force_n);  // after the older fields: the committed seeds end before it
+  r.read(m.profile_count);       // and the profile after that
+  r.read(m.profile_depth_m);
+  r.read(m.profile_push_n);
   if ((control & 1U) != 0) {
     m.device_id = kDevice;
     m.scene_hash = kSceneHash;

@@ -37,6 +37,27 @@ TEST(LocalContactModel, SeriesStiffness) {
   EXPECT_EQ(series_stiffness_n_per_m(std::numeric_limits<double>::quiet_NaN(), 1.0), 0.0);
 }
 
+// A profile along the normal: linear between its points, the end slopes beyond, in place of
+// f0 + K·(x − x0) along the normal only; across it and for damping the linear model stays.
+TEST(LocalContactModel, AProfileReplacesTheLinearSpringAlongTheNormal) {
+  LocalContactModel m = wall_model();  // normal +z, x0 at z = −1 mm, f0 1 N, K 1000, B 2
+  m.stiffness_n_per_m(0, 0) = 500.0;   // across the normal too
+  m.profile_count = 3;
+  m.profile_depth_m = {-0.001, 0.0, 0.002};
+  m.profile_push_n = {0.0, 1.0, 5.0};  // 1000 N/m, then 2000 N/m deeper
+  EXPECT_DOUBLE_EQ(profile_push_n(m, 0.001), 3.0);
+  EXPECT_DOUBLE_EQ(profile_push_n(m, 0.004), 9.0);    // the last slope beyond the end
+  EXPECT_DOUBLE_EQ(profile_push_n(m, -0.002), -1.0);  // the first slope before the start
+  // 3 mm deeper than x0 and 1 mm across, moving in at 0.1 m/s.
+  const Vec3 x = m.x0_world_m + Vec3(0.001, 0.0, -0.003);
+  const Vec3 f = local_model_force(m, x, Vec3(0.0, 0.0, -0.1));
+  EXPECT_NEAR(f.z(), 7.0 + 2.0 * 0.1, 1e-12);  // the profile at 3 mm, plus damping
+  EXPECT_NEAR(f.x(), -0.5, 1e-12);             // K across the normal, as without a profile
+  m.profile_count = 0;
+  EXPECT_NEAR(local_model_force(m, x, Vec3(0.0, 0.0, -0.1)).z(), 4.0 + 0.2, 1e-12);
+  EXPECT_TRUE(std::isnan(profile_push_n(m, 0.001)));
+}
+
 TEST(LocalContactModel, TissueCoupledForceIsTheQuasiStaticForceForSeriesStiffness) {
   // Linear tissue k_t = 500 under a contact k_c = 2000: series 400 N/m. At x0 = 10 mm with the
   // tissue settled under a rendered 3 N (y = 6 mm, compression 4 mm), the quasi-static force at

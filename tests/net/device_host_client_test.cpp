@@ -12,6 +12,7 @@
 
 #include <chrono>
 #include <optional>
+#include <string>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -82,7 +83,10 @@ class DeviceHostClientTest : public ::testing::Test {
     return m;
   }
 
-  Participant participant{kDomain, "device-host-client"};
+  // A session (DDS partition) per test: ctest runs the tests of this file side by side.
+  Participant participant{
+      kDomain,
+      std::string("dhc-") + ::testing::UnitTest::GetInstance()->current_test_info()->name()};
   std::optional<DeviceHostClient> client;
   TopicWriter<hapsim_msg_LocalModel> models_out{participant};
   TopicReader<hapsim_msg_DeviceState> states_in{participant};

@@ -150,9 +150,7 @@ TEST(LinkSweep, LocalModelMeetsItsTargetsOnAReducedGrid) {
     EXPECT_LT(std::abs(row.steady_force_error), 0.05);
     EXPECT_LT(r.hold_ripple_rms_n, 0.05);
     EXPECT_LE(r.peak_force_n, kPlant.max_force_n);
-    const bool known_miss = c.environment == SweepEnvironment::kTissue &&
-                            c.hand == SweepHand::kStiff && c.delay_s >= 0.05;
-    EXPECT_LT(r.energy_generated_j, known_miss ? 0.030 : 0.020);
+    EXPECT_LT(r.energy_generated_j, 0.020);
     // Every reordered sample was refused by sequence, and nothing else was refused.
     EXPECT_EQ(r.refused_out_of_order, r.reordered);
     EXPECT_EQ(r.refused_other, 0u);
@@ -160,6 +158,22 @@ TEST(LinkSweep, LocalModelMeetsItsTargetsOnAReducedGrid) {
       EXPECT_GT(r.reordered, 0u);  // jitter U[0, d/2] at 1 kHz reorders
     }
   }
+}
+
+// A linear model a round trip old is too soft on a stiffening tissue for the depth the device has
+// reached since: the stiff hand's press at 100 ms generates energy beyond the 20 mJ target
+// without the tissue's profile, and far less with it.
+TEST(LinkSweep, TheTissuesProfileIsWhatKeepsALongLinkFromGeneratingEnergy) {
+  LinkCase c =
+      make_case(ForceMode::kLocalModel, SweepEnvironment::kTissue, SweepHand::kStiff, 100, 0.0);
+  const LinkRun with_profile = run_link_case(c);
+  c.tissue_profile = false;
+  const LinkRun linear = run_link_case(c);
+  EXPECT_GT(linear.energy_generated_j, 0.020);
+  EXPECT_LT(with_profile.energy_generated_j, 0.020);
+  EXPECT_LT(with_profile.energy_generated_j, 0.5 * linear.energy_generated_j);
+  EXPECT_TRUE(with_profile.stable);
+  EXPECT_NEAR(with_profile.steady_force_n, tissue_hold_n(c.hand), 0.01 * tissue_hold_n(c.hand));
 }
 
 TEST(LinkSweep, OutageFadesTheLocalModelToZeroAndRawHoldsItsLastForce) {

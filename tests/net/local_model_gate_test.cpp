@@ -3,6 +3,7 @@
 #include "net/net_test_support.h"
 #include "support/allocation_counter.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -31,6 +32,49 @@ TEST(LocalModelCodec, RoundTripsEveryFieldBitForBit) {
   EXPECT_EQ(
       decode_local_model(encode_local_model(capped, {kDeviceId, 0}, kSceneHash)).max_normal_force_n,
       9.2);
+  // A profile travels point by point.
+  LocalContactModel stiffening = test::model_for(44);
+  stiffening.profile_count = 3;
+  stiffening.profile_depth_m = {-0.002, 0.0, 0.004};
+  stiffening.profile_push_n = {0.0, 1.0, 5.0};
+  const hapsim_msg_LocalModel with_profile =
+      encode_local_model(stiffening, {kDeviceId, 0}, kSceneHash);
+  EXPECT_EQ(with_profile.profile_count, 3);
+  EXPECT_TRUE(test::same_bits(with_profile, encode_local_model(decode_local_model(with_profile),
+                                                               {kDeviceId, 0}, kSceneHash)));
+  EXPECT_EQ(decode_local_model(with_profile).profile_push_n[2], 5.0);
+}
+
+// A profile must be a spring that pushes no less the deeper it goes, with at least two points.
+TEST(LocalModelGate, RefusesAProfileThatIsNotAConservativeSpring) {
+  const auto with_profile = [](std::uint64_t sequence, std::uint16_t count,
+                               std::array<double, 3> depth_m, std::array<double, 3> push_n) {
+    hapsim_msg_LocalModel m = message_for(sequence);
+    m.profile_count = count;
+    for (std::size_t i = 0; i < 3; ++i) {
+      m.profile_depth_m[i] = depth_m[i];
+      m.profile_push_n[i] = push_n[i];
+    }
+    return m;
+  };
+  LocalModelGate gate(kDeviceId, kSceneHash, 1);
+  LocalContactModel out;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(gate.admit(with_profile(10, 1, {0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}), kNow, out),
+            SampleVerdict::kMalformed);  // one point is no profile
+  EXPECT_EQ(gate.admit(with_profile(10, 9, {0.0, 0.001, 0.002}, {1.0, 2.0, 3.0}), kNow, out),
+            SampleVerdict::kMalformed);  // more than the wire holds
+  EXPECT_EQ(gate.admit(with_profile(10, 3, {0.0, nan, 0.002}, {1.0, 2.0, 3.0}), kNow, out),
+            SampleVerdict::kMalformed);
+  EXPECT_EQ(gate.admit(with_profile(10, 3, {0.0, 0.001, 0.002}, {1.0, 0.5, 3.0}), kNow, out),
+            SampleVerdict::kOutOfRange);  // pushes less deeper in: energy out
+  EXPECT_EQ(gate.admit(with_profile(10, 3, {0.0, 0.002, 0.002}, {1.0, 2.0, 3.0}), kNow, out),
+            SampleVerdict::kOutOfRange);  // two pushes at one depth
+  EXPECT_EQ(gate.admit(with_profile(10, 3, {0.0, 0.001, 0.002}, {1.0, 2.0, 1e6}), kNow, out),
+            SampleVerdict::kOutOfRange);
+  EXPECT_EQ(gate.admit(with_profile(10, 3, {-0.002, 0.0, 0.004}, {0.0, 1.0, 5.0}), kNow, out),
+            SampleVerdict::kAccepted);
+  EXPECT_EQ(out.profile_count, 3);
 }
 
 TEST(LocalModelGate, AcceptsInOrderAndCountsEachReason) {

@@ -59,7 +59,8 @@ inline bool same_bits(const hapsim_msg_LocalModel& a, const hapsim_msg_LocalMode
          eq(a.stiffness_n_per_m, b.stiffness_n_per_m) &&
          eq(a.damping_n_s_per_m, b.damping_n_s_per_m) && eq(a.normal, b.normal) &&
          eq(a.validity_radius_m, b.validity_radius_m) && a.valid == b.valid &&
-         eq(a.max_normal_force_n, b.max_normal_force_n);
+         eq(a.max_normal_force_n, b.max_normal_force_n) && a.profile_count == b.profile_count &&
+         eq(a.profile_depth_m, b.profile_depth_m) && eq(a.profile_push_n, b.profile_push_n);
 }
 
 }  // namespace hapsim::net::test

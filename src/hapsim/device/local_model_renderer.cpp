@@ -29,6 +29,19 @@ bool usable(const LocalContactModel& m) noexcept {
       return false;
     }
   }
+  // A profile, like K, must not push harder as the device backs out.
+  if (m.profile_count < 0 || m.profile_count == 1 ||
+      m.profile_count > LocalContactModel::kMaxProfilePoints) {
+    return false;
+  }
+  for (int i = 0; i < m.profile_count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (!std::isfinite(m.profile_depth_m[k]) || !std::isfinite(m.profile_push_n[k]) ||
+        (i > 0 && !(m.profile_depth_m[k] > m.profile_depth_m[k - 1] &&
+                    m.profile_push_n[k] >= m.profile_push_n[k - 1]))) {
+      return false;
+    }
+  }
   return true;
 }
 

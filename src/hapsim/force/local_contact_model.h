@@ -17,6 +17,7 @@
 
 #include "hapsim/core/types.h"
 
+#include <array>
 #include <cstdint>
 #include <limits>
 
@@ -41,6 +42,17 @@ struct LocalContactModel {
   /// deeper in, a saturated contact pushes no harder, and the linear model must not say it does.
   /// Infinite: no limit.
   double max_normal_force_n = std::numeric_limits<double>::infinity();
+  /// Where the contact is not linear along its normal (a stiffening tissue), its push along the
+  /// normal against the depth beyond x0 (metres along −normal): `profile_count` points, depth
+  /// increasing and push non-decreasing (a conservative spring), interpolated linearly and
+  /// extended past the ends with the end segments' slopes. Along the normal it takes the place
+  /// of f0 + K·(x − x0); across it, and for the damping, the linear model stays. Fewer than two
+  /// points: no profile. A linear model a round trip old is too soft on a stiffening tissue
+  /// for the depth the device has reached since; the profile carries how it stiffens.
+  static constexpr int kMaxProfilePoints = 8;
+  std::array<double, kMaxProfilePoints> profile_depth_m{};
+  std::array<double, kMaxProfilePoints> profile_push_n{};
+  int profile_count = 0;
   /// Simulation time of the step that made it (the simulation's clock; the device never compares
   /// it with its own).
   double sim_time_s = 0.0;
@@ -59,11 +71,16 @@ struct LocalContactModel {
 [[nodiscard]] double series_stiffness_n_per_m(double contact_stiffness_n_per_m,
                                               double tissue_stiffness_n_per_m) noexcept;
 
-/// The model's force at the device's (x, v): f0 − K·(x − x0) − B·(v − v0); zero for an invalid
-/// model or non-finite input. No validity radius, clamping or push-only rule: the device's
-/// renderer (device/local_model_renderer.h) applies those. haptic path
+/// The model's force at the device's (x, v): f0 − K·(x − x0) − B·(v − v0), its push along the
+/// normal from the profile where there is one; zero for an invalid model or non-finite input. No
+/// validity radius, clamping or push-only rule: the device's renderer
+/// (device/local_model_renderer.h) applies those. haptic path
 [[nodiscard]] Vec3 local_model_force(const LocalContactModel& model, const Vec3& x_world_m,
                                      const Vec3& v_world_m_per_s) noexcept;
+
+/// The profile's push at `depth_m` beyond x0 (linear between points, the end slopes beyond);
+/// NaN without a profile. haptic path
+[[nodiscard]] double profile_push_n(const LocalContactModel& model, double depth_m) noexcept;
 
 /// The force a model should carry when the simulation's tissue is driven by the force the device
 /// actually rendered (SPEC §8), along the contact normal: the rendered force F_r, corrected by

@@ -8,6 +8,7 @@
 #include "hapsim/net/local_model_gate.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -71,6 +72,31 @@ double model_stiffness_n_per_m(const LinkCase& c, double tissue_depth) {
                                   tissue_stiffness_n_per_m(p, tissue_depth));
 }
 
+// How the tissue stiffens about x0: the settled force's rise from x0 at a few depths around it
+// (down to the surface, which pushes nothing), added to f0 (force/local_contact_model.h).
+void fill_tissue_profile(const OneDofPlant& p, double x0_m, double f0_n, LocalContactModel& m) {
+  constexpr std::array<double, 8> kOffsets_m{-0.016, -0.008, -0.004, 0.0,
+                                             0.004,  0.008,  0.016,  0.032};
+  const double at_x0_n = quasi_static_force_n(p, SweepEnvironment::kTissue, x0_m);
+  int count = 0;
+  const auto add = [&](double depth_m) {
+    const auto k = static_cast<std::size_t>(count++);
+    m.profile_depth_m[k] = depth_m;
+    m.profile_push_n[k] =
+        f0_n + quasi_static_force_n(p, SweepEnvironment::kTissue, x0_m + depth_m) - at_x0_n;
+  };
+  if (x0_m > 0.0 && x0_m + kOffsets_m.front() < 0.0) {
+    add(-x0_m);  // the surface
+  }
+  for (const double offset_m : kOffsets_m) {
+    if (x0_m + offset_m > 0.0 && offset_m > (count > 0 ? m.profile_depth_m[count - 1] : -1.0) &&
+        count < LocalContactModel::kMaxProfilePoints) {
+      add(offset_m);
+    }
+  }
+  m.profile_count = count >= 2 ? count : 0;
+}
+
 // The simulation's local model for a device state (SPEC §8): its tissue sits where the force the
 // device rendered put it, and f0 is corrected for it (force/local_contact_model.h).
 LocalContactModel make_model(const LinkCase& c, const DeviceStateSample& s,
@@ -91,6 +117,9 @@ LocalContactModel make_model(const LinkCase& c, const DeviceStateSample& s,
   m.damping_n_s_per_m = p.contact_damping_n_s_per_m * kIn * kIn.transpose();
   m.normal_world = -kIn;
   m.validity_radius_m = p.validity_radius_m;
+  if (!wall && c.tissue_profile) {
+    fill_tissue_profile(p, x_m, f0_n, m);
+  }
   m.sim_time_s = s.input.time_s;
   m.sequence = sequence;
   m.device_sequence = s.sequence;

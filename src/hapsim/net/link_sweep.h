@@ -126,6 +126,9 @@ struct LinkCase {
   double fade_s = 0.05;
   double reengage_s = 0.5;
   ModelStiffness model_stiffness = ModelStiffness::kSeries;
+  /// The tissue's models carry how it stiffens along the normal (LocalContactModel's profile);
+  /// false: the linear model alone (K at the tissue's current depth).
+  bool tissue_profile = true;
   std::uint64_t seed = 1;
   OneDofPlant plant;
 };

@@ -1,5 +1,6 @@
 #include "hapsim/net/local_model_codec.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -56,6 +57,12 @@ hapsim_msg_LocalModel encode_local_model(const LocalContactModel& model, Contact
   m.validity_radius_m = model.validity_radius_m;
   m.valid = model.valid;
   m.max_normal_force_n = std::isinf(model.max_normal_force_n) ? -1.0 : model.max_normal_force_n;
+  const int points = std::clamp(model.profile_count, 0, LocalContactModel::kMaxProfilePoints);
+  m.profile_count = static_cast<std::uint16_t>(points);
+  for (int i = 0; i < points; ++i) {
+    m.profile_depth_m[i] = model.profile_depth_m[static_cast<std::size_t>(i)];
+    m.profile_push_n[i] = model.profile_push_n[static_cast<std::size_t>(i)];
+  }
   return m;
 }
 
@@ -75,6 +82,11 @@ LocalContactModel decode_local_model(const hapsim_msg_LocalModel& m) noexcept {
   model.valid = m.valid;
   model.max_normal_force_n =
       m.max_normal_force_n < 0.0 ? std::numeric_limits<double>::infinity() : m.max_normal_force_n;
+  model.profile_count = std::min<int>(m.profile_count, LocalContactModel::kMaxProfilePoints);
+  for (int i = 0; i < model.profile_count; ++i) {
+    model.profile_depth_m[static_cast<std::size_t>(i)] = m.profile_depth_m[i];
+    model.profile_push_n[static_cast<std::size_t>(i)] = m.profile_push_n[i];
+  }
   return model;
 }
 

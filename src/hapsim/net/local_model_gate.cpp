@@ -15,6 +15,26 @@ LocalModelGate::LocalModelGate(std::uint16_t device_id, std::uint64_t scene_hash
       finger_count_(std::clamp(finger_count, 1, kMaxFingers)),
       limits_(limits) {}
 
+namespace {
+
+// A profile is a conservative spring along the normal: depths strictly increasing, pushes never
+// falling (a falling push would give energy back as the device goes in), all within the limits.
+bool profile_ok(const hapsim_msg_LocalModel& m, const LocalModelLimits& limits) noexcept {
+  for (int i = 0; i < m.profile_count; ++i) {
+    if (std::abs(m.profile_depth_m[i]) > limits.max_validity_radius_m ||
+        std::abs(m.profile_push_n[i]) > limits.max_force_n) {
+      return false;
+    }
+    if (i > 0 && !(m.profile_depth_m[i] > m.profile_depth_m[i - 1] &&
+                   m.profile_push_n[i] >= m.profile_push_n[i - 1])) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 std::uint64_t LocalModelGate::rejected() const noexcept {
   std::uint64_t sum = 0;
   for (std::size_t i = 1; i < kSampleVerdicts; ++i) {
@@ -28,7 +48,9 @@ SampleVerdict LocalModelGate::check(const hapsim_msg_LocalModel& m,
   if (m.finger >= finger_count_ || !std::isfinite(m.sim_time_s) || !all_finite(m.x0_m) ||
       !all_finite(m.v0_m_per_s) || !all_finite(m.f0_n) || !all_finite(m.stiffness_n_per_m) ||
       !all_finite(m.damping_n_s_per_m) || !all_finite(m.normal) ||
-      !std::isfinite(m.validity_radius_m) || !std::isfinite(m.max_normal_force_n)) {
+      !std::isfinite(m.validity_radius_m) || !std::isfinite(m.max_normal_force_n) ||
+      m.profile_count > LocalContactModel::kMaxProfilePoints || m.profile_count == 1 ||
+      !all_finite(m.profile_depth_m) || !all_finite(m.profile_push_n)) {
     return SampleVerdict::kMalformed;
   }
   if (m.device_id != device_id_) {
@@ -52,7 +74,8 @@ SampleVerdict LocalModelGate::check(const hapsim_msg_LocalModel& m,
       !(m.validity_radius_m >= 0.0 && m.validity_radius_m <= limits_.max_validity_radius_m) ||
       !diagonal_ok || !normal_ok || m.device_sequence > device_sequence_now ||
       !(m.max_normal_force_n == -1.0 ||
-        (m.max_normal_force_n >= 0.0 && m.max_normal_force_n <= limits_.max_force_n))) {
+        (m.max_normal_force_n >= 0.0 && m.max_normal_force_n <= limits_.max_force_n)) ||
+      !profile_ok(m, limits_)) {
     return SampleVerdict::kOutOfRange;
   }
   const auto finger = static_cast<std::size_t>(m.finger);
