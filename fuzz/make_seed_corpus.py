@@ -126,11 +126,41 @@ def device_state_seeds():
     write(t, "all_ones", b"\xff" * len(full))
 
 
+# --- command: control, hapsim_msg_Command fields -----------------------------------------------
+def command(control=1, issuer=7, seq=1, scene=SCENE, serve=0x5E5E5E5E5E5E5E5E, kind=4,
+            material=1, fields=0b000101, values=(800.0, 0.01, 4.0, 1.0, 0.3, 0.2)):
+    return (struct.pack("<BQQQQHIH", control, issuer, seq, scene, serve, kind, material, fields) +
+            struct.pack("<6d", *values))
+
+
+def command_seeds():
+    t = "command"
+    full = command()
+    write(t, "empty", b"")
+    write(t, "short", full[:20])
+    write(t, "material", full)
+    write(t, "pause", command(kind=1, fields=0))
+    write(t, "resume", command(kind=2, fields=0))
+    write(t, "reset", command(kind=3, fields=0))
+    write(t, "unknown_kind", command(kind=9))
+    write(t, "unknown_field", command(fields=0b1000000))
+    write(t, "no_field", command(fields=0))
+    write(t, "material_out_of_range", command(material=4))
+    write(t, "nan_stiffness", command(values=(NAN, 0.01, 4.0, 1.0, 0.3, 0.2)))
+    write(t, "negative_force", command(values=(800.0, 0.01, -4.0, 1.0, 0.3, 0.2)))
+    write(t, "huge_stiffness", command(values=(1e300, 0.01, 4.0, 1.0, 0.3, 0.2)))
+    write(t, "nan_unset_field", command(fields=0b000001, values=(800.0, NAN, INF, NAN, NAN, NAN)))
+    write(t, "other_scene", command(control=0, scene=1))
+    write(t, "other_serve", command(control=0, serve=1))
+    write(t, "all_ones", b"\xff" * len(full))
+
+
 if __name__ == "__main__":
     if CORPUS.exists():
         shutil.rmtree(CORPUS)
     legacy_seeds()
     local_model_seeds()
     device_state_seeds()
+    command_seeds()
     for folder in sorted(CORPUS.iterdir()):
         print(f"{folder.relative_to(HERE.parent)}: {len(list(folder.iterdir()))} seeds")

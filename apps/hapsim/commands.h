@@ -27,5 +27,6 @@ void add_kinematics_commands(CLI::App& app);
 void add_serve_command(CLI::App& app);
 void add_device_command(CLI::App& app);
 void add_watch_command(CLI::App& app);
+void add_control_command(CLI::App& app);
 
 }  // namespace hapsim::app

@@ -15,6 +15,7 @@
 #include "session_json.h"
 #include "stop_signal.h"
 
+#include "hapsim/net/command_receiver.h"
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/legacy_force_udp.h"
 #include "hapsim/net/link_shim_spec.h"
@@ -31,6 +32,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cinttypes>
@@ -43,10 +45,12 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <numeric>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 namespace hapsim::app {
 namespace {
@@ -77,18 +81,33 @@ std::string read_text(const std::string& path) {
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
-// Off the haptic thread: publishes the newest snapshot for viewers at the view rate and prints
-// every change of who drives the world, until `done`.
+// Off the haptic thread: publishes the newest snapshot for viewers at the view rate, acts on the
+// commands viewers and operators send (net/command_receiver.h) and prints every change of who
+// drives the world and every command, until `done`.
 class ServeMonitor {
  public:
   ServeMonitor(const net::Participant& participant, const World& world, std::uint64_t hash,
                std::uint64_t serve_id, const net::RemoteDevice& device, double view_rate_hz)
       : views_out_(participant),
         encoder_(world),
+        commands_(participant, world, hash, serve_id),
         hash_(hash),
         serve_id_(serve_id),
         device_(device),
-        period_(std::chrono::microseconds(static_cast<std::int64_t>(1e6 / view_rate_hz))) {}
+        period_(std::chrono::microseconds(static_cast<std::int64_t>(1e6 / view_rate_hz))) {
+    for (const MaterialDescription& m : world.description().materials) {
+      material_names_.push_back(m.name);
+    }
+  }
+
+  /// The loop's client, or null once the loop stopped (returns once the monitor let go of it).
+  void set_client(WorldHapticClient* client) {
+    const std::lock_guard<std::mutex> lock(snapshots_mutex_);
+    if (client == nullptr && client_ != nullptr) {
+      refused_materials_ = client_->refused_material_changes();
+    }
+    client_ = client;
+  }
 
   /// The loop's snapshots, or null when they go away (returns once the monitor let go of them).
   void set_snapshots(TripleBuffer<WorldSnapshot>* snapshots) {
@@ -106,6 +125,9 @@ class ServeMonitor {
     }
   }
   [[nodiscard]] std::uint64_t views_published() const { return views_; }
+  /// After stop(): the commands' verdicts, and material changes the world refused.
+  [[nodiscard]] const net::VerdictCounts& command_verdicts() const { return commands_.counts(); }
+  [[nodiscard]] std::uint64_t refused_material_changes() const { return refused_materials_; }
 
  private:
   void run() {
@@ -126,9 +148,22 @@ class ServeMonitor {
         std::fflush(stdout);
       }
       const std::lock_guard<std::mutex> lock(snapshots_mutex_);
-      if (snapshots_ != nullptr && snapshots_->update()) {
+      commands_.poll(client_, [&](const net::CommandEvent& event) {
+        // Each refusal reason said once (a flood of bad commands must not flood the output);
+        // the counts are in the summary.
+        const auto v = static_cast<std::size_t>(event.verdict);
+        if (event.verdict == net::SampleVerdict::kAccepted || !refusal_said_[v]) {
+          refusal_said_[v] = event.verdict != net::SampleVerdict::kAccepted;
+          std::printf("command      %s at %.3f s\n",
+                      net::describe_command_event(event, material_names_).c_str(), t_s);
+          std::fflush(stdout);
+        }
+      });
+      const bool paused = client_ != nullptr && client_->paused();
+      if (snapshots_ != nullptr && (snapshots_->update() || paused != view_paused_)) {
+        view_paused_ = paused;
         views_ += views_out_.write(encoder_.encode(snapshots_->read_slot(), hash_, serve_id_,
-                                                   device_.host_driving()))
+                                                   device_.host_driving(), paused))
                       ? 1
                       : 0;
       }
@@ -137,6 +172,12 @@ class ServeMonitor {
 
   net::TopicWriter<hapsim_msg_ViewState> views_out_;
   net::ViewStateEncoder encoder_;
+  net::CommandReceiver commands_;
+  std::vector<std::string> material_names_;
+  std::array<bool, net::kSampleVerdicts> refusal_said_{};
+  WorldHapticClient* client_ = nullptr;  // guarded by snapshots_mutex_
+  bool view_paused_ = false;
+  std::uint64_t refused_materials_ = 0;
   std::uint64_t hash_;
   std::uint64_t serve_id_;
   const net::RemoteDevice& device_;
@@ -259,6 +300,7 @@ void serve(const ServeArgs& args) {
   options.realtime = true;
   options.observer = &publisher;
   options.on_snapshots = [&monitor](TripleBuffer<WorldSnapshot>* s) { monitor.set_snapshots(s); };
+  options.on_client = [&monitor](WorldHapticClient* c) { monitor.set_client(c); };
   options.stop = &stop;
   monitor.start();
   SessionSummary summary;
@@ -283,6 +325,17 @@ void serve(const ServeArgs& args) {
     std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
                 verdicts[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
   }
+  const net::VerdictCounts& commands = monitor.command_verdicts();
+  const std::uint64_t commands_received = std::accumulate(commands.begin(), commands.end(), 0ULL);
+  if (commands_received > 0) {
+    std::printf("commands     %" PRIu64 " received:", commands_received);
+    for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
+      std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
+                  commands[v], v + 1 < net::kSampleVerdicts ? "," : "");
+    }
+    std::printf("; material changes the world refused: %" PRIu64 "\n",
+                monitor.refused_material_changes());
+  }
   if (!args.link_shim.empty()) {
     std::printf("link shim    lost %" PRIu64 " device states\n", remote.link_lost());
   }
@@ -305,9 +358,11 @@ void serve(const ServeArgs& args) {
                   {"lockstep_timeouts", remote.lockstep_timeouts()},
                   {"peak_rendered_force_n", publisher.peak_rendered_force_n()}};
     for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
-      j["serve"]["device_states"][net::verdict_name(static_cast<net::SampleVerdict>(v))] =
-          verdicts[v];
+      const char* verdict = net::verdict_name(static_cast<net::SampleVerdict>(v));
+      j["serve"]["device_states"][verdict] = verdicts[v];
+      j["serve"]["commands"][verdict] = commands[v];
     }
+    j["serve"]["refused_material_changes"] = monitor.refused_material_changes();
     j["ok"] = summary.pop_throughs == 0 && summary.max_force_limit_violations == 0;
     json_out.write(j);
   }

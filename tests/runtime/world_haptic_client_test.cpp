@@ -255,6 +255,49 @@ TEST(WorldHapticClient, RecordsAreNumberedByTheCyclesThatStepped) {
   EXPECT_EQ(expected, 120u);
 }
 
+// Counts which of its calls came in which cycle (a served world publishes from them).
+class CountingObserver final : public WorldCycleObserver {
+ public:
+  void before_step(World& /*world*/) noexcept override { ++before; }
+  void after_step(const World& /*world*/, const HapticCycle& cycle) noexcept override {
+    ++stepped;
+    last_stepped_cycle = cycle.index;
+  }
+  void after_paused_cycle(const World& /*world*/, const HapticCycle& cycle) noexcept override {
+    ++paused;
+    last_paused_cycle = cycle.index;
+  }
+  std::uint64_t before = 0;
+  std::uint64_t stepped = 0;
+  std::uint64_t paused = 0;
+  std::uint64_t last_stepped_cycle = 0;
+  std::uint64_t last_paused_cycle = 0;
+};
+
+TEST(WorldHapticClient, TheObserverHearsOfEveryCycleSteppedOrPaused) {
+  World world(test::two_body_world());
+  CountingObserver observer;
+  WorldHapticClientOptions co;
+  co.publish_snapshots = false;
+  co.observer = &observer;
+  WorldHapticClient client(world, co);
+  for (std::uint64_t i = 0; i < 100; ++i) {
+    client.set_paused(i >= 30 && i < 70);
+    const DeviceInput in = press_ball(0.001 * static_cast<double>(i));
+    const DeviceCommand out = client.step(in, 0.001);
+    HapticCycle cycle;
+    cycle.index = i;
+    cycle.input = &in;
+    cycle.output = &out;
+    client.after_cycle(cycle);
+  }
+  EXPECT_EQ(observer.before, 60u);
+  EXPECT_EQ(observer.stepped, 60u);
+  EXPECT_EQ(observer.paused, 40u);
+  EXPECT_EQ(observer.last_paused_cycle, 69u);
+  EXPECT_EQ(observer.last_stepped_cycle, 99u);
+}
+
 TEST(WorldHapticClient, ResetAndPauseReachTheSnapshot) {
   World world(test::two_body_world());
   SimulatedDevice device(device_profile("omega3"), press_ball, 1.0);

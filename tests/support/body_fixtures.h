@@ -1,5 +1,5 @@
 // Bodies and materials the world tests of dynamic bodies share: a penalty material with Coulomb
-// friction, a static floor box whose top face is z = 0, a probe input.
+// friction, a static floor box whose top face is z = 0, a Gaussian sheet, a probe input.
 #pragma once
 
 #include "hapsim/geometry/procedural.h"
@@ -31,6 +31,21 @@ inline BodyDescription floor_body(std::uint32_t material) {
   s.name = "floor";
   s.material = material;
   s.mesh = make_box(Vec3(0.3, 0.3, 0.05));
+  b.segments.push_back(std::move(s));
+  return b;
+}
+
+/// A Gaussian sheet (two-sided, its default grid and side) at z = 0 of the world.
+inline BodyDescription sheet_body(std::uint32_t material) {
+  BodyDescription b;
+  b.name = "sheet";
+  b.kind = BodyKind::kDeformable;
+  b.deformation = BodyDeformation::kGaussianSheet;
+  SegmentDescription s;
+  s.name = "sheet";
+  s.material = material;
+  s.mesh = make_sheet(b.sheet.nodes_per_side, b.sheet.side_m);
+  s.two_sided = true;
   b.segments.push_back(std::move(s));
   return b;
 }

@@ -22,6 +22,7 @@ namespace {
 
 using test::floor_body;
 using test::probe_at;
+using test::sheet_body;
 
 constexpr double kBallRadius = 0.03;
 constexpr double kBallMass = 0.1;
@@ -44,20 +45,6 @@ BodyDescription ball_body(const Vec3& p_world, std::uint32_t material) {
   b.segments.push_back(std::move(s));
   b.rigid.mass_kg = kBallMass;
   b.rigid.inertia_kg_m2 = Mat3::Identity() * 0.4 * kBallMass * kBallRadius * kBallRadius;
-  return b;
-}
-
-BodyDescription sheet_body(std::uint32_t material) {
-  BodyDescription b;
-  b.name = "sheet";
-  b.kind = BodyKind::kDeformable;
-  b.deformation = BodyDeformation::kGaussianSheet;
-  SegmentDescription s;
-  s.name = "sheet";
-  s.material = material;
-  s.mesh = make_sheet(b.sheet.nodes_per_side, b.sheet.side_m);
-  s.two_sided = true;
-  b.segments.push_back(std::move(s));
   return b;
 }
 

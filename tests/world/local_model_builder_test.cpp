@@ -7,6 +7,7 @@
 #include "hapsim/world/world.h"
 
 #include "support/allocation_counter.h"
+#include "support/body_fixtures.h"
 
 #include <cmath>
 
@@ -140,16 +141,7 @@ TEST(LocalModelBuilder, ASheetsComplianceIsInSeriesWithTheContact) {
   w.name = "sheet";
   w.materials.push_back(penalty_material(1000.0, 0.02, 10.0));
   w.passivity_damping_factor = 0.0;
-  BodyDescription b;
-  b.name = "sheet";
-  b.kind = BodyKind::kDeformable;
-  b.deformation = BodyDeformation::kGaussianSheet;
-  SegmentDescription s;
-  s.name = "sheet";
-  s.mesh = make_sheet(b.sheet.nodes_per_side, b.sheet.side_m);
-  s.two_sided = true;
-  b.segments.push_back(std::move(s));
-  w.bodies.push_back(std::move(b));
+  w.bodies.push_back(test::sheet_body(0));
   w.tools.push_back(ToolDescription{"tip", 0.0, Vec3::Zero(), -1});
   World world(std::move(w));
   const LocalModelBuilder builder(world.model());

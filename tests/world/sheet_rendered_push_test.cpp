@@ -8,6 +8,8 @@
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/world/world.h"
 
+#include "support/body_fixtures.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -23,24 +25,9 @@ constexpr double kContactStiffness_n_per_m = 1000.0;
 WorldDescription sheet_world() {
   WorldDescription w;
   w.name = "sheet";
-  MaterialDescription m;
-  m.name = "tissue";
-  m.response = ContactResponse::kPenalty;
-  m.contact.stiffness_n_per_m = kContactStiffness_n_per_m;
-  m.contact.max_penetration_m = 0.02;
-  m.contact.max_force_n = 10.0;
-  w.materials.push_back(m);
+  w.materials.push_back(test::penalty_material("tissue", kContactStiffness_n_per_m, 10.0, 0.0));
   w.passivity_damping_factor = 0.0;
-  BodyDescription b;
-  b.name = "sheet";
-  b.kind = BodyKind::kDeformable;
-  b.deformation = BodyDeformation::kGaussianSheet;
-  SegmentDescription s;
-  s.name = "sheet";
-  s.mesh = make_sheet(b.sheet.nodes_per_side, b.sheet.side_m);
-  s.two_sided = true;
-  b.segments.push_back(std::move(s));
-  w.bodies.push_back(std::move(b));
+  w.bodies.push_back(test::sheet_body(0));
   w.tools.push_back(ToolDescription{"tip", 0.0, Vec3::Zero(), -1});
   return w;
 }

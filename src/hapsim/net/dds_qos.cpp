@@ -4,6 +4,12 @@
 
 namespace hapsim::net {
 
+namespace {
+
+constexpr int kCommandHistory = 16;
+
+}  // namespace
+
 Qos::Qos() : qos_(dds_create_qos()) {
   if (qos_ == nullptr) {
     throw std::bad_alloc();
@@ -15,7 +21,8 @@ Qos::~Qos() {
 }
 
 void apply_profile(Qos& qos, QosProfile profile) {
-  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST, 1);
+  dds_qset_history(qos.get(), DDS_HISTORY_KEEP_LAST,
+                   profile == QosProfile::kCommand ? kCommandHistory : 1);
   if (profile == QosProfile::kStream) {
     dds_qset_reliability(qos.get(), DDS_RELIABILITY_BEST_EFFORT, 0);
     dds_qset_durability(qos.get(), DDS_DURABILITY_VOLATILE);

@@ -61,15 +61,7 @@ void LocalModelPublisher::after_step(const World& world, const HapticCycle& cycl
   }
   const bool driving = device_.host_driving();
   builder_.build(world.state(), ++sequence_, driving ? device_.host_state().sequence : 0, models_);
-  std::uint64_t written = 0;
-  for (std::size_t t = 0; t < models_.size(); ++t) {
-    written += writer_.write(encode_local_model(
-                   models_[t], {device_id_, static_cast<std::uint16_t>(t)}, scene_hash_))
-                   ? 1
-                   : 0;
-  }
-  published_.fetch_add(written, std::memory_order_relaxed);
-  refused_.fetch_add(models_.size() - written, std::memory_order_relaxed);
+  write_models();
   if (driving) {
     const DeviceCommand& rendered = device_.host_state().rendered;
     double peak = rendered.force_world_n.allFinite() ? rendered.force_world_n.norm() : 0.0;
@@ -81,6 +73,33 @@ void LocalModelPublisher::after_step(const World& world, const HapticCycle& cycl
       peak_rendered_n_.store(peak, std::memory_order_relaxed);
     }
   }
+}
+
+// haptic path
+void LocalModelPublisher::after_paused_cycle(const World& world,
+                                             const HapticCycle& /*cycle*/) noexcept {
+  ++sequence_;
+  const std::uint64_t answered = device_.host_driving() ? device_.host_state().sequence : 0;
+  for (LocalContactModel& m : models_) {
+    m = LocalContactModel{};  // invalid: free space
+    m.sequence = sequence_;
+    m.device_sequence = answered;
+    m.sim_time_s = world.state().time_s;
+  }
+  write_models();
+}
+
+// haptic path
+void LocalModelPublisher::write_models() noexcept {
+  std::uint64_t written = 0;
+  for (std::size_t t = 0; t < models_.size(); ++t) {
+    written += writer_.write(encode_local_model(
+                   models_[t], {device_id_, static_cast<std::uint16_t>(t)}, scene_hash_))
+                   ? 1
+                   : 0;
+  }
+  published_.fetch_add(written, std::memory_order_relaxed);
+  refused_.fetch_add(models_.size() - written, std::memory_order_relaxed);
 }
 
 }  // namespace hapsim::net

@@ -45,6 +45,9 @@ class LocalModelPublisher final : public WorldCycleObserver {
   void before_step(World& world) noexcept override;
   /// haptic path
   void after_step(const World& world, const HapticCycle& cycle) noexcept override;
+  /// haptic path: the world is paused, so every tool's model is free space (the device's force
+  /// blends to zero within its blend time instead of fading as a silent host's would).
+  void after_paused_cycle(const World& world, const HapticCycle& cycle) noexcept override;
 
   // Any thread.
   [[nodiscard]] std::uint64_t published() const noexcept {
@@ -67,6 +70,9 @@ class LocalModelPublisher final : public WorldCycleObserver {
   std::vector<LocalContactModel> models_;
   std::vector<int> tool_finger_;
   std::vector<double> rendered_push_n_;  ///< per tool, for World::set_rendered_push
+  /// Writes models_ (answering `device_sequence`), counting what DDS took. haptic path
+  void write_models() noexcept;
+
   std::uint64_t sequence_ = 0;
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::uint64_t> refused_{0};

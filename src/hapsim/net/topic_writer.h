@@ -38,6 +38,12 @@ class TopicWriter {
     return status.current_count;
   }
   [[nodiscard]] std::uint64_t failed_writes() const noexcept { return failed_; }
+  /// Reliable topics: blocks until every matched reader acknowledged what was written, or
+  /// `timeout_s` passed (false). Never on the haptic path.
+  [[nodiscard]] bool wait_for_acks(double timeout_s) const noexcept {
+    return dds_wait_for_acks(writer_.get(), static_cast<dds_duration_t>(timeout_s * 1e9)) ==
+           DDS_RETCODE_OK;
+  }
 
  private:
   DdsEntity topic_;

@@ -36,14 +36,16 @@ ViewStateEncoder::ViewStateEncoder(const World& world)
 
 const hapsim_msg_ViewState& ViewStateEncoder::encode(const WorldSnapshot& s,
                                                      std::uint64_t scene_hash,
-                                                     std::uint64_t serve_id, bool host_driving) {
+                                                     std::uint64_t serve_id, bool host_driving,
+                                                     bool paused) {
   hapsim_msg_ViewState& m = message_;
   m = hapsim_msg_ViewState{};
   m.scene_hash = scene_hash;
   m.serve_id = serve_id;
   m.cycle = s.cycle;
-  m.sim_time_s = s.time_s;
+  m.sim_time_s = s.world_time_s;  // the world's clock: a viewer sees a pause and a reset
   m.device_host_driving = host_driving;
+  m.paused = paused;
   put3(m.device_p_m, s.input.p_world);
   m.device_q_wxyz[0] = s.input.q_world.w();
   m.device_q_wxyz[1] = s.input.q_world.x();
@@ -189,6 +191,7 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
 
   s.cycle = m.cycle;
   s.time_s = m.sim_time_s;
+  s.world_time_s = m.sim_time_s;
   s.input.p_world = get3(m.device_p_m);
   s.input.q_world =
       Quat(m.device_q_wxyz[0], m.device_q_wxyz[1], m.device_q_wxyz[2], m.device_q_wxyz[3]);

@@ -28,7 +28,7 @@ class ViewStateEncoder {
   /// the next encode).
   [[nodiscard]] const hapsim_msg_ViewState& encode(const WorldSnapshot& snapshot,
                                                    std::uint64_t scene_hash, std::uint64_t serve_id,
-                                                   bool host_driving);
+                                                   bool host_driving, bool paused = false);
 
  private:
   std::vector<std::vector<float>> rest_body_;  ///< per flat segment, as in WorldSnapshot

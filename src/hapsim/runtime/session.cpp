@@ -356,6 +356,9 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
   if (options.on_snapshots) {
     options.on_snapshots(client.snapshots());
   }
+  if (options.on_client) {
+    options.on_client(&client);
+  }
   HapticLoopOptions loop_options = options.loop;
   loop_options.period_s = options.dt_s;
   loop_options.max_cycles = steps;
@@ -377,6 +380,9 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
     }
   });
   loop.wait();
+  if (options.on_client) {
+    options.on_client(nullptr);
+  }
   if (options.on_snapshots) {
     options.on_snapshots(nullptr);  // the buffer goes with the client
   }

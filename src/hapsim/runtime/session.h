@@ -48,6 +48,10 @@ struct SessionOptions {
   /// buffer before the loop starts and null once the loop has stopped, before the buffer goes
   /// (both calls on the calling thread: a reader elsewhere must be done with it on return).
   std::function<void(TripleBuffer<WorldSnapshot>*)> on_snapshots;
+  /// Real-time runs only: the loop's client (to pause it, reset the world or change a material
+  /// from another thread: WorldHapticClient's thread-safe requests) before the loop starts, and
+  /// null once it has stopped, before the client goes (both calls on the calling thread).
+  std::function<void(WorldHapticClient*)> on_client;
   /// Real-time runs only: when this becomes true the run ends after the current cycle (a
   /// served world runs until stopped). Not owned; may be null.
   const std::atomic<bool>* stop = nullptr;

@@ -121,8 +121,12 @@ void WorldHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
   if (snapshots_) {
     publish_snapshot(cycle);
   }
-  if (options_.observer != nullptr && stepped_) {
-    options_.observer->after_step(world_, cycle);
+  if (options_.observer != nullptr) {
+    if (stepped_) {
+      options_.observer->after_step(world_, cycle);
+    } else {
+      options_.observer->after_paused_cycle(world_, cycle);
+    }
   }
   // Records of stepped cycles only, numbered by them (a paused cycle changed nothing: a replay
   // numbers the steps it takes 0, 1, 2, ...).
@@ -142,6 +146,7 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
   const auto slot = static_cast<std::size_t>(snapshots_->write_index());
   s.cycle = cycle.index;
   s.time_s = cycle.time_s;
+  s.world_time_s = world_.state().time_s;
   s.input = *cycle.input;
   s.output = *cycle.output;
   const WorldDescription& d = world_.description();

@@ -31,6 +31,8 @@ class WorldCycleObserver {
   virtual void before_step(World& /*world*/) noexcept {}
   /// After the step and the device write: the world holds this cycle's state.
   virtual void after_step(const World& world, const HapticCycle& cycle) noexcept = 0;
+  /// After a cycle that did not step (the client is paused: the device got zero force).
+  virtual void after_paused_cycle(const World& /*world*/, const HapticCycle& /*cycle*/) noexcept {}
 
  protected:
   WorldCycleObserver() = default;
@@ -45,7 +47,8 @@ struct WorldHapticClientOptions {
   bool publish_snapshots = true;
   /// Capacity of the record ring in cycles (0: no records). 2048 gives the consumer 2 s of slack.
   std::size_t record_capacity = 0;
-  /// Called around every step that is taken (not while paused). Not owned; may be null.
+  /// Called around every step that is taken, and after every paused cycle. Not owned; may be
+  /// null.
   WorldCycleObserver* observer = nullptr;
 };
 

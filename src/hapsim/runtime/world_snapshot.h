@@ -13,7 +13,10 @@ namespace hapsim {
 
 struct WorldSnapshot {
   std::uint64_t cycle = 0;
+  /// The loop's clock (runs on while paused).
   double time_s = 0.0;
+  /// The world's own clock: stands still while paused, back to 0 after a reset.
+  double world_time_s = 0.0;
   DeviceInput input;
   /// What the device was sent (after safety).
   DeviceCommand output;

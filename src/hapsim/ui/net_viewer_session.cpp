@@ -1,6 +1,7 @@
 #include "hapsim/ui/net_viewer_session.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/net/command_sender.h"
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/loaned_reader.h"
 #include "hapsim/net/participant.h"
@@ -59,7 +60,8 @@ class NetViewerSession final : public ViewerSession {
     decoder_.emplace(*world_);
     view_ = std::make_unique<WorldScene>(*world_);
     view_->update(snapshot_);
-    device_name_ = "simulation host '" + session_ + "' (view only)";
+    commands_.emplace(participant_, info_);
+    device_name_ = "simulation host '" + session_ + "'";
     title_ =
         std::filesystem::path(info_.scene_file).filename().string() + " — connected to " + session_;
     connected_at_ = std::chrono::steady_clock::now();
@@ -70,6 +72,9 @@ class NetViewerSession final : public ViewerSession {
       restarts_ += 1;
       restarted_other_scene_ = info->scene_hash != info_.scene_hash;
       info_.serve_id = info->serve_id;
+      if (!restarted_other_scene_) {
+        commands_->retarget(*info);  // Pause and Reset go to the host that runs now
+      }
     }
     bool fresh = false;
     views_in_.take([&](const hapsim_msg_ViewState& m) {
@@ -78,6 +83,7 @@ class NetViewerSession final : public ViewerSession {
         ++views_;
         fresh = true;
         host_driving_ = m.device_host_driving;
+        host_paused_ = m.paused;
         last_view_ = std::chrono::steady_clock::now();
       } else {
         ++refused_;
@@ -97,8 +103,9 @@ class NetViewerSession final : public ViewerSession {
     lines.erase(std::remove_if(lines.begin(), lines.end(),
                                [](const auto& l) { return l.first.rfind("served", 0) == 0; }),
                 lines.end());
-    lines.emplace_back("served by", host_driving_ ? "serve, driven by a device host"
-                                                  : "serve, driven by its script");
+    lines.emplace_back("served by", std::string(host_driving_ ? "serve, driven by a device host"
+                                                              : "serve, driven by its script") +
+                                        (host_paused_ ? " (paused)" : ""));
     lines.emplace_back(
         "served views",
         std::to_string(views_) +
@@ -134,13 +141,29 @@ class NetViewerSession final : public ViewerSession {
   const std::string& device_name() const override { return device_name_; }
   const std::vector<std::string>& warnings() const override { return setup_->scene.warnings; }
   const std::string& title() const override { return title_; }
-  void set_paused(bool /*paused*/) override {}
-  void reset() override {}
+  // Pause, Resume and Reset go to the simulation host as commands (net/command_sender.h): the
+  // host pauses or resets the one world every viewer and the device host share.
+  // The viewer calls set_paused with its own flag when it connects: nothing is sent then unless
+  // it differs from what the host shows (a late viewer never resumes a paused host by joining).
+  void set_paused(bool paused) override {
+    if (paused == host_paused_) {
+      return;
+    }
+    net::SessionCommand c;
+    c.kind = paused ? net::SessionCommandKind::kPause : net::SessionCommandKind::kResume;
+    commands_sent_ += commands_->send(c) ? 1 : 0;
+  }
+  void reset() override {
+    net::SessionCommand c;
+    c.kind = net::SessionCommandKind::kReset;
+    commands_sent_ += commands_->send(c) ? 1 : 0;
+  }
   void draw_controls() override {
     ImGui::TextWrapped(
-        "Connected to session '%s' (scene hash %s). The simulation and the device "
-        "run elsewhere: pause, reset and recording belong to them.",
-        session_.c_str(), hex(info_.scene_hash).c_str());
+        "Connected to session '%s' (scene hash %s). The simulation and the device run "
+        "elsewhere: Pause, Resume and Reset are sent to the simulation host (%" PRIu64
+        " sent), recording belongs to it.",
+        session_.c_str(), hex(info_.scene_hash).c_str(), commands_sent_);
     draw_world_display_controls(*view_);
   }
   bool set_recording(const std::filesystem::path* /*path*/, std::string& error) override {
@@ -159,6 +182,9 @@ class NetViewerSession final : public ViewerSession {
   net::LoanedReader<hapsim_msg_ViewState> views_in_;
   net::SceneInfoSample info_;
   std::optional<RunSetup> setup_;
+  std::optional<net::CommandSender> commands_;
+  std::uint64_t commands_sent_ = 0;
+  bool host_paused_ = false;
   World* world_ = nullptr;
   WorldSnapshot snapshot_;
   std::optional<net::ViewStateDecoder> decoder_;
