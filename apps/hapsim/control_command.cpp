@@ -7,6 +7,7 @@
 // prints what it set, and what the world refused).
 #include "commands.h"
 #include "dds_options.h"
+#include "session_join.h"
 #include "stop_signal.h"
 
 #include "hapsim/net/command_sender.h"
@@ -119,19 +120,12 @@ void control(const ControlArgs& args) {
     throw CommandError("--timeout " + std::to_string(args.timeout_s) +
                        ": expected more than 0 and at most 3600 s");
   }
-  net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
-  net::Participant participant(args.dds.domain, args.dds.session);
-  net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
-  net::LoanedReader<hapsim_msg_ViewState> views_in(participant);
-  const std::atomic<bool>& stop = install_stop_signals();
-  const std::optional<net::SceneInfoSample> info =
-      net::wait_for_scene_info(info_in, args.timeout_s, &stop);
-  if (!info) {
-    throw CommandError("no simulation host (hapsim serve … --session " + args.dds.session +
-                       ") answered within " + std::to_string(args.timeout_s) + " s");
-  }
+  SessionJoin session(args.dds, args.timeout_s);
+  const net::SceneInfoSample* info = &session.info();
+  net::LoanedReader<hapsim_msg_ViewState>& views_in = session.views();
+  const std::atomic<bool>& stop = session.stop();
   const net::SessionCommand command = make_command(args, *info);
-  net::CommandSender sender(participant, *info);
+  net::CommandSender sender(session.participant(), *info);
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(args.timeout_s));
   // The host's reader must be matched, or a reliable write has no one to reach.

@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "dds_options.h"
 #include "json_output.h"
+#include "session_join.h"
 #include "snapshot_view.h"
 #include "stop_signal.h"
 
@@ -54,21 +55,14 @@ double peak_tool_force_n(const WorldSnapshot& s) {
 void watch(const WatchArgs& args) {
   using Clock = std::chrono::steady_clock;
   JsonOutput json_out(args.json_path);
-  net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
-  net::Participant participant(args.dds.domain, args.dds.session);
-  net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
-  net::LoanedReader<hapsim_msg_ViewState> views_in(participant);
-  const std::atomic<bool>& stop = install_stop_signals();
-  const std::optional<net::SceneInfoSample> info =
-      net::wait_for_scene_info(info_in, args.wait_s, &stop);
-  if (!info) {
-    throw CommandError("no simulation host (hapsim serve … --session " + args.dds.session +
-                       ") answered within " + std::to_string(args.wait_s) + " s");
-  }
+  SessionJoin session(args.dds, args.wait_s);
+  const net::SceneInfoSample* info = &session.info();
+  net::LoanedReader<hapsim_msg_ViewState>& views_in = session.views();
+  const std::atomic<bool>& stop = session.stop();
   const RunSetup setup = net::build_served_scene(*info, DeviceChoice::external(), args.data_dir);
   const World& world = *setup.world;
   std::printf("watching     %s in session '%s' (%s)\n", info->scene_file.c_str(),
-              args.dds.session.c_str(), domain.config().c_str());
+              args.dds.session.c_str(), session.domain().config().c_str());
   std::fflush(stdout);
 
   WorldSnapshot snapshot = make_world_snapshot(world);
