@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <ctime>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace hapsim {
@@ -359,6 +360,25 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
   if (options.on_client) {
     options.on_client(&client);
   }
+  // Whoever holds the client or its snapshots lets go before they go, however this returns.
+  struct HandBack {
+    explicit HandBack(const SessionOptions& o) : options(o) {}
+    HandBack(const HandBack&) = delete;
+    HandBack& operator=(const HandBack&) = delete;
+    HandBack(HandBack&&) = delete;
+    HandBack& operator=(HandBack&&) = delete;
+    const SessionOptions& options;
+    ~HandBack() {
+      if (options.on_client) {
+        options.on_client(nullptr);
+      }
+      if (options.on_snapshots) {
+        options.on_snapshots(nullptr);  // the buffer goes with the client
+      }
+    }
+  };
+  std::optional<HandBack> hand_back;
+  hand_back.emplace(options);
   HapticLoopOptions loop_options = options.loop;
   loop_options.period_s = options.dt_s;
   loop_options.max_cycles = steps;
@@ -380,12 +400,7 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
     }
   });
   loop.wait();
-  if (options.on_client) {
-    options.on_client(nullptr);
-  }
-  if (options.on_snapshots) {
-    options.on_snapshots(nullptr);  // the buffer goes with the client
-  }
+  hand_back.reset();
   const double wall_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   for (std::size_t flat = 0; flat < world.flat_segment_count(); ++flat) {
