@@ -157,9 +157,9 @@ class UrdfReader {
 
   SerialChain read(std::string_view xml) {
     // urdfdom reports parse problems through console_bridge on stderr; we report them ourselves.
+    check_xml_text(xml, name_);
     const console_bridge::LogLevel level = console_bridge::getLogLevel();
     console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
-    check_xml_text(xml, name_);
     urdf::ModelInterfaceSharedPtr model;
     try {
       model = urdf::parseURDF(std::string(xml));
@@ -173,6 +173,19 @@ class UrdfReader {
                   "not a valid URDF (urdfdom could not read a <robot> with connected "
                   "links, named joints and known joint types from it)");
     }
+    // A link urdfdom made its own child holds itself through a shared_ptr: the model would leak
+    // (found by the urdf fuzz target). Its links let go of their children when we are done.
+    struct ReleaseLinks {
+      urdf::ModelInterface& model;
+      ~ReleaseLinks() {
+        for (auto& [link_name, link] : model.links_) {
+          if (link) {
+            link->child_links.clear();
+            link->child_joints.clear();
+          }
+        }
+      }
+    } release{*model};
     check_link_tree(*model, name_);
     return build(*model);
   }
