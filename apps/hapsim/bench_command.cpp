@@ -467,7 +467,7 @@ void add_bench_command(CLI::App& app) {
                    "../shared/data)");
   step->add_option("--duration", step_args->duration_s,
                    "Simulated seconds per run (default: the whole palpation)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_seconds());
   step->add_option("--json", step_args->json_path, "Write the rows as a JSON array to FILE");
   step->callback([step_args] { run_step(*step_args); });
 

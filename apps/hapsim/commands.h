@@ -15,6 +15,20 @@ class CommandError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A CLI11 check for a length of time in seconds: a finite number > 0 ("nan" passes CLI11's own
+/// PositiveNumber, and would read as "not given").
+inline CLI::Validator positive_seconds() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v) || !(v > 0.0) || !(v < 1e300)) {
+          return "expected a finite number of seconds > 0, got '" + text + "'";
+        }
+        return {};
+      },
+      "SECONDS>0");
+}
+
 /// Exit status a subcommand's callback sets for main() to return (0 unless it says otherwise).
 int& exit_status();
 

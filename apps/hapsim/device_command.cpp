@@ -398,7 +398,7 @@ void add_device_command(CLI::App& app) {
       ->check(CLI::Range(0, 65535));
   cmd->add_option("--duration", args->duration_s,
                   "Seconds to run the loop (default: until stopped)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_seconds());
   cmd->add_option("--force-mode", args->force_mode,
                   "local-model (default) or raw (the paper's raw forces: unsafe beyond a few ms "
                   "of delay; for comparison)")

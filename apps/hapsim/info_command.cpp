@@ -1,5 +1,6 @@
 // `hapsim info MESH`: counts, validation, bounds, area and volume, and the cost and quality of
 // both acceleration structures built over it.
+#include "checked_output.h"
 #include "commands.h"
 #include "mesh_argument.h"
 
@@ -86,11 +87,7 @@ void run_info(const InfoOptions& opt) {
                         {"memory_bytes", s.memory_bytes},
                         {"leaf_tightness", s.leaf_tightness},
                         {"inner_tightness", s.inner_tightness}};
-    std::ofstream out(opt.json_path);
-    if (!out) {
-      throw CommandError(opt.json_path + ": cannot write the JSON file");
-    }
-    out << j.dump(2) << "\n";
+    write_json_file("--json", opt.json_path, j);
   }
 }
 

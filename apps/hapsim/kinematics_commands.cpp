@@ -3,6 +3,7 @@
 // `hapsim ik URDF --poses FILE.csv [--tip LINK]`: joint values reaching each pose, and whether
 // they do; each row starts from the previous row's answer (a path is tracked), the first from the
 // middle of the limits.
+#include "checked_output.h"
 #include "commands.h"
 #include "number_csv.h"
 
@@ -74,9 +75,7 @@ void run_fk(const KinematicsOptions& opt) {
     write_pose(out, chain.forward(q));
     std::fprintf(out, "\n");
   }
-  if (out != stdout) {
-    std::fclose(out);
-  }
+  close_checked(out, "--out", opt.out_path);
   std::FILE* info = out == stdout ? stderr : stdout;
   std::fprintf(info, "hapsim fk: %zu rows, chain %s -> %s (%zu joints)%s\n", rows.size(),
                chain.base_link().c_str(), chain.tip_link().c_str(), n,
@@ -127,9 +126,7 @@ void run_ik(const KinematicsOptions& opt) {
       seed = q;  // track the path
     }
   }
-  if (out != stdout) {
-    std::fclose(out);
-  }
+  close_checked(out, "--out", opt.out_path);
   std::FILE* info = out == stdout ? stderr : stdout;
   std::fprintf(info,
                "hapsim ik: %zu poses, %zu reached (largest error %.3g mm, %.3g deg), %zu "

@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include <exception>
+#include <filesystem>
 #include <iostream>
 
 namespace hapsim::app {
@@ -54,6 +55,12 @@ int main(int argc, char** argv) {
     return 2;
   } catch (const hapsim::Error& e) {
     std::cerr << "hapsim: " << e.what() << "\n";
+    return 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the user gave that the file system refuses (a symlink loop, an unreadable folder,
+    // a name too long) is bad input like any other: name the path and the reason.
+    const std::string path = e.path1().empty() ? std::string("a path") : e.path1().string();
+    std::cerr << "hapsim: " << path << ": " << e.code().message() << "\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "hapsim: internal error: " << e.what() << "\n";

@@ -1,10 +1,11 @@
 #include "number_csv.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/text_file.h"
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -36,20 +37,31 @@ bool parse_double(std::string_view field, double* out) {
   return ec == std::errc() && ptr == end;
 }
 
+// A row as quoted in a message: one line, cut to 60 characters.
+std::string shown(std::string_view row) {
+  return row.size() > 60 ? std::string(row.substr(0, 57)) + "..." : std::string(row);
+}
+
 }  // namespace
 
 std::vector<std::vector<double>> read_number_rows_csv(const std::filesystem::path& path,
                                                       std::size_t columns, const std::string& names,
                                                       const std::string& what) {
-  const std::string where = path.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
-    throw Error(where, "no such " + what + " file (expected a CSV of " + names + " rows)");
+    throw Error(path.string(), "no such " + what + " file (expected a CSV of " + names + " rows)");
   }
-  std::ifstream in(path);
-  if (!in) {
-    throw Error(where, "cannot open the " + what + " file");
-  }
+  constexpr std::size_t kMaxCsvBytes = std::size_t{256} << 20;
+  return parse_number_rows_csv(read_text_file(path, kMaxCsvBytes, what + " CSV"), path.string(),
+                               columns, names, what);
+}
+
+std::vector<std::vector<double>> parse_number_rows_csv(std::string_view text,
+                                                       const std::string& where,
+                                                       std::size_t columns,
+                                                       const std::string& names,
+                                                       const std::string& what) {
+  std::istringstream in{std::string(text)};
   std::vector<std::vector<double>> rows;
   std::string line;
   std::size_t line_number = 0;
@@ -88,17 +100,14 @@ std::vector<std::vector<double>> read_number_rows_csv(const std::filesystem::pat
                           std::to_string(fields));
     }
     if (!numeric) {
-      throw Error(at, "expected numbers " + names + ", got '" + std::string(row) + "'");
+      throw Error(at, "expected numbers " + names + ", got '" + shown(row) + "'");
     }
     for (const double v : values) {
       if (!std::isfinite(v)) {
-        throw Error(at, "values must be finite, got '" + std::string(row) + "'");
+        throw Error(at, "values must be finite, got '" + shown(row) + "'");
       }
     }
     rows.push_back(std::move(values));
-  }
-  if (in.bad()) {
-    throw Error(where, "read error");
   }
   if (rows.empty()) {
     throw Error(where, "no " + what + ": expected rows of " + names);

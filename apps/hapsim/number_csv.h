@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace hapsim::app {
@@ -14,5 +15,12 @@ namespace hapsim::app {
 std::vector<std::vector<double>> read_number_rows_csv(const std::filesystem::path& path,
                                                       std::size_t columns, const std::string& names,
                                                       const std::string& what);
+
+/// The same from CSV text; `where` (a file name) prefixes every error as "where:line".
+std::vector<std::vector<double>> parse_number_rows_csv(std::string_view text,
+                                                       const std::string& where,
+                                                       std::size_t columns,
+                                                       const std::string& names,
+                                                       const std::string& what);
 
 }  // namespace hapsim::app

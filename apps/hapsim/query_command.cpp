@@ -1,6 +1,7 @@
 // `hapsim query MESH --points FILE.csv --method exact|spheretree|knee`: signed distance, closest
 // point, normal and triangle for each point, in the input's order and units. An approximate
 // method (the knee paper's) also reports its error against the exact query on the same points.
+#include "checked_output.h"
 #include "commands.h"
 #include "mesh_argument.h"
 #include "points_csv.h"
@@ -59,6 +60,20 @@ void run_query(const QueryOptions& opt) {
   // Read the points before the (possibly slow) mesh load so a bad file fails fast.
   const std::vector<Vec3> points_units =
       opt.points == "builtin:probe-path" ? builtin_probe_path() : read_points_csv(opt.points);
+  // Squared distances overflow from ~1e154 m on (the answer was inf and no triangle); nothing a
+  // query is for lies that far, so a point beyond 1e9 m is a unit or column mix-up, said as such.
+  constexpr double kMaxPointDistance_m = 1e9;
+  for (std::size_t i = 0; i < points_units.size(); ++i) {
+    const double farthest_m = (points_units[i] * opt.scale).cwiseAbs().maxCoeff();
+    if (!(farthest_m <= kMaxPointDistance_m)) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    ": point %zu lies %.3g m from the origin along an axis; expected points within "
+                    "%.0e m (a unit mix-up?)",
+                    i + 1, farthest_m, kMaxPointDistance_m);
+      throw CommandError(opt.points + text);
+    }
+  }
   MeshArgument arg = load_mesh_argument(opt.mesh, opt.scale);
   if (arg.mesh.empty()) {
     throw CommandError(opt.mesh + ": the mesh has no triangles");
@@ -97,9 +112,7 @@ void run_query(const QueryOptions& opt) {
     min_distance = std::min(min_distance, s.signed_distance);
     max_distance = std::max(max_distance, s.signed_distance);
   }
-  if (out != stdout) {
-    std::fclose(out);
-  }
+  close_checked(out, "--out", opt.out_path);
   const SampleSummary cost = summarize_samples(query_ns);
   const double median_ns = cost.p50;
   const double p99_ns = cost.p99;
@@ -152,11 +165,7 @@ void run_query(const QueryOptions& opt) {
                                 {"misses", error->misses},
                                 {"false_contacts", error->false_contacts}};
     }
-    std::ofstream js(opt.json_path);
-    if (!js) {
-      throw CommandError(opt.json_path + ": cannot write the JSON file");
-    }
-    js << full.dump(2) << "\n";
+    write_json_file("--json", opt.json_path, full);
   }
 }
 

@@ -252,6 +252,16 @@ void run(const RunArgs& args) {
   if (!(duration_s > 0.0) || !std::isfinite(duration_s)) {
     throw CommandError(args.scene + ": the run has no length (give --duration S)");
   }
+  if (const double steps = duration_s / scene.run.dt_s;
+      !(steps <= max_session_steps(args.realtime))) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  ": a run of %g s at run.dt_s %g s is %.3g steps; at most %.0e %s (give a "
+                  "shorter --duration)",
+                  duration_s, scene.run.dt_s, steps, max_session_steps(args.realtime),
+                  args.realtime ? "in real time" : "as fast as possible");
+    throw CommandError(args.scene + text);
+  }
   std::printf("device       %s; %.3f s at %.0f Hz%s\n", device_name.c_str(), duration_s,
               1.0 / scene.run.dt_s, args.realtime ? " in real time" : " as fast as possible");
   // What the load and the run's assembly let through but noticed: through the log, as mesh
@@ -389,7 +399,8 @@ void add_run_command(CLI::App& app) {
                   "trajectory CSV)");
   cmd->add_option("--duration", args->duration_s,
                   "Simulated seconds (default: the scene's run.duration_s, else until the "
-                  "trajectory ends)");
+                  "trajectory ends)")
+      ->check(positive_seconds());
   cmd->add_option("--record", args->record_path, "Record every cycle to FILE (binary)");
   cmd->add_option("--replay", args->replay_path,
                   "Drive the world with a recording's inputs and check the run reproduces it "

@@ -381,7 +381,7 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--duration", args->duration_s,
                   "Seconds to serve (default: until stopped; counted from the device host's "
                   "first state with --wait-for-device)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_seconds());
   cmd->add_flag("--wait-for-device", args->wait_for_device,
                 "Step nothing until a device host's first state arrives (a served run then "
                 "covers exactly what the device did)");

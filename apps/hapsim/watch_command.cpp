@@ -153,9 +153,9 @@ void add_watch_command(CLI::App& app) {
   add_dds_options(cmd, args->dds);
   cmd->add_option("--data", args->data_dir, "The scene's data folder (default: the host's)");
   cmd->add_option("--duration", args->duration_s, "Seconds to watch (default: until stopped)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_seconds());
   cmd->add_option("--wait", args->wait_s, "Seconds to wait for a simulation host (default 20)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_seconds());
   cmd->add_option("--snapshot", args->snapshot_path,
                   "Write the view at the largest force seen to FILE.png (offscreen)");
   cmd->add_option("--json", args->json_path, "Write what was seen as JSON");

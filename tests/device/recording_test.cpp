@@ -1,9 +1,9 @@
 #include "hapsim/device/recording.h"
 
-#include "support/temp_path.h"
 #include "hapsim/core/error.h"
 #include "hapsim/device/force_safety.h"
 #include "hapsim/device/simulated_device.h"
+#include "support/temp_path.h"
 
 #include <bit>
 #include <cmath>
@@ -208,6 +208,27 @@ TEST(Recording, CorruptFrameNamesTheFrame) {
     EXPECT_NE(message.find("corrupt"), std::string::npos) << message;
   }
   std::filesystem::remove(path);
+}
+
+// A device's input is checked before it is recorded and the command is the world's, NaN zeroed:
+// a recording holding a NaN input (made up, or corrupted with its checksum redone) replayed as
+// "identical" before, proving nothing; now reading it names the frame and the field.
+TEST(Recording, NonFiniteInputOrCommandIsRefused) {
+  auto frames = make_frames(3);
+  frames[1].input.p_world.x() = std::numeric_limits<double>::quiet_NaN();
+  const auto path = write_recording(frames);
+  const std::string message = read_error(path);
+  EXPECT_NE(message.find("frame 1 "), std::string::npos) << message;
+  EXPECT_NE(message.find("input.p_world[0] is nan"), std::string::npos) << message;
+
+  frames = make_frames(3);
+  frames[2].command.finger_force_n[1] = -std::numeric_limits<double>::infinity();
+  const auto path2 = write_recording(frames);
+  const std::string message2 = read_error(path2);
+  EXPECT_NE(message2.find("frame 2 "), std::string::npos) << message2;
+  EXPECT_NE(message2.find("command.finger_force_n[1] is -inf"), std::string::npos) << message2;
+  std::filesystem::remove(path);
+  std::filesystem::remove(path2);
 }
 
 TEST(Recording, CorruptHeaderIsRejected) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <type_traits>
 #include <utility>
@@ -238,6 +239,21 @@ const char* check_counts(const RecordedFrame& f) {
   return nullptr;
 }
 
+// The first input or command number that is not finite: a device's input is checked before it is
+// recorded (a plugin's NaN sample is refused) and the command is the world's, NaN already zeroed,
+// so a recording holding one is corrupt or made up, and a replay of it proves nothing.
+struct NonFiniteFinder {
+  std::string field;
+  template <class T>
+  void operator()(const FieldId& id, const T& value) {
+    if constexpr (std::is_floating_point_v<T>) {
+      if (field.empty() && id.group != nullptr && id.group_index < 0 && !std::isfinite(value)) {
+        field = field_name(id) + " is " + format_value(value);
+      }
+    }
+  }
+};
+
 }  // namespace
 
 std::size_t recorded_frame_size_bytes() {
@@ -440,6 +456,12 @@ bool RecordingReader::next(RecordedFrame& frame) {
   }
   if (const char* problem = check_counts(decoded)) {
     throw Error(where, which + " is corrupt: " + problem);
+  }
+  NonFiniteFinder non_finite;
+  visit_frame(decoded, non_finite);
+  if (!non_finite.field.empty()) {
+    throw Error(where, which + " is corrupt: " + non_finite.field +
+                           "; a recording holds finite inputs and commands only");
   }
   frame = decoded;
   offset_ += got;

@@ -1,6 +1,7 @@
 #include "hapsim/geometry/mesh_io.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/isolated_call.h"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -11,6 +12,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -98,10 +101,89 @@ std::size_t gather_triangles(const aiScene& scene, TriangleMesh& out) {
   return skipped_primitives;
 }
 
+// What the importer hands back: the triangles as read (node transforms applied, unscaled) and
+// how many point/line primitives it skipped.
+struct ImportedTriangles {
+  TriangleMesh mesh;
+  std::size_t skipped_primitives = 0;
+};
+
+ImportedTriangles import_triangles(const fs::path& path, bool weld) {
+  const std::string where = path.string();
+  Assimp::Importer importer;
+  // Only what is needed to get triangles: no normal generation, no degenerate removal, no
+  // "fixing" of invalid data — validation must see the file's real defects.
+  unsigned flags = aiProcess_Triangulate | aiProcess_ValidateDataStructure;
+  if (!weld) {
+    flags |= aiProcess_JoinIdenticalVertices;  // keep the file's indexing where it has one
+  }
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFile(where, flags);
+  } catch (const std::exception& e) {  // e.g. bad_alloc from a lying size field
+    throw Error(where, std::string("mesh importer failed: ") + e.what() + "; " + kExpected);
+  }
+  if (scene == nullptr) {
+    throw Error(where,
+                std::string("cannot read mesh: ") + importer.GetErrorString() + "; " + kExpected);
+  }
+  if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 && scene->mNumMeshes == 0) {
+    throw Error(where, "file holds no meshes (incomplete scene); expected triangles");
+  }
+  ImportedTriangles out;
+  out.skipped_primitives = gather_triangles(*scene, out.mesh);
+  return out;
+}
+
+// The child's result through the pipe: counts, then the vertices and triangles as raw bytes.
+std::string encode_triangles(const ImportedTriangles& in) {
+  const std::uint64_t counts[3] = {in.mesh.vertices.size(), in.mesh.triangles.size(),
+                                   in.skipped_primitives};
+  std::string out(reinterpret_cast<const char*>(counts), sizeof counts);
+  for (const Vec3& v : in.mesh.vertices) {
+    out.append(reinterpret_cast<const char*>(v.data()), 3 * sizeof(double));
+  }
+  for (const TriangleIndices& t : in.mesh.triangles) {
+    out.append(reinterpret_cast<const char*>(t.data()), 3 * sizeof(std::uint32_t));
+  }
+  return out;
+}
+
+void decode_triangles(const std::string& bytes, const std::string& where, TriangleMesh& mesh,
+                      std::size_t& skipped_primitives) {
+  std::uint64_t counts[3] = {0, 0, 0};
+  const auto fail = [&] { throw Error(where, "the mesh importer's result was cut short"); };
+  if (bytes.size() < sizeof counts) {
+    fail();
+  }
+  std::memcpy(counts, bytes.data(), sizeof counts);
+  const std::uint64_t vertex_bytes = counts[0] * 3 * sizeof(double);
+  const std::uint64_t triangle_bytes = counts[1] * 3 * sizeof(std::uint32_t);
+  if (counts[0] > bytes.size() || counts[1] > bytes.size() ||
+      bytes.size() != sizeof counts + vertex_bytes + triangle_bytes) {
+    fail();
+  }
+  const char* p = bytes.data() + sizeof counts;
+  mesh.vertices.resize(counts[0]);
+  for (Vec3& v : mesh.vertices) {
+    std::memcpy(v.data(), p, 3 * sizeof(double));
+    p += 3 * sizeof(double);
+  }
+  mesh.triangles.resize(counts[1]);
+  for (TriangleIndices& t : mesh.triangles) {
+    std::memcpy(t.data(), p, 3 * sizeof(std::uint32_t));
+    p += 3 * sizeof(std::uint32_t);
+  }
+  skipped_primitives = counts[2];
+}
+
 void check_readable(const fs::path& path) {
   std::error_code ec;
   if (!fs::exists(path, ec)) {
-    throw Error(path.string(), std::string("mesh file not found; ") + kExpected);
+    // A loop of symlinks or a name too long is not "not found": say what the system said.
+    throw Error(path.string(), (ec ? "cannot reach the mesh file (" + ec.message() + "); "
+                                   : std::string("mesh file not found; ")) +
+                                   kExpected);
   }
   if (!fs::is_regular_file(path, ec)) {
     throw Error(path.string(), std::string("not a regular file; ") + kExpected);
@@ -116,6 +198,31 @@ void check_readable(const fs::path& path) {
   if (!std::ifstream(path, std::ios::binary).good()) {
     throw Error(path.string(), "file cannot be opened for reading (permissions?)");
   }
+}
+
+// Assimp's PLY reader looks for the header's end without a bound: a header whose 'end_header' is
+// misspelt loops for ever (ASCII) or crashes (binary). A header is a few hundred bytes of lines.
+void check_ply_header(const fs::path& path) {
+  constexpr std::size_t kMaxHeaderBytes = 64 * 1024;
+  std::string head(kMaxHeaderBytes, '\0');
+  std::ifstream in(path, std::ios::binary);
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  if (head.rfind("ply", 0) != 0) {
+    throw Error(path.string(),
+                "not a PLY file (it does not start with 'ply'); " + std::string(kExpected));
+  }
+  for (std::size_t at = head.find("end_header"); at != std::string::npos;
+       at = head.find("end_header", at + 1)) {
+    const std::size_t after = at + std::string_view("end_header").size();
+    const bool line_start = at > 0 && head[at - 1] == '\n';
+    const bool line_end = after < head.size() && (head[after] == '\n' || head[after] == '\r');
+    if (line_start && line_end) {
+      return;
+    }
+  }
+  throw Error(path.string(),
+              "PLY header has no 'end_header' line in its first 64 kB; " + std::string(kExpected));
 }
 
 // Logs and notes every defect present; throws for those the policy refuses.
@@ -202,30 +309,23 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& options, Mes
     throw Error(where, "unsupported mesh format '" + path.extension().string() + "'; " + kExpected);
   }
 
+  if (lower_extension(path) == ".ply") {
+    check_ply_header(path);
+  }
   TriangleMesh mesh;
   std::size_t skipped_primitives = 0;
   {
-    Assimp::Importer importer;
-    // Only what is needed to get triangles: no normal generation, no degenerate removal, no
-    // "fixing" of invalid data — validation below must see the file's real defects.
-    unsigned flags = aiProcess_Triangulate | aiProcess_ValidateDataStructure;
-    if (!options.weld) {
-      flags |= aiProcess_JoinIdenticalVertices;  // keep the file's indexing where it has one
-    }
-    const aiScene* scene = nullptr;
-    try {
-      scene = importer.ReadFile(where, flags);
-    } catch (const std::exception& e) {  // e.g. bad_alloc from a lying size field
-      throw Error(where, std::string("mesh importer failed: ") + e.what() + "; " + kExpected);
-    }
-    if (scene == nullptr) {
-      throw Error(where,
-                  std::string("cannot read mesh: ") + importer.GetErrorString() + "; " + kExpected);
-    }
-    if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 && scene->mNumMeshes == 0) {
-      throw Error(where, "file holds no meshes (incomplete scene); expected triangles");
-    }
-    skipped_primitives = gather_triangles(*scene, mesh);
+    // Assimp runs in a child process: a malformed file can hang it, crash it or trip one of its
+    // assertions (seen with a few hundred bytes of PLY); here that is one error naming the file.
+    std::error_code ec;
+    const std::size_t file_bytes = fs::file_size(path, ec);
+    IsolationLimits limits;
+    limits.time_s = 30.0 + static_cast<double>(file_bytes) / 1e6;  // ~1 s per MB on a slow disk
+    limits.memory_bytes = (std::size_t{2} << 30) + 32 * file_bytes;
+    const std::string bytes = run_isolated(where, "the mesh importer (Assimp)", limits, [&] {
+      return encode_triangles(import_triangles(path, options.weld));
+    });
+    decode_triangles(bytes, where, mesh, skipped_primitives);
   }
   if (mesh.triangles.empty()) {
     throw Error(where, "file holds no triangles" +

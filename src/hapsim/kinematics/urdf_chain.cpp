@@ -1,6 +1,7 @@
 #include "hapsim/kinematics/urdf_chain.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/text_file.h"
 #include "hapsim/geometry/csg.h"
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/polygonizer.h"
@@ -27,6 +28,114 @@ Iso3 to_iso(const urdf::Pose& pose) {
   return X;
 }
 
+// Line and column (1-based) of a byte offset, for messages about the raw text.
+std::string text_position(std::string_view text, std::size_t byte) {
+  std::size_t line = 1;
+  std::size_t column = 1;
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+    column = text[i] == '\n' ? 1 : column + 1;
+    line += text[i] == '\n' ? 1 : 0;
+  }
+  return std::to_string(line) + ":" + std::to_string(column);
+}
+
+// Length of the UTF-8 sequence at `i` (1-4), or 0 if it is not valid UTF-8.
+std::size_t utf8_length(std::string_view text, std::size_t i) {
+  const auto b = static_cast<unsigned char>(text[i]);
+  const std::size_t n = b < 0x80           ? 1
+                        : (b >> 5) == 0x6  ? 2
+                        : (b >> 4) == 0xE  ? 3
+                        : (b >> 3) == 0x1E ? 4
+                                           : 0;
+  if (n == 0 || i + n > text.size()) {
+    return 0;
+  }
+  for (std::size_t k = 1; k < n; ++k) {
+    if ((static_cast<unsigned char>(text[i + k]) >> 6) != 0x2) {
+      return 0;
+    }
+  }
+  return n;
+}
+
+// TinyXML (under urdfdom) parses elements recursively and trusts its input to be UTF-8: a file
+// nested thousands of elements deep overflows the stack, and a multi-byte lead byte at the end of
+// the text makes it read past the buffer. Both are refused here, before it sees the text.
+void check_xml_text(std::string_view xml, const std::string& name) {
+  for (std::size_t i = 0; i < xml.size();) {
+    const std::size_t n = utf8_length(xml, i);
+    if (n == 0 || xml[i] == '\0') {
+      throw Error(name + ":" + text_position(xml, i),
+                  "not UTF-8 text (byte " + std::to_string(static_cast<unsigned char>(xml[i])) +
+                      "); expected a URDF (XML)");
+    }
+    i += n;
+  }
+  constexpr int kMaxDepth = 64;  // a URDF is four levels deep (robot, link, collision, geometry)
+  int depth = 0;
+  for (std::size_t i = xml.find('<'); i != std::string_view::npos; i = xml.find('<', i)) {
+    const std::string_view rest = xml.substr(i);
+    std::string_view close = ">";
+    int change = 0;
+    if (rest.substr(0, 4) == "<!--") {
+      close = "-->";
+    } else if (rest.substr(0, 9) == "<![CDATA[") {
+      close = "]]>";
+    } else if (rest.substr(0, 2) == "<?") {
+      close = "?>";
+    } else if (rest.substr(0, 2) == "</") {
+      change = -1;
+    } else if (rest.substr(0, 2) != "<!") {
+      change = +1;  // an opening tag, unless it closes itself
+    }
+    const std::size_t end = xml.find(close, i + 1);
+    if (end == std::string_view::npos) {
+      return;  // unterminated: TinyXML reports it
+    }
+    if (change == 1 && xml[end - 1] == '/') {
+      change = 0;
+    }
+    depth = std::max(0, depth + change);
+    if (depth > kMaxDepth) {
+      throw Error(name + ":" + text_position(xml, i),
+                  "XML nested deeper than " + std::to_string(kMaxDepth) +
+                      " elements; expected a URDF (robot, link, collision, geometry)");
+    }
+    i = end + close.size();
+  }
+}
+
+// urdfdom accepts a joint whose child is its own parent, a link that is the child of two joints
+// (the last one read wins) and loops of links not reaching the root; every walk towards the root
+// or down the children would then go round for ever (`hapsim fk` hung). A URDF is a tree.
+void check_link_tree(const urdf::ModelInterface& model, const std::string& name) {
+  std::map<std::string, std::string> parent_joint_of;  // child link -> the joint naming it
+  for (const auto& [joint_name, joint] : model.joints_) {
+    if (!joint) {
+      continue;
+    }
+    if (joint->parent_link_name == joint->child_link_name) {
+      throw Error(name, "joint '" + joint_name + "' names link '" + joint->child_link_name +
+                            "' as both its parent and its child; expected a tree of links");
+    }
+    const auto [it, inserted] = parent_joint_of.emplace(joint->child_link_name, joint_name);
+    if (!inserted) {
+      throw Error(name, "link '" + joint->child_link_name + "' is the child of two joints ('" +
+                            it->second + "' and '" + joint_name + "'); expected a tree of links");
+    }
+  }
+  for (const auto& [link_name, link] : model.links_) {
+    std::size_t steps = 0;
+    for (urdf::LinkConstSharedPtr l = link; l; l = l->getParent()) {
+      if (++steps > model.links_.size()) {
+        const std::string joint = link->parent_joint ? link->parent_joint->name : std::string("?");
+        throw Error(name, "link '" + link_name + "' is its own ancestor (through joint '" + joint +
+                              "'): the joints form a cycle; expected a tree of links");
+      }
+    }
+  }
+}
+
 int movable_joints_to_root(const urdf::ModelInterface& model, const urdf::LinkConstSharedPtr& link,
                            const std::string& base) {
   int n = 0;
@@ -48,6 +157,7 @@ class UrdfReader {
 
   SerialChain read(std::string_view xml) {
     // urdfdom reports parse problems through console_bridge on stderr; we report them ourselves.
+    check_xml_text(xml, name_);
     const console_bridge::LogLevel level = console_bridge::getLogLevel();
     console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
     urdf::ModelInterfaceSharedPtr model;
@@ -63,6 +173,20 @@ class UrdfReader {
                   "not a valid URDF (urdfdom could not read a <robot> with connected "
                   "links, named joints and known joint types from it)");
     }
+    // A link urdfdom made its own child holds itself through a shared_ptr: the model would leak
+    // (found by the urdf fuzz target). Its links let go of their children when we are done.
+    struct ReleaseLinks {
+      urdf::ModelInterface& model;
+      ~ReleaseLinks() {
+        for (auto& [link_name, link] : model.links_) {
+          if (link) {
+            link->child_links.clear();
+            link->child_joints.clear();
+          }
+        }
+      }
+    } release{*model};
+    check_link_tree(*model, name_);
     return build(*model);
   }
 
@@ -287,13 +411,9 @@ SerialChain parse_urdf_chain(std::string_view urdf_xml, std::string_view name,
 }
 
 SerialChain load_urdf_chain(const std::filesystem::path& file, const UrdfChainOptions& options) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in || std::filesystem::is_directory(file)) {
-    throw Error(file.string(), "cannot open the URDF file (missing or unreadable)");
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_urdf_chain(text.str(), file.string(), file.parent_path(), options);
+  constexpr std::size_t kMaxUrdfBytes = std::size_t{16} << 20;  // the GP7's is 9 kB
+  return parse_urdf_chain(read_text_file(file, kMaxUrdfBytes, "URDF file"), file.string(),
+                          file.parent_path(), options);
 }
 
 }  // namespace hapsim

@@ -456,7 +456,16 @@ SessionSummary run_session(World& world, Device& device, const SessionOptions& o
   if (!(options.dt_s > 0.0) || !(options.dt_s <= 0.1)) {
     throw Error("session", "dt must be in (0, 0.1] s, got " + std::to_string(options.dt_s));
   }
-  const auto steps = static_cast<std::size_t>(std::llround(options.duration_s / options.dt_s));
+  const double wanted_steps = options.duration_s / options.dt_s;
+  if (!(wanted_steps <= max_session_steps(options.realtime))) {
+    char text[160];
+    std::snprintf(text, sizeof text, "%g s at dt %g s is %.3g steps; at most %.0e %s",
+                  options.duration_s, options.dt_s, wanted_steps,
+                  max_session_steps(options.realtime),
+                  options.realtime ? "in real time" : "as fast as possible");
+    throw Error("session", text);
+  }
+  const auto steps = static_cast<std::size_t>(std::llround(wanted_steps));
   if (steps == 0) {
     throw Error("session", "duration " + std::to_string(options.duration_s) +
                                " s is shorter than one step of " + std::to_string(options.dt_s) +

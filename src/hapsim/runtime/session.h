@@ -22,6 +22,14 @@
 
 namespace hapsim {
 
+/// The most steps one session runs: as fast as possible, 1e8 (27.8 h at 1 kHz; the step-cost
+/// samples alone take 800 MB); in real time, 1e11 (a served world "until stopped" is a year).
+/// run_session() refuses more, so a dt_s of 1e-9 or a duration of 1e300 s is an error, not a
+/// bad_alloc or an integer overflow.
+[[nodiscard]] constexpr double max_session_steps(bool realtime) {
+  return realtime ? 1e11 : 1e8;
+}
+
 struct SessionOptions {
   /// Simulated seconds to run (> 0).
   double duration_s = 10.0;

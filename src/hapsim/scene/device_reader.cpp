@@ -138,8 +138,9 @@ void read_glove_pick_and_place(const SceneReader& r, const Json& j, const std::s
   g.ball = r.nonempty_string(r.required(j, ptr, "ball"), JsonReader::at(ptr, "ball"), "a body");
   g.sheet = r.nonempty_string(r.required(j, ptr, "sheet"), JsonReader::at(ptr, "sheet"), "a body");
   for (const auto& [key, name] : {std::pair{"ball", &g.ball}, std::pair{"sheet", &g.sheet}}) {
+    const std::string* wanted = name;  // clang 14 cannot capture a structured binding
     if (std::none_of(scene.world.bodies.begin(), scene.world.bodies.end(),
-                     [&](const BodyDescription& b) { return b.name == *name; })) {
+                     [&](const BodyDescription& b) { return b.name == *wanted; })) {
       r.fail(JsonReader::at(ptr, key), "no body named '" + *name + "' in /bodies");
     }
   }

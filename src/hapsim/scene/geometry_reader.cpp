@@ -26,7 +26,8 @@ void GeometryReader::check_sizes(const std::string& ptr, const std::vector<Loade
   std::map<std::pair<bool, double>, std::vector<Implausible>> groups;
   std::vector<std::pair<bool, double>> order;
   for (const LoadedMesh& m : meshes) {
-    if (!size_checked_.insert(std::filesystem::absolute(m.file).lexically_normal()).second) {
+    std::error_code ec;
+    if (!size_checked_.insert(std::filesystem::absolute(m.file, ec).lexically_normal()).second) {
       continue;  // once per file
     }
     const Box3 bounds = m.mesh->bounds();
@@ -176,8 +177,10 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
       const std::string fp = JsonReader::at(kp, "folder");
       const std::filesystem::path folder =
           r_.path(r_.required(m, kp, "folder"), fp, "a folder path");
-      if (!std::filesystem::is_directory(folder)) {
-        r_.fail(fp, "expected a folder of mesh files; " + folder.string() + " is not a folder");
+      std::error_code ec;  // a loop of symlinks, a name too long, an unreadable folder: said
+      if (!std::filesystem::is_directory(folder, ec)) {
+        r_.fail(fp, "expected a folder of mesh files; " + folder.string() + " is not a folder" +
+                        (ec ? " (" + ec.message() + ")" : std::string()));
       }
       std::string pattern = "*.stl";
       if (m.contains("pattern")) {
@@ -198,12 +201,18 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
               ? r_.string(m["strip_suffix"], JsonReader::at(kp, "strip_suffix"), "text")
               : "";
       std::vector<std::filesystem::path> files;
-      for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+      std::filesystem::directory_iterator it(folder, ec);
+      for (; !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
+        const std::filesystem::directory_entry& entry = *it;
         const std::string name = ascii_lower(entry.path().filename().string());
-        if (entry.is_regular_file() && name.size() >= ending.size() &&
+        std::error_code entry_ec;
+        if (entry.is_regular_file(entry_ec) && name.size() >= ending.size() &&
             name.compare(name.size() - ending.size(), ending.size(), ending) == 0) {
           files.push_back(entry.path());
         }
+      }
+      if (ec) {
+        r_.fail(fp, "cannot list the folder " + folder.string() + " (" + ec.message() + ")");
       }
       std::sort(files.begin(), files.end());
       if (files.empty()) {

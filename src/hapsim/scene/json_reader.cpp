@@ -118,6 +118,11 @@ double JsonReader::number(const Json& j, const std::string& ptr, const std::stri
   if (!std::isfinite(v)) {
     fail(ptr, "expected a finite number" + (unit.empty() ? "" : " in " + unit));
   }
+  // A length beyond any scene (a body at 1e300 m squares to inf in every distance test).
+  constexpr double kMaxLength_m = 1e6;
+  if (unit == "m" && !(std::abs(v) <= kMaxLength_m)) {
+    fail(ptr, "expected a length within 1e6 m, got " + shown(j));
+  }
   return v;
 }
 

@@ -2,9 +2,11 @@
 
 #include "hapsim/core/device_io.h"
 #include "hapsim/core/error.h"
+#include "hapsim/core/text_file.h"
 #include "hapsim/geometry/mass_properties.h"
 #include "hapsim/scene/device_reader.h"
 #include "hapsim/scene/geometry_reader.h"
+#include "hapsim/scene/json_text.h"
 #include "hapsim/scene/scene_reader.h"
 #include "hapsim/scene/teleop_reader.h"
 
@@ -22,6 +24,9 @@ namespace hapsim {
 namespace {
 
 using Json = nlohmann::json;
+
+// Far above any scene (the knee_vhf scene is a few kB; meshes are files of their own).
+constexpr std::size_t kMaxSceneFileBytes = std::size_t{64} << 20;
 
 // The parser of the top level, materials, bodies, tools and run; the parts have their own readers
 // (geometry_reader.h, device_reader.h, teleop_reader.h). It carries the file name for messages,
@@ -436,49 +441,16 @@ void Parser::parse_run(const Json& root, SceneDescription& scene) const {
   }
 }
 
-// 1-based line and column of a byte offset, for JSON syntax errors.
-std::string line_column(std::string_view text, std::size_t byte) {
-  byte = std::min(byte, text.size());
-  std::size_t line = 1;
-  std::size_t column = 1;
-  for (std::size_t i = 0; i < byte; ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      column = 1;
-    } else {
-      ++column;
-    }
-  }
-  return std::to_string(line) + ":" + std::to_string(column);
-}
-
 }  // namespace
 
 SceneDescription parse_scene(std::string_view json_text, const std::filesystem::path& file,
                              const SceneLoadOptions& options) {
-  Json root;
-  try {
-    root = Json::parse(json_text.begin(), json_text.end());
-  } catch (const Json::parse_error& e) {
-    // e.byte is one past the offending character.
-    const std::size_t byte = e.byte > 0 ? e.byte - 1 : 0;
-    std::string what = e.what();
-    if (const auto pos = what.find("syntax error"); pos != std::string::npos) {
-      what = what.substr(pos);
-    }
-    throw Error(file.string() + ":" + line_column(json_text, byte), "invalid JSON: " + what);
-  }
+  const Json root = parse_json_text(json_text, file.string());
   return Parser(file, options).parse(root);
 }
 
 SceneDescription load_scene(const std::filesystem::path& file, const SceneLoadOptions& options) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in || std::filesystem::is_directory(file)) {
-    throw Error(file.string(), "cannot open the scene file (missing or unreadable)");
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scene(text.str(), file, options);
+  return parse_scene(read_text_file(file, kMaxSceneFileBytes, "scene file"), file, options);
 }
 
 }  // namespace hapsim

@@ -21,15 +21,17 @@ std::filesystem::path SceneReader::path(const Json& j, const std::string& ptr,
 std::filesystem::path SceneReader::existing_file(const Json& j, const std::string& ptr,
                                                  const std::string& what) const {
   std::filesystem::path p = path(j, ptr, what);
-  if (!std::filesystem::is_regular_file(p)) {
-    fail(ptr, "no such file: " + p.string());
+  std::error_code ec;  // a loop of symlinks or a name too long is said, not thrown
+  if (!std::filesystem::is_regular_file(p, ec)) {
+    fail(ptr, "no such file: " + p.string() + (ec ? " (" + ec.message() + ")" : std::string()));
   }
   return p;
 }
 
 std::filesystem::path SceneReader::data_dir(const std::string& ptr) const {
   if (!options_.data_dir.empty()) {
-    if (!std::filesystem::is_directory(options_.data_dir)) {
+    std::error_code ec;
+    if (!std::filesystem::is_directory(options_.data_dir, ec)) {
       fail(ptr, "the data folder " + options_.data_dir.string() + " does not exist");
     }
     return options_.data_dir;
@@ -44,7 +46,8 @@ std::filesystem::path SceneReader::data_dir(const std::string& ptr) const {
                   beside.lexically_normal().string() + ")");
   }
   std::filesystem::path dir = *root / data_default_;
-  if (!std::filesystem::is_directory(dir)) {
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) {
     fail(ptr, "needs the data folder " + dir.string() + ", which does not exist; give --data DIR");
   }
   return dir;

@@ -19,7 +19,8 @@ void read_teleop(const SceneReader& r, const Json& j, const std::string& ptr,
       r.one_of(s["model"], JsonReader::at(sp, "model"), {"procedural"});
     } else {
       t.slave_urdf = r.path(s["urdf"], JsonReader::at(sp, "urdf"), "a URDF file path");
-      if (!std::filesystem::is_regular_file(t.slave_urdf)) {
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(t.slave_urdf, ec)) {
         r.fail(JsonReader::at(sp, "urdf"), "no such file: " + t.slave_urdf.string());
       }
     }

@@ -1,6 +1,7 @@
 #include "hapsim/script/trajectory.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/text_file.h"
 
 #include <algorithm>
 #include <array>
@@ -397,16 +398,10 @@ Trajectory parse_trajectory_csv(std::string_view text, std::string_view source_n
 }
 
 Trajectory load_trajectory_csv(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    throw Error(path.string(), "cannot open trajectory file");
-  }
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) {
-    throw Error(path.string(), "cannot read trajectory file");
-  }
-  return parse_trajectory_csv(buffer.str(), path.string());
+  // An hour at 1 kHz with five fingers is about 400 MB of text.
+  constexpr std::size_t kMaxTrajectoryBytes = std::size_t{1} << 30;
+  return parse_trajectory_csv(read_text_file(path, kMaxTrajectoryBytes, "trajectory CSV"),
+                              path.string());
 }
 
 std::string format_trajectory_csv(const Trajectory& trajectory) {
