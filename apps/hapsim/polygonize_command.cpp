@@ -138,8 +138,8 @@ void run_polygonize(const PolygonizeCommandOptions& opt) {
   if (!(opt.cell_m > 0.0) || !std::isfinite(opt.cell_m)) {
     throw CommandError("--cell-m: must be a positive cell size in metres");
   }
-  if (!std::isfinite(opt.offset_m) || opt.offset_m < 0.0) {
-    throw CommandError("--offset-m: must be >= 0 metres, got " + std::to_string(opt.offset_m));
+  if (!std::isfinite(opt.offset_m)) {
+    throw CommandError("--offset-m: must be a finite distance in metres");
   }
   if (opt.crop_min.empty() != opt.crop_max.empty()) {
     throw CommandError("--crop-min and --crop-max go together");
@@ -211,8 +211,8 @@ void run_polygonize(const PolygonizeCommandOptions& opt) {
     return s;
   };
   field.distance = [&](const Vec3& p) { return field.evaluate(p).distance_m; };
-  bounds.min() -= Vec3::Constant(offset_m);
-  bounds.max() += Vec3::Constant(offset_m);
+  bounds.min() -= Vec3::Constant(std::max(offset_m, 0.0));
+  bounds.max() += Vec3::Constant(std::max(offset_m, 0.0));
   field.bounds = crop ? bounds.intersection(*crop) : bounds;
   // The grid is centred on the bounds: shift it off the crop planes by an odd fraction of a cell,
   // so no node lies exactly on a flat face (a vertex on a node makes a zero-area triangle).
@@ -270,7 +270,8 @@ void add_polygonize_command(CLI::App& app) {
       "cut to a box (marching tetrahedra on exact signed distances)");
   cmd->add_option("--mesh", opt->meshes, "A closed mesh of the union (repeatable)");
   cmd->add_option("--csg", opt->csg_path, "A CSG solid: one NODE as in a scene file, metres");
-  cmd->add_option("--offset-m", opt->offset_m, "Grow the union by this much, metres (a skin)");
+  cmd->add_option("--offset-m", opt->offset_m,
+                  "Grow the union by this much, metres (a skin); negative shrinks it");
   cmd->add_option("--crop-min", opt->crop_min, "Cut to the box from X,Y,Z (mesh units) ...");
   cmd->add_option("--crop-max", opt->crop_max, "... to X,Y,Z (mesh units)");
   cmd->add_option("--cell-m", opt->cell_m, "Grid cell, metres")->required();
