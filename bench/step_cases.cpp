@@ -31,7 +31,7 @@ std::filesystem::path default_scenes_dir() {
 std::vector<StepBenchCase> default_step_cases(
     const std::filesystem::path& scenes_dir, const std::optional<std::filesystem::path>& data_dir) {
   std::vector<StepBenchCase> cases;
-  cases.push_back({"knee-1-finger", scenes_dir / "knee.json", std::nullopt});
+  cases.push_back({"knee-1-finger", scenes_dir / "knee_procedural.json", std::nullopt});
   if (data_dir && std::filesystem::is_directory(*data_dir / "knee_vhf_left")) {
     cases.push_back({"vhf-5-fingers", scenes_dir / "knee_vhf.json", *data_dir / "knee_vhf_left"});
   }

@@ -14,15 +14,15 @@ mkdir -p "$out"
 xvfb=(xvfb-run -a -s "-screen 0 1280x720x24")
 
 echo "== haptic loop alone, ${seconds} s (hapsim run --realtime)"
-"$bin" run "${HAPSIM_ROOT}/scenes/knee.json" -q --realtime --duration "$seconds" \
+"$bin" run "${HAPSIM_ROOT}/scenes/knee_procedural.json" -q --realtime --duration "$seconds" \
   --json "$out/loop-alone.json" | grep -E "real time|step cost"
 
 echo "== viewer on the procedural knee, ${seconds} s, scripted palpation, no vsync"
-"${xvfb[@]}" "$bin" view "${HAPSIM_ROOT}/scenes/knee.json" --device sim --no-vsync \
+"${xvfb[@]}" "$bin" view "${HAPSIM_ROOT}/scenes/knee_procedural.json" --device sim --no-vsync \
   --duration "$seconds" --json "$out/view-knee.json" --screenshot "$out/view-knee.png"
 
 echo "== the same with the 3D view filling the window (no panels)"
-"${xvfb[@]}" "$bin" view "${HAPSIM_ROOT}/scenes/knee.json" --device sim --no-vsync --no-panels \
+"${xvfb[@]}" "$bin" view "${HAPSIM_ROOT}/scenes/knee_procedural.json" --device sim --no-vsync --no-panels \
   --duration "$((seconds < 20 ? seconds : 20))" --json "$out/view-knee-nopanels.json"
 
 data="${HAPSIM_ROOT}/../shared/data/knee_vhf_left"

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The main job: install what is missing, build, then run the knee palpation scene on the simulated
-# device (scenes/knee.json: a procedural knee, one fingertip, a scripted palpation) and report what
+# device (scenes/knee.json: the real Visible Human knee at ~13.5k vertices, one fingertip, a scripted
+# palpation of the landmarks a surgeon feels) and report what
 # happened, with a picture of the final state. Extra arguments go to `hapsim run` (e.g. --method
 # knee, --realtime, --record FILE, --snapshot FILE.png --snapshot-every 500).
 set -euo pipefail

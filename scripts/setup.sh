@@ -15,6 +15,8 @@ HAPSIM_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   # product libraries: find_package(Eigen3, assimp, urdfdom, nlohmann_json, CLI11, spdlog)
   libeigen3-dev libassimp-dev liburdfdom-dev nlohmann-json3-dev libcli11-dev libspdlog-dev
+  # find_package(meshoptimizer): mesh simplification (hapsim simplify, display levels of detail)
+  libmeshoptimizer-dev
   # find_package(OpenGL COMPONENTS OpenGL EGL): GL/gl.h and KHR/ (libgl-dev), libOpenGL.so
   # (libopengl-dev, GLVND's OpenGL library: the renderer links it, not libGL), EGL/egl.h and
   # libEGL.so (libegl-dev)

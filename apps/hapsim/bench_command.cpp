@@ -510,7 +510,7 @@ void add_bench_command(CLI::App& app) {
                    "--dds: seconds per run (default 10.5: the knee's palpation)")
       ->check(CLI::Range(1.0, 600.0));
   network->add_option("--scene", network_args->dds_args.scene,
-                      "--dds: the scene served (default scenes/knee.json)");
+                      "--dds: the scene served (default scenes/knee_procedural.json)");
   network->add_option("--domain", network_args->dds_args.domain, "--dds: DDS domain id")
       ->check(CLI::Range(0, 232));
   network->callback([network_args] { run_network(*network_args); });

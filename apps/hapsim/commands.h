@@ -42,5 +42,7 @@ void add_serve_command(CLI::App& app);
 void add_device_command(CLI::App& app);
 void add_watch_command(CLI::App& app);
 void add_control_command(CLI::App& app);
+void add_simplify_command(CLI::App& app);
+void add_polygonize_command(CLI::App& app);
 
 }  // namespace hapsim::app

@@ -36,6 +36,8 @@ int main(int argc, char** argv) {
   add_device_command(app);
   add_watch_command(app);
   add_control_command(app);
+  add_simplify_command(app);
+  add_polygonize_command(app);
 #ifdef HAPSIM_WITH_BENCH
   add_bench_command(app);
 #endif

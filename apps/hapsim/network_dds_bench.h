@@ -9,7 +9,7 @@
 namespace hapsim::app {
 
 struct NetworkDdsArgs {
-  std::string scene = "scenes/knee.json";
+  std::string scene = "scenes/knee_procedural.json";
   int viewers = 8;
   double duration_s = 10.5;
   int domain = 0;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -205,6 +206,33 @@ TEST(Cli, MeshWithNanCoordinatesIsRefusedAndNamed) {
   const RunResult r = run_hapsim("info " + obj.string());
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("cube_nan.obj"), std::string::npos) << r.output;
+}
+
+// `hapsim simplify`: a sphere to 500 vertices, written, and its Hausdorff line; bad input is one
+// line and exit 2.
+TEST(Cli, SimplifyWritesAClosedMeshAndItsHausdorffDistance) {
+  const auto out = std::filesystem::temp_directory_path() / "hapsim_simplified.stl";
+  const auto json = std::filesystem::temp_directory_path() / "hapsim_simplified.json";
+  const RunResult r = run_hapsim("simplify builtin:bumpy-sphere --target-vertices 500 --out " +
+                                 out.string() + " --json " + json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("hausdorff"), std::string::npos) << r.output;
+  std::ifstream in(json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_LE(j["vertices"].get<int>(), 500);
+  EXPECT_TRUE(j["closed"].get<bool>());
+  EXPECT_GT(j["hausdorff_m"].get<double>(), 0.0);
+  EXPECT_LE(j["hausdorff_m"].get<double>(), j["hausdorff_bound_m"].get<double>());
+
+  for (const std::string& bad :
+       {"simplify builtin:box --target-vertices 0 --out " + out.string(),
+        std::string("simplify builtin:box --target-vertices 10 --out x.notamesh"),
+        "simplify builtin:sheet16 --target-vertices 10 --out " + out.string(),
+        "simplify /nonexistent/knee.stl --target-vertices 10 --out " + out.string()}) {
+    const RunResult b = run_hapsim(bad);
+    EXPECT_EQ(b.exit_code, 2) << bad << ": " << b.output;
+    EXPECT_EQ(std::count(b.output.begin(), b.output.end(), '\n'), 1) << b.output;
+  }
 }
 
 TEST(Cli, InfoOnTheRealKnee) {

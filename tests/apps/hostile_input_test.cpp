@@ -56,7 +56,7 @@ fs::path write(const std::string& name, const std::string& text) {
 
 // A valid scene (the shipped knee) with `replace` put in for `find`.
 fs::path knee_with(const std::string& name, const std::string& find, const std::string& replace) {
-  std::ifstream in(kScenes + "knee.json");
+  std::ifstream in(kScenes + "knee_procedural.json");
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::size_t at = text.find(find);
   EXPECT_NE(at, std::string::npos) << find;
@@ -145,7 +145,7 @@ TEST(HostileInput, FileSystemRefusalsNameThePath) {
 TEST(HostileInput, UnboundedStepCountsAreRefused) {
   const fs::path tiny_dt = knee_with("tiny_dt.json", "\"dt_s\": 0.001", "\"dt_s\": 1e-9");
   expect_one_line_error(run_limited("run " + tiny_dt.string()), {tiny_dt.string(), "steps"});
-  const std::string knee = kScenes + "knee.json";
+  const std::string knee = kScenes + "knee_procedural.json";
   expect_one_line_error(run_limited("run " + knee + " --duration 1e300"), {"--duration"});
   expect_one_line_error(run_limited("run " + knee + " --duration nan"), {"--duration", "nan"});
   const fs::path long_traj =

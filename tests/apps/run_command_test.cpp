@@ -27,10 +27,10 @@ using hapsim::test::RunResult;
 using hapsim::test::temp_path;
 using hapsim::test::write_file;
 
-const std::string kKnee = std::string(HAPSIM_SCENES_DIR) + "/knee.json";
+const std::string kKnee = std::string(HAPSIM_SCENES_DIR) + "/knee_procedural.json";
 
 TEST(RunCommand, KneePalpationReportsAndWritesJson) {
-  const auto json_path = temp_path("knee.json");
+  const auto json_path = temp_path("knee_procedural.json");
   const RunResult r = run_hapsim("run " + kKnee + " --duration 4 -q --json " + json_path.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("pop-throughs: 0"), std::string::npos) << r.output;

@@ -13,7 +13,7 @@
 namespace hapsim {
 namespace {
 
-const std::string kKnee = std::string(HAPSIM_SCENES_DIR) + "/knee.json";
+const std::string kKnee = std::string(HAPSIM_SCENES_DIR) + "/knee_procedural.json";
 
 TEST(RunCommand, RealtimeAddsTheLoopFiguresToTheSummary) {
   const auto json = test::temp_path("rt.json");

@@ -77,7 +77,7 @@ TEST(TeleopRun, RecordingReplaysBitForBit) {
   // A recording of the knee is not a recording of the teleop scene.
   const auto knee_rec = temp_path("knee.rec");
   ASSERT_EQ(
-      run_hapsim("run " + kScenes + "/knee.json -q --duration 0.05 --record " + knee_rec.string())
+      run_hapsim("run " + kScenes + "/knee_procedural.json -q --duration 0.05 --record " + knee_rec.string())
           .exit_code,
       0);
   const RunResult wrong =

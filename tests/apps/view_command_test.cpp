@@ -44,7 +44,7 @@ TEST(ViewCommand, MouseProbeUnderXvfbDentsTheKneeAndShowsTheForce) {
   const auto out = test::temp_path("viewer");
   const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' bash ") +
                           HAPSIM_SOURCE_DIR + "/tests/apps/viewer_smoke.sh " + HAPSIM_BIN_PATH +
-                          " " + HAPSIM_SCENES_DIR + "/knee.json " + out.string();
+                          " " + HAPSIM_SCENES_DIR + "/knee_procedural.json " + out.string();
   const int status = std::system(cmd.c_str());
   std::ifstream log(out / "view.log");
   const std::string log_text((std::istreambuf_iterator<char>(log)), {});
@@ -89,7 +89,7 @@ TEST(ViewCommand, PrintsTheScenesWarningsOnceAndListsThemInItsJson) {
   const auto json = test::temp_path("view_warnings.json");
   const auto log = test::temp_path("view_warnings.log");
   const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' ") + HAPSIM_BIN_PATH +
-                          " view " + HAPSIM_SCENES_DIR + "/knee.json --device sim:" + far.string() +
+                          " view " + HAPSIM_SCENES_DIR + "/knee_procedural.json --device sim:" + far.string() +
                           " --duration 2 --size 640x480 --json " + json.string() + " > " +
                           log.string() + " 2>&1";
   const int status = std::system(cmd.c_str());
@@ -108,7 +108,7 @@ TEST(ViewCommand, PrintsTheScenesWarningsOnceAndListsThemInItsJson) {
 
 TEST(ViewCommand, NoDisplayIsAClearError) {
   const std::string cmd = std::string("env -u DISPLAY -u WAYLAND_DISPLAY ") + HAPSIM_BIN_PATH +
-                          " view " + HAPSIM_SCENES_DIR + "/knee.json > " +
+                          " view " + HAPSIM_SCENES_DIR + "/knee_procedural.json > " +
                           test::temp_path("nodisplay.txt").string() + " 2>&1";
   const int status = std::system(cmd.c_str());
   std::ifstream in(test::temp_path("nodisplay.txt"));

@@ -52,7 +52,7 @@ TEST(DeviceHostProcess, TheExamplePluginDrivesAServedWorld) {
   ASSERT_TRUE(test::on_loopback_config());
   const auto device_json = hapsim::test::temp_path("plugin-device.json");
   const std::string net = " --session plugin-test --domain 77";
-  BackgroundHapsim serve("serve " + kScenes + "knee.json --duration 6" + net,
+  BackgroundHapsim serve("serve " + kScenes + "knee_procedural.json --duration 6" + net,
                          hapsim::test::temp_path("plugin-serve.log"));
   ASSERT_TRUE(serve.wait_for("dds ", 20s)) << serve.output();
   BackgroundHapsim device(std::string("device --device plugin:") + HAPSIM_EXAMPLE_DRIVER +

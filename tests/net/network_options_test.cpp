@@ -9,7 +9,7 @@
 namespace hapsim::net {
 namespace {
 
-const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee.json";
+const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee_procedural.json";
 
 // `hapsim ARGS` with CYCLONEDDS_URI unset (the commands' own default then applies).
 hapsim::test::RunResult run_without_uri(const std::string& args) {

@@ -27,7 +27,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr dds_domainid_t kDomain = 74;
-const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee.json";
+const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee_procedural.json";
 
 std::uint64_t knee_hash() {
   RunSetup setup = make_run_setup(load_scene(kScene), DeviceChoice::scene_script());

@@ -27,7 +27,7 @@ namespace {
 using namespace std::chrono_literals;
 using hapsim::test::BackgroundHapsim;
 
-const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee.json";
+const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee_procedural.json";
 
 nlohmann::json read_json(const std::filesystem::path& path) {
   std::ifstream in(path);

@@ -15,7 +15,7 @@
 namespace hapsim::net {
 namespace {
 
-const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee.json";
+const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee_procedural.json";
 constexpr std::uint64_t kHash = 0x1234;
 
 struct Served {

@@ -68,7 +68,7 @@ TEST(SceneReference, KneeInEachDisplayModeMatchesTheReferences) {
     GTEST_SKIP() << "no EGL context on this machine";
   }
   const SceneDescription scene =
-      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_procedural.json");
   World world(scene.world);
   auto device = make_scene_device(scene, world);
   WorldScene view(world);
@@ -101,7 +101,7 @@ TEST(SceneReference, KneeSegmentAndGroupColoursMatchTheReferences) {
     GTEST_SKIP() << "no EGL context on this machine";
   }
   const SceneDescription scene =
-      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_procedural.json");
   World world(scene.world);
   WorldSceneOptions o;
   o.colouring = SegmentColouring::kSegments;

@@ -181,7 +181,7 @@ TEST(WorldHapticClient, ReaderThreadSeesConsistentSnapshotsAndHapticThreadDoesNo
 // whole haptic cycle (device read, World::step, safety, write, publish) allocates nothing.
 TEST(WorldHapticClient, KneeSceneWithItsScriptedDeviceAllocatesNothingOnTheHapticThread) {
   const SceneDescription scene =
-      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_procedural.json");
   World world(scene.world);
   auto device = make_scene_device(scene, world);
   WorldHapticClientOptions co;
@@ -406,12 +406,12 @@ TEST(Session, RealtimeRecordingReplaysBitForBitOffline) {
   std::filesystem::remove(again);
 }
 
-// `hapsim run scenes/knee.json --realtime --record F` then `--replay F`: the shipped scene with its
+// `hapsim run scenes/knee_procedural.json --realtime --record F` then `--replay F`: the shipped scene with its
 // palpation script on the real-time loop, stalled once while the fingertip presses, replays bit for
 // bit the way the command replays it (make_run_setup with the recording, an inline run).
 TEST(Session, RealtimeKneeRecordingReplaysBitForBitAfterAStall) {
   const SceneDescription scene =
-      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_procedural.json");
   const auto path = std::filesystem::temp_directory_path() /
                     ("hapsim_rt_knee_" + std::to_string(::getpid()) + ".rec");
   RunSetup setup = make_run_setup(scene, DeviceChoice::scene_script());

@@ -134,11 +134,8 @@ struct Grid {
   }
 };
 
-Grid make_grid(const CsgSolid& solid, const PolygonizeOptions& options) {
-  if (solid.is_empty()) {
-    throw Error(kWhere, "the solid is empty (no primitive); nothing to polygonise");
-  }
-  const Box3 box = solid.bounds();
+Grid make_grid(const DistanceField& solid, const PolygonizeOptions& options) {
+  const Box3 box = solid.bounds;
   if (box.isEmpty()) {
     throw Error(kWhere, "the solid's bounds are empty (e.g. an intersection of disjoint solids)");
   }
@@ -193,7 +190,7 @@ Grid make_grid(const CsgSolid& solid, const PolygonizeOptions& options) {
 
 // Evaluates the distance at every node of slab k; border nodes are clamped to "outside" so the
 // mesh is closed even if bounds() were ever too tight.
-void evaluate_slab(const CsgSolid& solid, const Grid& g, int k, int threads,
+void evaluate_slab(const DistanceField& solid, const Grid& g, int k, int threads,
                    std::vector<double>* values) {
   const auto rows = [&](int j0, int j1) {
     for (int j = j0; j < j1; ++j) {
@@ -236,7 +233,7 @@ struct Refined {
 // Finds the zero crossing on the segment p_in (d_in < 0) → p_out (d_out ≥ 0): Newton along the
 // segment, safeguarded by a shrinking bracket (bisection when Newton leaves it). The result
 // stays on the segment, which is what keeps the triangulation fold-free.
-Refined refine_on_edge(const CsgSolid& solid, const Vec3& p_in, double d_in, const Vec3& p_out,
+Refined refine_on_edge(const DistanceField& solid, const Vec3& p_in, double d_in, const Vec3& p_out,
                        double d_out, double tolerance_m, std::size_t* evaluations) {
   const Vec3 D = p_out - p_in;
   double lo = 0.0;
@@ -275,6 +272,21 @@ Refined refine_on_edge(const CsgSolid& solid, const Vec3& p_in, double d_in, con
 
 TriangleMesh polygonize(const CsgSolid& solid, const PolygonizeOptions& options,
                         PolygonizeStats* stats) {
+  if (solid.is_empty()) {
+    throw Error(kWhere, "the solid is empty (no primitive); nothing to polygonise");
+  }
+  DistanceField field;
+  field.evaluate = [&solid](const Vec3& p) { return solid.evaluate(p); };
+  field.distance = [&solid](const Vec3& p) { return solid.distance(p); };
+  field.bounds = solid.bounds();
+  return polygonize(field, options, stats);
+}
+
+TriangleMesh polygonize(const DistanceField& solid, const PolygonizeOptions& options,
+                        PolygonizeStats* stats) {
+  if (!solid.evaluate || !solid.distance) {
+    throw Error(kWhere, "the distance field has no evaluation function");
+  }
   const Grid g = make_grid(solid, options);
   const int threads = options.threads > 0
                           ? options.threads
@@ -282,7 +294,7 @@ TriangleMesh polygonize(const CsgSolid& solid, const PolygonizeOptions& options,
   const auto& cases = tet_cases();
   const auto tets = kuhn_tets();
   const std::size_t nxy = static_cast<std::size_t>(g.nx) * g.ny;
-  const double scale = std::max(solid.bounds().sizes().maxCoeff(), g.h);
+  const double scale = std::max(solid.bounds.sizes().maxCoeff(), g.h);
   const double tolerance_m = 1e-10 * scale;
 
   PolygonizeStats st;

@@ -23,6 +23,7 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
 
 namespace hapsim {
 
@@ -61,6 +62,21 @@ struct PolygonizeStats {
   /// Largest |distance| at an output vertex, metres.
   double max_vertex_distance_m = 0.0;
 };
+
+/// Any signed distance field (negative inside, the right sign everywhere, |value| at most the
+/// true distance), e.g. an offset of meshes' exact signed distances built in a higher layer.
+struct DistanceField {
+  /// Distance and unit outward gradient; called from several threads at once.
+  std::function<SdfSample(const Vec3&)> evaluate;
+  /// Distance only (same value as evaluate), for the grid; called from several threads at once.
+  std::function<double(const Vec3&)> distance;
+  /// A box containing everything inside the field.
+  Box3 bounds;
+};
+
+/// Polygonises a distance field, as the CSG overload below (which wraps its solid in one).
+TriangleMesh polygonize(const DistanceField& field, const PolygonizeOptions& options,
+                        PolygonizeStats* stats = nullptr);
 
 /// Polygonises `solid`. Throws hapsim::Error (where = "polygonize") for: no cell size or
 /// resolution, non-positive/non-finite cell size, an empty solid (structurally, or no grid node

@@ -35,6 +35,8 @@ class RenderMesh {
  public:
   /// Appearance: change freely, no re-upload needed.
   Vec3f colour = Vec3f(0.8f, 0.8f, 0.8f);
+  /// 1 opaque; less is blended over what is behind it, drawn after every opaque mesh.
+  float opacity = 1.0f;
   /// World-from-mesh pose.
   Iso3 X_world_mesh = Iso3::Identity();
   bool visible = true;

@@ -66,9 +66,10 @@ void main() {
 constexpr const char* kLitFragment = R"(#version 330 core
 in vec3 v_front_colour;
 in vec3 v_back_colour;
+uniform float u_opacity;
 out vec4 o_colour;
 void main() {
-  o_colour = vec4(gl_FrontFacing ? v_front_colour : v_back_colour, 1.0);
+  o_colour = vec4(gl_FrontFacing ? v_front_colour : v_back_colour, u_opacity);
 }
 )";
 
@@ -209,7 +210,7 @@ struct GpuMesh {
 struct LitUniforms {
   GLint model_view = -1, projection = -1, colour = -1, use_vertex_colour = -1, light_count = -1,
         light_dir = -1, light_colour = -1, ambient = -1, specular = -1, shininess = -1,
-        point_size = -1;
+        point_size = -1, opacity = -1;
 };
 
 }  // namespace
@@ -344,6 +345,7 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   s.lit_u.model_view = loc(s.lit, "u_model_view");
   s.lit_u.projection = loc(s.lit, "u_projection");
   s.lit_u.colour = loc(s.lit, "u_colour");
+  s.lit_u.opacity = loc(s.lit, "u_opacity");
   s.lit_u.use_vertex_colour = loc(s.lit, "u_use_vertex_colour");
   s.lit_u.light_count = loc(s.lit, "u_light_count");
   s.lit_u.light_dir = loc(s.lit, "u_light_dir_camera");
@@ -516,34 +518,41 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   glUniform1f(s.lit_u.point_size, style.point_size_px);
   const float line_width = std::clamp(style.line_width_px, 1.0f, s.max_line_width);
   glLineWidth(line_width);
-  for (MeshId id = 0; id < scene.mesh_count(); ++id) {
-    const RenderMesh& m = scene.mesh(id);
-    const GpuMesh& gpu = s.meshes[id];
-    if (!m.visible || gpu.vertex_count == 0) {
-      continue;
+  glUniform1f(s.lit_u.opacity, 1.0f);
+  // Opaque meshes first; see-through ones (opacity < 1) last, blended, not writing depth.
+  const auto draw_meshes = [&](bool translucent) {
+    for (MeshId id = 0; id < scene.mesh_count(); ++id) {
+      const RenderMesh& m = scene.mesh(id);
+      const GpuMesh& gpu = s.meshes[id];
+      if (!m.visible || gpu.vertex_count == 0 || (m.opacity < 1.0f) != translucent) {
+        continue;
+      }
+      glUniform1f(s.lit_u.opacity, m.opacity);
+      set_matrix(s.lit_u.model_view, (X_camera_world * m.X_world_mesh.matrix()).cast<float>());
+      const bool vertex_colours =
+          style.colour_mode == ColourMode::kVertexColours && gpu.has_vertex_colours;
+      glUniform1i(s.lit_u.use_vertex_colour, vertex_colours ? 1 : 0);
+      set_vec3(s.lit_u.colour, style.colour_mode == ColourMode::kPalette
+                                   ? palette_colour(static_cast<int>(id))
+                                   : m.colour);
+      glBindVertexArray(gpu.vao);
+      switch (style.display_mode) {
+        case DisplayMode::kPoints:
+          glDrawArrays(GL_POINTS, 0, gpu.vertex_count);
+          break;
+        case DisplayMode::kLines:
+          glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
+          glDrawElements(GL_TRIANGLES, gpu.index_count, GL_UNSIGNED_INT, nullptr);
+          glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
+          break;
+        case DisplayMode::kFaces:
+          glDrawElements(GL_TRIANGLES, gpu.index_count, GL_UNSIGNED_INT, nullptr);
+          break;
+      }
     }
-    set_matrix(s.lit_u.model_view, (X_camera_world * m.X_world_mesh.matrix()).cast<float>());
-    const bool vertex_colours =
-        style.colour_mode == ColourMode::kVertexColours && gpu.has_vertex_colours;
-    glUniform1i(s.lit_u.use_vertex_colour, vertex_colours ? 1 : 0);
-    set_vec3(s.lit_u.colour, style.colour_mode == ColourMode::kPalette
-                                 ? palette_colour(static_cast<int>(id))
-                                 : m.colour);
-    glBindVertexArray(gpu.vao);
-    switch (style.display_mode) {
-      case DisplayMode::kPoints:
-        glDrawArrays(GL_POINTS, 0, gpu.vertex_count);
-        break;
-      case DisplayMode::kLines:
-        glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
-        glDrawElements(GL_TRIANGLES, gpu.index_count, GL_UNSIGNED_INT, nullptr);
-        glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
-        break;
-      case DisplayMode::kFaces:
-        glDrawElements(GL_TRIANGLES, gpu.index_count, GL_UNSIGNED_INT, nullptr);
-        break;
-    }
-  }
+    glUniform1f(s.lit_u.opacity, 1.0f);
+  };
+  draw_meshes(false);
 
   if (!scene.spheres.empty()) {
     glBindVertexArray(s.sphere.vao);
@@ -569,6 +578,13 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
     glBindVertexArray(s.stream_vao);
     glDrawArrays(GL_LINES, segments_first, stream_end - segments_first);
   }
+  glUseProgram(s.lit);
+  glEnable(GL_BLEND);
+  glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+  glDepthMask(GL_FALSE);
+  draw_meshes(true);
+  glDepthMask(GL_TRUE);
+  glDisable(GL_BLEND);
   glBindVertexArray(0);
   glUseProgram(0);
 }

@@ -145,6 +145,7 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
       seg->mesh = scene_.add_mesh(role.box ? faceted(sd.mesh) : sd.mesh, seg->tissue_colour,
                                   world.body_pose(b));
       scene_.mesh(seg->mesh).name = seg->label;
+      scene_.mesh(seg->mesh).opacity = static_cast<float>(m.opacity);
       // A rig's floor is a slab much wider than the scene: the checked floor stands for it.
       scene_.mesh(seg->mesh).visible = !role.floor;
       for (const Vec3& v : sd.mesh.vertices) {

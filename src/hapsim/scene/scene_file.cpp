@@ -159,9 +159,10 @@ void Parser::parse_materials(const Json& j, const std::string& ptr, WorldDescrip
   for (const auto& [name, m] : j.items()) {
     const std::string p = at(ptr, name);
     object(m, p, "a material");
-    allow_keys(m, p,
-               {"description", "response", "stiffness_n_per_m", "max_penetration_m", "max_force_n",
-                "damping_n_s_per_m", "static_friction", "dynamic_friction", "deformation"});
+    allow_keys(
+        m, p,
+        {"description", "response", "stiffness_n_per_m", "max_penetration_m", "max_force_n",
+         "damping_n_s_per_m", "static_friction", "dynamic_friction", "deformation", "opacity"});
     MaterialDescription md;
     md.name = name;
     if (m.contains("response")) {
@@ -183,6 +184,7 @@ void Parser::parse_materials(const Json& j, const std::string& ptr, WorldDescrip
       fail(at(p, "dynamic_friction"), "expected dynamic friction <= static friction (" +
                                           std::to_string(c.static_friction) + ")");
     }
+    md.opacity = number_in(m, p, "opacity", 1.0, 0.0, 1.0, "", true);
     if (m.contains("deformation")) {
       const std::string dp = at(p, "deformation");
       const Json& d = object(m["deformation"], dp, "deformation parameters");

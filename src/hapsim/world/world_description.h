@@ -77,6 +77,8 @@ struct MaterialDescription {
   ContactResponse response = ContactResponse::kProxy;
   /// Used when the body is deformable.
   DeflectionParams deflection;
+  /// Display only: 1 opaque, less is drawn see-through (a skin over the anatomy).
+  double opacity = 1.0;
 };
 
 /// A segment that is exactly a sphere (its mesh only approximates it): bodies meet it through its

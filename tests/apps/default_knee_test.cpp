@@ -1,0 +1,78 @@
+// The default scene, scenes/knee.json: the real Visible Human knee derived by
+// scripts/derive-knee.sh and committed (no ../shared needed). Every part is a closed, valid
+// surface, the whole is at the knee paper's budget, and the main job's palpation touches the
+// landmarks a surgeon feels with a few newtons, without pop-through or a force above the rating.
+#include <nlohmann/json.hpp>
+
+#include "hapsim_process.h"
+
+#include "hapsim/geometry/mesh_io.h"
+#include "hapsim/geometry/mesh_validation.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+using hapsim::test::run_hapsim;
+using hapsim::test::RunResult;
+using hapsim::test::temp_path;
+
+const fs::path kScenes = HAPSIM_SCENES_DIR;
+
+TEST(DefaultKnee, EveryPartClosedValidAndTheWholeAtThePapersBudget) {
+  std::size_t parts = 0;
+  std::size_t vertices = 0;
+  for (const auto& entry : fs::directory_iterator(kScenes / "knee_vhf_small")) {
+    if (entry.path().extension() != ".stl") {
+      continue;
+    }
+    ++parts;
+    hapsim::MeshReport report;
+    const hapsim::TriangleMesh mesh = hapsim::load_mesh(entry.path(), {}, &report);
+    const hapsim::MeshReport check = hapsim::validate_mesh(mesh);
+    EXPECT_TRUE(check.closed) << entry.path() << ": " << check.summary();
+    EXPECT_FALSE(check.has_defects()) << entry.path() << ": " << check.summary();
+    EXPECT_EQ(check.components, 1u) << entry.path();
+    EXPECT_GT(check.signed_volume, 0.0) << entry.path();
+    vertices += mesh.vertex_count();
+  }
+  EXPECT_EQ(parts, 27u);
+  // The knee paper's model: about 13.5k vertices.
+  EXPECT_GE(vertices, 12000u);
+  EXPECT_LE(vertices, 14000u);
+  EXPECT_TRUE(fs::exists(kScenes / "knee_vhf_small" / "ATTRIBUTION.md"));
+}
+
+TEST(DefaultKnee, PalpationTouchesTheLandmarksWithAFewNewtons) {
+  const auto json_path = temp_path("default_knee_run.json");
+  const auto png = temp_path("default_knee_final.png");
+  const RunResult r = run_hapsim("run " + (kScenes / "knee.json").string() + " -q --json " +
+                                 json_path.string() + " --snapshot " + png.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("pop_throughs").get<std::size_t>(), 0u);
+  EXPECT_EQ(j.at("max_force_limit_violations").get<std::size_t>(), 0u);
+  std::map<std::string, double> peak_n;
+  for (const auto& s : j.at("segments")) {
+    if (s.at("contacts").get<std::size_t>() > 0) {
+      peak_n[s.at("body").get<std::string>() + "/" + s.at("name").get<std::string>()] =
+          s.at("peak_force_n").get<double>();
+    }
+  }
+  for (const char* landmark : {"knee/Bone_Patella", "knee/Tendon_Patellar", "knee/Bone_Tibia",
+                               "knee/Ligament_MCL", "knee/Ligament_LCL", "knee/Skin"}) {
+    ASSERT_TRUE(peak_n.count(landmark)) << landmark << " never touched";
+    EXPECT_GT(peak_n[landmark], 0.5) << landmark;
+    EXPECT_LT(peak_n[landmark], 10.0) << landmark;
+  }
+  EXPECT_TRUE(fs::exists(png));
+}
+
+}  // namespace
