@@ -119,6 +119,9 @@ class RunSnapshots final : public SnapshotSink {
   void write(const World& world, const std::string& path) {
     if (!scene_) {
       scene_ = make_scene_(world);
+      for (const std::string& warning : scene_->warnings()) {
+        spdlog::warn("snapshot: {}", warning);
+      }
       scene_->scene().style.display_mode = parse_display_mode(args_.display_mode);
       camera_ = framed_camera(scene_->rest_bounds_world(),
                               static_cast<double>(writer_->width()) / writer_->height(), yaw_rad_,

@@ -65,6 +65,16 @@ struct RenderSphere {
   bool wireframe = false;
 };
 
+/// A rounded rod from `a_world` to `b_world` (a phalanx, a robot link, a master arm's segment),
+/// lit: a cylinder of `radius_m` with a sphere of the same radius at each end. Drawn filled in
+/// every display mode, like the spheres.
+struct RenderCapsule {
+  Vec3 a_world = Vec3::Zero();
+  Vec3 b_world = Vec3::Zero();
+  double radius_m = 0.01;
+  Vec3f colour = Vec3f(0.8f, 0.8f, 0.8f);
+};
+
 /// A straight line from `a_world` to `b_world`, unlit, drawn RenderStyle::line_width_px wide.
 struct RenderSegment {
   Vec3 a_world = Vec3::Zero();
@@ -149,11 +159,13 @@ class RenderScene {
   [[nodiscard]] const RenderMesh& mesh(MeshId id) const;
   [[nodiscard]] std::size_t mesh_count() const { return meshes_.size(); }
 
-  /// World bounds of the visible meshes and spheres (for OrbitCamera::frame); empty if none.
+  /// World bounds of the visible meshes, spheres and capsules (for OrbitCamera::frame); empty if
+  /// none.
   [[nodiscard]] Box3 bounds_world() const;
 
   /// Per-frame content: cleared and refilled by the app (vectors keep their capacity).
   std::vector<RenderSphere> spheres;
+  std::vector<RenderCapsule> capsules;
   std::vector<RenderSegment> segments;
   std::vector<ShadowMark> shadow_marks;
 

@@ -144,6 +144,7 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
   s.time_s = cycle.time_s;
   s.input = *cycle.input;
   s.output = *cycle.output;
+  s.hand = world_.hand_reading();
   const WorldDescription& d = world_.description();
   if (last_result_ != nullptr) {
     const StepResult& r = *last_result_;
