@@ -157,6 +157,80 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
   EXPECT_GT(p[0], 2 * p[1]) << "no red ball at its projection";
 }
 
+// A teleoperation scene stepped `steps` cycles on its scripted pick-and-place (−1: all of it).
+std::unique_ptr<World> stepped_teleop(const SceneDescription& scene, int steps) {
+  TeleopSetup setup = make_teleop_setup(scene, std::nullopt, true);
+  auto world = std::make_unique<World>(setup.description);
+  const double dt = scene.run.dt_s;
+  const Trajectory& t = setup.trajectory;
+  if (steps < 0) {
+    steps = static_cast<int>((t.end_time_s() - t.start_time_s()) / dt);
+  }
+  for (int k = 1; k <= steps; ++k) {
+    world->step(setup.trajectory.sample_at(setup.trajectory.start_time_s() + k * dt), dt);
+  }
+  return world;
+}
+
+TEST(SceneReference, Gp7DrawnFromItsVisualMeshesMatchesTheReference) {
+  const auto data = std::filesystem::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7";
+  if (!std::filesystem::exists(data / "gp7.urdf")) {
+    GTEST_SKIP() << "Motoman GP7 URDF not found in " << data << " (real-data tests skip)";
+  }
+  auto writer = make_writer();
+  if (!writer) {
+    GTEST_SKIP() << "no EGL context on this machine";
+  }
+  SceneLoadOptions o;
+  o.data_dir = data;
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop_gp7.json", o);
+  const auto world = stepped_teleop(scene, 6000);
+  WorldScene view(*world);
+  view.update_from_world(*world);
+  const OrbitCamera camera =
+      framed_camera(view.rest_bounds_world(), static_cast<double>(kWidth) / kHeight, -0.9, 0.45);
+  check_reference(*writer, view.scene(), camera, "teleop_gp7");
+}
+
+TEST(SceneReference, BallsImprintInTheSheetMatchesTheReference) {
+  auto writer = make_writer();
+  if (!writer) {
+    GTEST_SKIP() << "no EGL context on this machine";
+  }
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
+  // The whole pick-and-place: the ball rests in its dent on the sheet (the ball hidden).
+  auto world = stepped_teleop(scene, -1);
+  const TeleopRigDescription& rig = *world->description().teleop;
+  const Vec3 ball = world->body_pose(rig.ball_body).translation();
+  WorldScene view(*world);
+  view.update_from_world(*world);
+  // Only the sheet, from above at the ball's side: its grid bends and darkens into the dent.
+  for (std::size_t i = 0; i < view.segment_count(); ++i) {
+    view.set_segment_visible(i, i == world->flat_segment(rig.sheet_body, 0));
+  }
+  view.scene().capsules.clear();
+  view.scene().spheres.clear();
+  OrbitCamera camera;
+  camera.target_world = ball - Vec3(0.0, 0.0, rig.ball.radius_m);
+  camera.yaw_rad = -0.9;
+  camera.pitch_rad = 0.7;
+  camera.distance_m = 0.3;
+  const auto dented = check_reference(*writer, view.scene(), camera, "sheet_imprint");
+  // Independent of the reference: the same view of a sheet at rest differs around the ball.
+  const World flat(world->description());
+  WorldScene rest(flat);
+  rest.update_from_world(flat);
+  for (std::size_t i = 0; i < rest.segment_count(); ++i) {
+    rest.set_segment_visible(i, i == flat.flat_segment(rig.sheet_body, 0));
+  }
+  rest.scene().capsules.clear();
+  rest.scene().spheres.clear();
+  const auto at_rest = writer->render(rest.scene(), camera);
+  EXPECT_GT(compare_images(dented, at_rest, kWidth, kHeight).differing_fraction, 0.01);
+}
+
 // A glove scene stepped `steps` cycles on its own script, framed on everything drawn (the hand
 // included), in faces.
 std::vector<std::uint8_t> glove_scene_picture(SnapshotWriter& writer, const std::string& file,
