@@ -10,6 +10,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/device/recording.h"
+#include "hapsim/render/force_scale.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/session.h"
@@ -280,8 +281,11 @@ void run(const RunArgs& args) {
   if (!args.snapshot_path.empty()) {
     snapshots = std::make_unique<RunSnapshots>(
         args,
-        [&args](const World& w) {
+        [&args, &setup](const World& w) {
           WorldSceneOptions o;
+          o.force_full_scale_n = force_display_scale_n(
+              w.description(), w.rig() != nullptr ? w.description().teleop->gripper.max_force_n
+                                                  : device_rated_force_n(*setup.profile));
           o.colouring = parse_colouring(args.colours);
           o.sphere_tree_level = args.sphere_tree_level;
           return std::make_unique<WorldScene>(w, o);

@@ -5,6 +5,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/kinematics/slave_shapes.h"
 #include "hapsim/render/creased_normals.h"
+#include "hapsim/render/force_scale.h"
 #include "hapsim/render/hand_figure.h"
 #include "hapsim/render/slave_figure.h"
 
@@ -380,6 +381,9 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
     tool_force_n_ = force_n;
   }
   const WorldDescription& d = world_.description();
+  const double heat_full_scale_n = options_.force_full_scale_n > 0.0
+                                       ? options_.force_full_scale_n
+                                       : force_display_scale_n(d, 0.0);
   scene_.spheres.clear();
   scene_.capsules.clear();
   scene_.segments.clear();
@@ -392,9 +396,9 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
   for (std::size_t t = 0; t < tools_.size() && t < d.tools.size(); ++t) {
     const ToolState& tool = tools_[t];
     const double f = t < tool_force_n_.size() ? tool_force_n_[t] : 0.0;
-    // Green when free (a fingertip: the hand's colour), towards red as the force grows (10 N full
-    // red).
-    const float heat = static_cast<float>(std::clamp(f / 10.0, 0.0, 1.0));
+    // Green when free (a fingertip: the hand's colour), towards red as the force grows to the
+    // display's full scale.
+    const float heat = static_cast<float>(std::clamp(f / heat_full_scale_n, 0.0, 1.0));
     const double radius = std::max(d.tools[t].radius_m, 0.002);
     const Vec3f cool = has_hand_ ? kHandColour : Vec3f(0.2f, 0.8f, 0.25f);
     scene_.spheres.push_back({tool.p_world, radius,

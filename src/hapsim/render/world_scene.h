@@ -34,6 +34,9 @@ struct WorldSceneOptions {
   int sphere_tree_level = -1;
   bool show_proxies = true;
   bool show_force_arrows = true;
+  /// A tool's force at which it is drawn full red, N; 0: the scene's largest contact force
+  /// (force_scale.h).
+  double force_full_scale_n = 0.0;
   /// Force arrow length per newton, metres.
   double arrow_m_per_n = 0.005;
   /// A rig's master arm drawn as lines beside the scene (its base on the floor, off the slave's

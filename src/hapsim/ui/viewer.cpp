@@ -597,7 +597,7 @@ class Viewer {
     for (const double p : forces_.peaks()) {
       peak = std::max(peak, p);
     }
-    const bool over = peak > session_->readout().bar_full_scale_n + 1e-9;
+    const bool over = peak > session_->readout().rated_force_n + 1e-9;
     const bool ok = !over && !forces_.saw_nonfinite();
     if (!options_.quiet) {
       std::printf("viewer       %s, %s\n", session_->title().c_str(), gl_version_.c_str());
@@ -620,7 +620,7 @@ class Viewer {
       std::printf(
           "forces       peak shown %.3f N (device rating %.1f N); largest deflection "
           "%.2f mm\n",
-          peak, session_->readout().bar_full_scale_n, peak_deflection_m_ * 1e3);
+          peak, session_->readout().rated_force_n, peak_deflection_m_ * 1e3);
       if (!options_.screenshot.empty()) {
         std::printf("screenshot   %s\n", options_.screenshot.string().c_str());
       }
