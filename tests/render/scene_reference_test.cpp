@@ -17,8 +17,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <numbers>
 
 namespace hapsim {
 namespace {
@@ -250,6 +252,29 @@ std::vector<std::uint8_t> glove_scene_picture(SnapshotWriter& writer, const std:
   const OrbitCamera camera =
       framed_camera(view.scene().bounds_world(), static_cast<double>(kWidth) / kHeight, yaw, pitch);
   return check_reference(writer, view.scene(), camera, name);
+}
+
+TEST(SceneReference, NamedViewMatchesTheReference) {
+  auto writer = make_writer();
+  if (!writer) {
+    GTEST_SKIP() << "no EGL context on this machine";
+  }
+  RunSetup run = make_run_setup(
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_hand.json"),
+      DeviceChoice{});
+  World& world = *run.world;
+  for (int i = 0; i < 1600; ++i) {
+    world.step(run.device->read(i * run.scene.run.dt_s), run.scene.run.dt_s);
+  }
+  WorldScene view(world);
+  view.update_from_world(world);
+  // The scene's "fig6" view: the knee paper's Fig. 6, the hand at the front of the knee.
+  const auto fig6 = std::find_if(run.scene.views.begin(), run.scene.views.end(),
+                                 [](const SceneView& v) { return v.name == "fig6"; });
+  ASSERT_NE(fig6, run.scene.views.end());
+  const OrbitCamera camera =
+      OrbitCamera::looking_at(fig6->eye_m, fig6->target_m, fig6->fov_deg * std::numbers::pi / 180);
+  check_reference(*writer, view.scene(), camera, "knee_hand_fig6");
 }
 
 TEST(SceneReference, GloveHandScenesMatchTheReferences) {

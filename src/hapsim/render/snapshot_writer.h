@@ -50,6 +50,10 @@ class SnapshotWriter {
 [[nodiscard]] OrbitCamera framed_camera(const Box3& bounds_world, double aspect, double yaw_rad,
                                         double pitch_rad, double margin = 1.05);
 
+/// "EX,EY,EZ,TX,TY,TZ,FOV": the eye and the target (world, metres) and the vertical field of view
+/// (degrees, in (1, 170]) of `--camera`; throws hapsim::Error saying what is wrong otherwise.
+[[nodiscard]] OrbitCamera parse_camera_spec(const std::string& spec);
+
 /// "out.png", 42 → "out_000042.png" (a series of snapshots).
 [[nodiscard]] std::string numbered_path(const std::string& path, std::uint64_t index);
 
