@@ -58,6 +58,8 @@ struct RunArgs {
   std::string size = "1280x720";
   std::string view;
   std::string camera;
+  std::string stereo = "off";
+  double eye_separation_m = 0.0;
   int sphere_tree_level = -1;
 };
 
@@ -106,6 +108,7 @@ class RunSnapshots final : public SnapshotSink {
         chosen_(std::move(chosen)) {
     const auto [w, h] = parse_size(args.size);
     writer_ = std::make_unique<SnapshotWriter>(w, h);
+    writer_->set_stereo(parse_stereo_mode(args.stereo), args.eye_separation_m);
   }
 
   void after_step(const World& world, std::size_t step) override {
@@ -217,6 +220,14 @@ void run(const RunArgs& args) {
     }
     (void)parse_size(args.size);
     (void)chosen_snapshot_camera({}, "", args.camera);  // a bad --camera fails before loading
+    try {
+      (void)parse_stereo_mode(args.stereo);
+    } catch (const Error& e) {
+      throw CommandError(e.what());
+    }
+    if (!(args.eye_separation_m >= 0.0) || !std::isfinite(args.eye_separation_m)) {
+      throw CommandError("--eye-separation: expected metres >= 0 (0: a thirtieth of the distance)");
+    }
   } else if (!args.view.empty() || !args.camera.empty()) {
     throw CommandError(std::string(args.view.empty() ? "--camera" : "--view") +
                        ": only with --snapshot FILE.png");
@@ -480,6 +491,11 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--view", args->view,
                   "Snapshot from the scene's named view NAME (its \"views\"; default: the final "
                   "picture framed on the last contact)");
+  cmd->add_option("--stereo", args->stereo,
+                  "Snapshot in stereo: off (default), side-by-side (left eye left) or anaglyph "
+                  "(red-cyan)");
+  cmd->add_option("--eye-separation", args->eye_separation_m,
+                  "Stereo eye separation, metres (default: a thirtieth of the view distance)");
   cmd->add_option("--camera", args->camera,
                   "Snapshot from EX,EY,EZ,TX,TY,TZ,FOV: eye and target (world, m) and vertical "
                   "field of view (degrees)");

@@ -91,6 +91,15 @@ TEST(RunCommand, BadCameraOptionsAreOneNamedLine) {
       "run " + hand +
       " -q --duration 0.1 --snapshot /tmp/x.png --view fig6 --camera 0,0,1,0,0,0,40");
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = test::run_hapsim("run " + hand + " -q --duration 0.1 --snapshot /tmp/x.png --stereo 3d");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--stereo"), std::string::npos) << r.output;
+  EXPECT_TRUE(one_line(r.output)) << r.output;
+  r = test::run_hapsim("run " + hand +
+                       " -q --duration 0.1 --snapshot /tmp/x.png --stereo anaglyph "
+                       "--eye-separation -1");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--eye-separation"), std::string::npos) << r.output;
   r = test::run_hapsim("run " + hand + " -q --duration 0.1 --view fig6");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--snapshot"), std::string::npos) << r.output;

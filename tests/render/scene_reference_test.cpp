@@ -254,6 +254,24 @@ std::vector<std::uint8_t> glove_scene_picture(SnapshotWriter& writer, const std:
   return check_reference(writer, view.scene(), camera, name);
 }
 
+TEST(SceneReference, StereoModesMatchTheReferences) {
+  auto writer = make_writer();
+  if (!writer) {
+    GTEST_SKIP() << "no EGL context on this machine";
+  }
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
+  const auto world = stepped_teleop(scene, 6000);
+  WorldScene view(*world);
+  view.update_from_world(*world);
+  const OrbitCamera camera =
+      framed_camera(view.rest_bounds_world(), static_cast<double>(kWidth) / kHeight, -0.9, 0.45);
+  writer->set_stereo(StereoMode::kSideBySide, 0.0);
+  check_reference(*writer, view.scene(), camera, "teleop_side_by_side");
+  writer->set_stereo(StereoMode::kAnaglyph, 0.0);
+  check_reference(*writer, view.scene(), camera, "teleop_anaglyph");
+}
+
 TEST(SceneReference, NamedViewMatchesTheReference) {
   auto writer = make_writer();
   if (!writer) {

@@ -39,7 +39,7 @@ SnapshotWriter::~SnapshotWriter() {
 const std::vector<std::uint8_t>& SnapshotWriter::render(const RenderScene& scene,
                                                         const OrbitCamera& camera) {
   context_->make_current();
-  renderer_->draw(scene, camera, width_px_, height_px_);
+  draw_stereo(*renderer_, scene, camera, stereo_, eye_separation_m_, 0, 0, width_px_, height_px_);
   context_->read_rgba(rgba_);
   return rgba_;
 }

@@ -5,6 +5,7 @@
 
 #include "hapsim/render/camera.h"
 #include "hapsim/render/render_scene.h"
+#include "hapsim/render/stereo.h"
 
 #include <cstdint>
 #include <memory>
@@ -28,6 +29,13 @@ class SnapshotWriter {
   SnapshotWriter(SnapshotWriter&&) = delete;
   SnapshotWriter& operator=(SnapshotWriter&&) = delete;
 
+  /// Stereo pictures from now on (stereo.h): side by side or red–cyan anaglyph; separation ≤ 0:
+  /// the default for the camera's distance.
+  void set_stereo(StereoMode mode, double eye_separation_m) {
+    stereo_ = mode;
+    eye_separation_m_ = eye_separation_m;
+  }
+
   /// Draws `scene` from `camera` and returns the pixels (RGBA8, top row first).
   const std::vector<std::uint8_t>& render(const RenderScene& scene, const OrbitCamera& camera);
   /// Draws and writes a PNG; throws hapsim::Error naming `path` when it cannot be written.
@@ -43,6 +51,8 @@ class SnapshotWriter {
   std::unique_ptr<OffscreenContext> context_;
   std::unique_ptr<Renderer> renderer_;
   std::vector<std::uint8_t> rgba_;
+  StereoMode stereo_ = StereoMode::kOff;
+  double eye_separation_m_ = 0.0;
 };
 
 /// A camera looking at the centre of `bounds_world` from azimuth `yaw_rad` and elevation

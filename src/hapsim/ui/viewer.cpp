@@ -120,6 +120,7 @@ class Viewer {
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
     panels_ = options.panels;
+    stereo_ = options.stereo;
     renderer_ = std::make_unique<Renderer>();
     gl_version_ = renderer_->gl_version();
     scene_choices_ = options.scene_choices;
@@ -181,7 +182,8 @@ class Viewer {
       glViewport(0, 0, fb_w, fb_h);
       glClearColor(0.1f, 0.1f, 0.12f, 1.0f);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-      renderer_->draw_in(session_->render_scene(), camera_, v.x, v.y, v.w, v.h);
+      draw_stereo(*renderer_, session_->render_scene(), camera_, stereo_, options_.eye_separation_m,
+                  v.x, v.y, v.w, v.h);
       draw_panels(fb_w, fb_h);
       const double draw_ms = std::chrono::duration<double, std::milli>(Clock::now() - d0).count();
       draw_ms_sum += draw_ms;
@@ -361,6 +363,11 @@ class Viewer {
         m = m == DisplayMode::kFaces   ? DisplayMode::kLines
             : m == DisplayMode::kLines ? DisplayMode::kPoints
                                        : DisplayMode::kFaces;
+      });
+      key_edge(GLFW_KEY_V, [this] {
+        stereo_ = stereo_ == StereoMode::kOff          ? StereoMode::kSideBySide
+                  : stereo_ == StereoMode::kSideBySide ? StereoMode::kAnaglyph
+                                                       : StereoMode::kOff;
       });
       key_edge(GLFW_KEY_TAB, [this] {
         panels_ = !panels_;
@@ -684,6 +691,7 @@ class Viewer {
   bool paused_ = false;
   bool built_once_ = false;
   bool panels_ = true;
+  StereoMode stereo_ = StereoMode::kOff;
   bool screenshot_requested_ = false;
   std::array<bool, 512> key_down_{};
   double peak_deflection_m_ = 0.0;
