@@ -59,6 +59,7 @@ struct RunArgs {
   std::string view;
   std::string camera;
   std::string stereo = "off";
+  bool room = false;
   double eye_separation_m = 0.0;
   int sphere_tree_level = -1;
 };
@@ -347,6 +348,7 @@ void run(const RunArgs& args) {
               w.description(), w.rig() != nullptr ? w.description().teleop->gripper.max_force_n
                                                   : device_rated_force_n(*setup.profile));
           o.colouring = parse_colouring(args.colours);
+          o.show_room = args.room;
           o.sphere_tree_level = args.sphere_tree_level;
           return std::make_unique<WorldScene>(w, o);
         },
@@ -491,6 +493,8 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--view", args->view,
                   "Snapshot from the scene's named view NAME (its \"views\"; default: the final "
                   "picture framed on the last contact)");
+  cmd->add_flag("--room", args->room,
+                "Snapshot with the room's walls on the floor's far edges (the knee paper's world)");
   cmd->add_option("--stereo", args->stereo,
                   "Snapshot in stereo: off (default), side-by-side (left eye left) or anaglyph "
                   "(red-cyan)");

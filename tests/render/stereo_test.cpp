@@ -2,7 +2,7 @@
 // channel is the left eye's and its green and blue the right eye's, pixel for pixel; side by side
 // is the left eye in the left half and the right eye in the right half. The eyes sit the
 // separation apart along the camera's right axis, looking at its target. Reference images of
-// both modes (the teleoperation scene) as the other reference pictures.
+// both modes (the teleoperation scene) as the other reference pictures. And the room's walls.
 #include "hapsim/render/stereo.h"
 
 #include "hapsim/core/error.h"
@@ -93,6 +93,49 @@ TEST(Stereo, AnaglyphAndSideBySideAreTheEyesPictures) {
       ASSERT_EQ(sbs[i + 2], right_half[i + 2]) << x << "," << y;
     }
   }
+}
+
+}  // namespace
+}  // namespace hapsim
+
+namespace hapsim {
+namespace {
+
+// The room (the knee paper's world): walls on the floor's two edges away from the eye, drawn in
+// the room's colour (unlit), nothing there without it; the floor's 'x' marks stay.
+TEST(Room, WallsStandOnTheFloorsFarEdges) {
+  auto gl = test::make_test_context(kW, kH);
+  if (!gl.context) {
+    GTEST_SKIP() << "no offscreen GL context: " << gl.why_not;
+  }
+  Renderer renderer;
+  RenderScene scene;
+  scene.floor.half_extent_m = 0.2;
+  scene.room.height_m = 0.3;
+  OrbitCamera c;
+  c.yaw_rad = 0.8;  // the eye at +x, +y: the walls at x = −0.2 and y = −0.2
+  c.pitch_rad = 0.5;
+  c.distance_m = 1.0;
+  const auto colour_at = [&](const std::vector<std::uint8_t>& image, const Vec3& p_world) {
+    const Vec3 px = c.project(p_world, kW, kH);
+    return test::pixel_at(image, kW, static_cast<int>(px.x()), static_cast<int>(px.y()));
+  };
+  scene.room.visible = true;
+  renderer.draw(scene, c, kW, kH);
+  const auto with_room = gl.context->read_rgba();
+  scene.room.visible = false;
+  renderer.draw(scene, c, kW, kH);
+  const auto without = gl.context->read_rgba();
+  const auto near = [](int a, float b) { return std::abs(a - static_cast<int>(255.0f * b)) <= 2; };
+  const Vec3f w = scene.room.colour;
+  const test::Pixel x_wall = colour_at(with_room, Vec3(-0.2, 0.0, 0.2));
+  EXPECT_TRUE(near(x_wall.r, w.x()) && near(x_wall.g, w.y()) && near(x_wall.b, w.z()))
+      << x_wall.r << " " << x_wall.g << " " << x_wall.b;
+  const test::Pixel y_wall = colour_at(with_room, Vec3(0.0, -0.2, 0.2));
+  EXPECT_TRUE(near(y_wall.r, 0.85f * w.x()) && near(y_wall.b, 0.85f * w.z()))
+      << y_wall.r << " " << y_wall.g << " " << y_wall.b;
+  const test::Pixel bare = colour_at(without, Vec3(-0.2, 0.0, 0.2));
+  EXPECT_TRUE(near(bare.r, scene.style.background.x())) << bare.r;
 }
 
 }  // namespace

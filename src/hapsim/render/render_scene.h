@@ -105,6 +105,15 @@ struct RenderFloor {
   Vec3f colour_b = Vec3f(0.62f, 0.62f, 0.65f);
 };
 
+/// The knee paper's room (001 §3.1: the hand, the knee and the room walls): two walls standing on
+/// the floor's far edges as seen from the camera (the corner behind the scene wherever the view
+/// turns), `height_m` tall, unlit, one a little darker than the other. Needs the floor.
+struct RenderRoom {
+  bool visible = false;
+  double height_m = 0.5;
+  Vec3f colour = Vec3f(0.78f, 0.76f, 0.70f);
+};
+
 /// Which frame a light's direction is given in: fixed in the world, or moving with the camera
 /// (a "headlight" rig: the lit side stays the side you look at while orbiting).
 enum class LightFrame { kWorld, kCamera };
@@ -170,6 +179,7 @@ class RenderScene {
   std::vector<ShadowMark> shadow_marks;
 
   RenderFloor floor;
+  RenderRoom room;
   Lighting lighting;
   RenderStyle style;
 

@@ -481,6 +481,28 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
       s.push(*corner, c);
     }
   }
+  const auto walls_first = static_cast<GLint>(s.staging.size() / kUnlitFloats);
+  if (fl.visible && scene.room.visible) {
+    // The two walls on the floor's edges away from the eye: the room's corner behind the scene.
+    const Vec3 eye = camera.eye_world();
+    const double e = fl.half_extent_m;
+    const double x = eye.x() > fl.centre_x_m ? fl.centre_x_m - e : fl.centre_x_m + e;
+    const double y = eye.y() > fl.centre_y_m ? fl.centre_y_m - e : fl.centre_y_m + e;
+    const double z0 = fl.height_m;
+    const double z1 = fl.height_m + scene.room.height_m;
+    const Vec3f c = scene.room.colour;
+    const Vec3f darker = 0.85f * c;
+    const Vec3 a(x, fl.centre_y_m - e, z0), b(x, fl.centre_y_m + e, z0),
+        d(x, fl.centre_y_m + e, z1), f(x, fl.centre_y_m - e, z1);
+    for (const Vec3* corner : {&a, &b, &d, &a, &d, &f}) {
+      s.push(*corner, c);
+    }
+    const Vec3 g(fl.centre_x_m - e, y, z0), h(fl.centre_x_m + e, y, z0),
+        k(fl.centre_x_m + e, y, z1), m(fl.centre_x_m - e, y, z1);
+    for (const Vec3* corner : {&g, &h, &k, &g, &k, &m}) {
+      s.push(*corner, darker);
+    }
+  }
   const auto marks_first = static_cast<GLint>(s.staging.size() / kUnlitFloats);
   for (const ShadowMark& mark : scene.shadow_marks) {
     const Vec3 q(mark.point_world.x(), mark.point_world.y(), fl.height_m);
@@ -515,7 +537,7 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   }
 
   glBindVertexArray(s.stream_vao);
-  if (marks_first > floor_first) {
+  if (walls_first > floor_first) {
     // Pushed back in depth so marks lying exactly on it win the depth test.
     glUseProgram(s.floor);
     set_matrix(s.floor_view_projection, view_projection);
@@ -526,11 +548,14 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
     set_vec3(s.floor_colour_b, fl.colour_b);
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(1.0f, 1.0f);
-    glDrawArrays(GL_TRIANGLES, floor_first, marks_first - floor_first);
+    glDrawArrays(GL_TRIANGLES, floor_first, walls_first - floor_first);
     glDisable(GL_POLYGON_OFFSET_FILL);
   }
   glUseProgram(s.unlit);
   set_matrix(s.unlit_view_projection, view_projection);
+  if (marks_first > walls_first) {
+    glDrawArrays(GL_TRIANGLES, walls_first, marks_first - walls_first);
+  }
   if (segments_first > marks_first) {
     glDrawArrays(GL_TRIANGLES, marks_first, segments_first - marks_first);
   }

@@ -145,6 +145,7 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
     }
     body_poses_.push_back(world.body_pose(b));
   }
+  scene_.room.visible = options_.show_room;
   has_hand_ = world.model().hand() != nullptr;
   hand_ = world.hand_reading();
   tools_.resize(d.tools.size());
@@ -257,6 +258,9 @@ MeshId WorldScene::segment_mesh(std::size_t flat_segment) const {
 
 void WorldScene::set_options(const WorldSceneOptions& options) {
   const bool recolour = options.colouring != options_.colouring;
+  if (options.show_room != options_.show_room) {
+    scene_.room.visible = options.show_room;
+  }
   options_ = options;
   if (recolour) {
     apply_colouring();
@@ -381,6 +385,9 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
     tool_force_n_ = force_n;
   }
   const WorldDescription& d = world_.description();
+  if (!rest_bounds_world_.isEmpty()) {
+    scene_.room.height_m = 1.3 * (rest_bounds_world_.max().z() - scene_.floor.height_m) + 0.05;
+  }
   const double heat_full_scale_n = options_.force_full_scale_n > 0.0
                                        ? options_.force_full_scale_n
                                        : force_display_scale_n(d, 0.0);

@@ -37,6 +37,8 @@ struct WorldSceneOptions {
   /// A tool's force at which it is drawn full red, N; 0: the scene's largest contact force
   /// (force_scale.h).
   double force_full_scale_n = 0.0;
+  /// The knee paper's room: walls on the floor's far edges, a little taller than the scene.
+  bool show_room = false;
   /// Force arrow length per newton, metres.
   double arrow_m_per_n = 0.005;
   /// A rig's master arm drawn as lines beside the scene (its base on the floor, off the slave's

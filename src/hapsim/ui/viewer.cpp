@@ -507,6 +507,8 @@ class Viewer {
       ImGui::RadioButton("faces", &mode, static_cast<int>(DisplayMode::kFaces));
       scene.style.display_mode = static_cast<DisplayMode>(mode);
       ImGui::Checkbox("floor", &scene.floor.visible);
+      ImGui::SameLine();
+      ImGui::Checkbox("room", &scene.room.visible);
       int lights = static_cast<int>(scene.lighting.lights.size());
       if (ImGui::SliderInt("lights", &lights, 1, Lighting::kMaxLights)) {
         resize_lights(scene.lighting, lights);
