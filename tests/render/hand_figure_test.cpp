@@ -1,11 +1,13 @@
 // The glove hand as a figure: its capsules checked against the hand's own kinematics, not stored
 // pictures — each finger's last capsule ends at the fingertip HandModel::fingertips_world gives
 // (where the tool sits), the angle between the middle and distal phalanges is the DIP angle the
-// coupling makes of the PIP reading (DIP = ratio · PIP), the palm reaches every finger's MCP; and
-// in a picture, the hand's colour is drawn where a fingertip projects.
+// coupling makes of the PIP reading (DIP = ratio · PIP), the palm reaches every finger's MCP; a
+// reading that does not put the fingertips at the tools draws no hand; and in a picture, the
+// hand's colour is drawn where a finger projects.
 #include "hapsim/render/hand_figure.h"
 
 #include "hapsim/render/world_scene.h"
+#include "hapsim/runtime/world_snapshot.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/world/world.h"
@@ -98,6 +100,15 @@ TEST(HandFigure, KneeHandSceneDrawsTheHandAtItsTools) {
                   .norm(),
               1e-12)
         << world.description().tools[t].name;
+  }
+  // A view that carries the tools but not this reading (a served world's): no hand, since it
+  // would not reach the tools.
+  {
+    WorldScene served(world);
+    WorldSnapshot snapshot = make_world_snapshot(world);
+    snapshot.tools[0].p_world += Vec3(0.01, 0.0, 0.0);
+    served.update(snapshot);
+    EXPECT_TRUE(served.scene().capsules.empty());
   }
   // In a picture: the hand's colour where the middle finger's PIP projects.
   auto gl = test::make_test_context(320, 240);

@@ -252,6 +252,23 @@ void WorldScene::add_sheet_grid(const Segment& seg) {
   }
 }
 
+// Whether the hand's reading puts each fingertip where its tool is: a served world's views carry
+// the tools but not the glove's reading, and a hand drawn at rest elsewhere would mislead (the
+// fingertips alone are drawn then).
+bool WorldScene::hand_agrees_with_tools() const {
+  constexpr double kToleranceM = 1e-4;
+  const auto tips = world_.model().hand()->fingertips_world(hand_);
+  const WorldDescription& d = world_.description();
+  for (std::size_t t = 0; t < tools_.size() && t < d.tools.size(); ++t) {
+    const int f = d.tools[t].finger;
+    if (f >= 0 && f < kHandFingers &&
+        !((tips[static_cast<std::size_t>(f)] - tools_[t].p_world).norm() <= kToleranceM)) {
+      return false;
+    }
+  }
+  return true;
+}
+
 MeshId WorldScene::segment_mesh(std::size_t flat_segment) const {
   return segments_.at(flat_segment)->mesh;
 }
@@ -395,7 +412,7 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
   scene_.capsules.clear();
   scene_.segments.clear();
   scene_.shadow_marks.clear();
-  if (has_hand_) {
+  if (has_hand_ && hand_agrees_with_tools()) {
     add_hand_figure(*world_.model().hand(), hand_, kHandColour, scene_.capsules);
   }
   const double scale =

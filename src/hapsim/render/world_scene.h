@@ -113,6 +113,7 @@ class WorldScene {
   void apply_colouring();
   void shade_dent(Segment& seg);
   void add_sheet_grid(const Segment& seg);
+  [[nodiscard]] bool hand_agrees_with_tools() const;
   void rebuild_overlays(const std::vector<ToolState>& tools, const std::vector<double>& force_n);
   void add_rig_overlays();
   void add_master(const TeleopSnapshot& s);
