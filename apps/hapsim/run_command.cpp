@@ -10,6 +10,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/device/recording.h"
+#include "hapsim/render/force_scale.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/session.h"
@@ -55,6 +56,11 @@ struct RunArgs {
   std::string display_mode = "faces";
   std::string colours = "tissue";
   std::string size = "1280x720";
+  std::string view;
+  std::string camera;
+  std::string stereo = "off";
+  bool room = false;
+  double eye_separation_m = 0.0;
   int sphere_tree_level = -1;
 };
 
@@ -94,18 +100,40 @@ class RunSnapshots final : public SnapshotSink {
  public:
   using MakeScene = std::function<std::unique_ptr<WorldScene>(const World&)>;
 
-  RunSnapshots(const RunArgs& args, MakeScene make_scene, double yaw_rad, double pitch_rad)
-      : args_(args), make_scene_(std::move(make_scene)), yaw_rad_(yaw_rad), pitch_rad_(pitch_rad) {
+  RunSnapshots(const RunArgs& args, MakeScene make_scene, double yaw_rad, double pitch_rad,
+               std::optional<OrbitCamera> chosen)
+      : args_(args),
+        make_scene_(std::move(make_scene)),
+        yaw_rad_(yaw_rad),
+        pitch_rad_(pitch_rad),
+        chosen_(std::move(chosen)) {
     const auto [w, h] = parse_size(args.size);
     writer_ = std::make_unique<SnapshotWriter>(w, h);
+    writer_->set_stereo(parse_stereo_mode(args.stereo), args.eye_separation_m);
   }
 
   void after_step(const World& world, std::size_t step) override {
+    note_contact(world);
     if (args_.snapshot_every > 0 && step % args_.snapshot_every == 0) {
       write(world, numbered_path(args_.snapshot_path, step));
     }
   }
   void final(const World& world) override {
+    note_contact(world);
+    if (!chosen_ && last_contact_world_) {
+      // The final picture: framed on the last contact (the series keeps its first camera).
+      if (!scene_) {
+        scene_ = make_scene_(world);
+      }
+      std::vector<Vec3> tools;
+      for (const ToolState& t : world.last_result().tools) {
+        tools.push_back(t.p_world);
+      }
+      camera_ = framed_on_contact(scene_->rest_bounds_world(), *last_contact_world_, tools,
+                                  static_cast<double>(writer_->width()) / writer_->height(),
+                                  yaw_rad_, pitch_rad_);
+      framed_ = true;
+    }
     write(world, args_.snapshot_path);
     std::printf("snapshot     %s (%s, %s", args_.snapshot_path.c_str(), args_.size.c_str(),
                 args_.display_mode.c_str());
@@ -116,13 +144,31 @@ class RunSnapshots final : public SnapshotSink {
   }
 
  private:
+  // The newest contact point of any tool, kept across steps without one.
+  void note_contact(const World& world) {
+    const StepResult& r = world.last_result();
+    if (!r.contacts.empty()) {
+      last_contact_world_ = r.contacts.front().point_world;
+    }
+  }
+
   void write(const World& world, const std::string& path) {
     if (!scene_) {
       scene_ = make_scene_(world);
+    }
+    if (!styled_) {
+      styled_ = true;
+      for (const std::string& warning : scene_->warnings()) {
+        spdlog::warn("snapshot: {}", warning);
+      }
       scene_->scene().style.display_mode = parse_display_mode(args_.display_mode);
-      camera_ = framed_camera(scene_->rest_bounds_world(),
-                              static_cast<double>(writer_->width()) / writer_->height(), yaw_rad_,
-                              pitch_rad_);
+    }
+    if (!framed_) {
+      framed_ = true;
+      camera_ = chosen_ ? *chosen_
+                        : framed_camera(scene_->rest_bounds_world(),
+                                        static_cast<double>(writer_->width()) / writer_->height(),
+                                        yaw_rad_, pitch_rad_);
     }
     scene_->update_from_world(world);
     writer_->write_png(scene_->scene(), camera_, path);
@@ -134,7 +180,11 @@ class RunSnapshots final : public SnapshotSink {
   double yaw_rad_;
   double pitch_rad_;
   std::unique_ptr<SnapshotWriter> writer_;
+  std::optional<OrbitCamera> chosen_;
+  std::optional<Vec3> last_contact_world_;
   std::unique_ptr<WorldScene> scene_;
+  bool styled_ = false;
+  bool framed_ = false;
   OrbitCamera camera_;
   std::size_t written_ = 0;
 };
@@ -170,6 +220,18 @@ void run(const RunArgs& args) {
                          folder.string());
     }
     (void)parse_size(args.size);
+    (void)chosen_snapshot_camera({}, "", args.camera);  // a bad --camera fails before loading
+    try {
+      (void)parse_stereo_mode(args.stereo);
+    } catch (const Error& e) {
+      throw CommandError(e.what());
+    }
+    if (!(args.eye_separation_m >= 0.0) || !std::isfinite(args.eye_separation_m)) {
+      throw CommandError("--eye-separation: expected metres >= 0 (0: a thirtieth of the distance)");
+    }
+  } else if (!args.view.empty() || !args.camera.empty()) {
+    throw CommandError(std::string(args.view.empty() ? "--camera" : "--view") +
+                       ": only with --snapshot FILE.png");
   }
   std::optional<std::filesystem::path> trajectory;
   if (!args.device.empty() && args.device != "sim") {
@@ -216,6 +278,9 @@ void run(const RunArgs& args) {
     }
   }();
   const SceneDescription& scene = setup.scene;
+  const std::optional<OrbitCamera> chosen_camera =
+      args.snapshot_path.empty() ? std::nullopt
+                                 : chosen_snapshot_camera(scene, args.view, args.camera);
   std::unique_ptr<World>& world = setup.world;
   std::unique_ptr<Device>& device = setup.device;
   const std::string& device_name = setup.device_name;
@@ -287,18 +352,23 @@ void run(const RunArgs& args) {
   if (!args.snapshot_path.empty()) {
     snapshots = std::make_unique<RunSnapshots>(
         args,
-        [&args](const World& w) {
+        [&args, &setup](const World& w) {
           WorldSceneOptions o;
+          o.force_full_scale_n = force_display_scale_n(
+              w.description(), w.rig() != nullptr ? w.description().teleop->gripper.max_force_n
+                                                  : device_rated_force_n(*setup.profile));
           o.colouring = parse_colouring(args.colours);
+          o.show_room = args.room;
           o.sphere_tree_level = args.sphere_tree_level;
           return std::make_unique<WorldScene>(w, o);
         },
-        snapshot_yaw_rad(*world), snapshot_pitch_rad(*world));
+        snapshot_yaw_rad(*world), snapshot_pitch_rad(*world), chosen_camera);
   }
 
   SessionOptions options;
   options.duration_s = duration_s;
-  if (snapshots && args.snapshot_every > 0) {
+  if (snapshots && !args.realtime) {
+    // Every step: numbered pictures, and the last contact the final picture is framed on.
     options.after_cycle = [&](std::size_t cycle) { snapshots->after_step(*world, cycle + 1); };
   }
   options.dt_s = scene.run.dt_s;
@@ -431,6 +501,19 @@ void add_run_command(CLI::App& app) {
                   "vertex groups)")
       ->check(CLI::IsMember({"tissue", "segments", "groups"}));
   cmd->add_option("--size", args->size, "Snapshot size WIDTHxHEIGHT (default 1280x720)");
+  cmd->add_option("--view", args->view,
+                  "Snapshot from the scene's named view NAME (its \"views\"; default: the final "
+                  "picture framed on the last contact)");
+  cmd->add_flag("--room", args->room,
+                "Snapshot with the room's walls on the floor's far edges (the knee paper's world)");
+  cmd->add_option("--stereo", args->stereo,
+                  "Snapshot in stereo: off (default), side-by-side (left eye left) or anaglyph "
+                  "(red-cyan)");
+  cmd->add_option("--eye-separation", args->eye_separation_m,
+                  "Stereo eye separation, metres (default: a thirtieth of the view distance)");
+  cmd->add_option("--camera", args->camera,
+                  "Snapshot from EX,EY,EZ,TX,TY,TZ,FOV: eye and target (world, m) and vertical "
+                  "field of view (degrees)");
   cmd->add_option("--sphere-tree-level", args->sphere_tree_level,
                   "Draw the sphere tree's spheres at this level in the snapshot (root = 0)")
       ->check(CLI::NonNegativeNumber);

@@ -1,8 +1,21 @@
-// Where the snapshots of a scene look from (hapsim run --snapshot, hapsim watch --snapshot): the
-// knee from the front, a rig from the front-right, a table-top scene from well above.
+// Where the snapshots of a scene look from (hapsim run --snapshot, hapsim watch --snapshot): a
+// view named in the scene (--view) or given outright (--camera); else the knee from the front, a
+// rig from the front-right, a table-top scene from well above, the final picture of a run
+// framed on its last contact.
 #pragma once
 
+#include "commands.h"
+
+#include "hapsim/core/error.h"
+#include "hapsim/render/camera.h"
+#include "hapsim/render/snapshot_writer.h"
+#include "hapsim/scene/scene_description.h"
 #include "hapsim/world/world.h"
+
+#include <numbers>
+#include <optional>
+#include <span>
+#include <string>
 
 namespace hapsim::app {
 
@@ -35,6 +48,49 @@ inline double snapshot_yaw_rad(const World& world) {
 }
 inline double snapshot_pitch_rad(const World& world) {
   return world.rig() != nullptr ? kTeleopPitch : (table_top(world) ? kTableTopPitch : kKneePitch);
+}
+
+/// The camera --view NAME or --camera SPEC chose (at most one of them), none when neither was
+/// given. CommandError (exit 2, one line) for both at once, an unknown view (naming the scene's
+/// views) or a bad spec.
+inline std::optional<OrbitCamera> chosen_snapshot_camera(const SceneDescription& scene,
+                                                         const std::string& view,
+                                                         const std::string& camera_spec) {
+  if (!view.empty() && !camera_spec.empty()) {
+    throw CommandError("--view and --camera: give one of them");
+  }
+  if (!camera_spec.empty()) {
+    try {
+      return parse_camera_spec(camera_spec);
+    } catch (const Error& e) {
+      throw CommandError(std::string(e.what()));
+    }
+  }
+  if (view.empty()) {
+    return std::nullopt;
+  }
+  std::string names;
+  for (const SceneView& v : scene.views) {
+    if (v.name == view) {
+      return OrbitCamera::looking_at(v.eye_m, v.target_m, v.fov_deg * std::numbers::pi / 180.0);
+    }
+    names += (names.empty() ? "" : ", ") + v.name;
+  }
+  throw CommandError("--view " + view + ": " + scene.file.string() + " has " +
+                     (names.empty() ? std::string("no views") : "the views " + names));
+}
+
+/// The final picture's default: from the scene's usual direction, framing a box around
+/// `contact_world` (a third of the scene's size each way) and the tools.
+inline OrbitCamera framed_on_contact(const Box3& scene_bounds_world, const Vec3& contact_world,
+                                     std::span<const Vec3> tools_world, double aspect,
+                                     double yaw_rad, double pitch_rad) {
+  const double half = std::max(0.05, 0.3 * scene_bounds_world.sizes().norm());
+  Box3 box(contact_world - Vec3::Constant(half), contact_world + Vec3::Constant(half));
+  for (const Vec3& t : tools_world) {
+    box.extend(t);
+  }
+  return framed_camera(box, aspect, yaw_rad, pitch_rad);
 }
 
 }  // namespace hapsim::app

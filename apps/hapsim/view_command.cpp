@@ -4,9 +4,11 @@
 #include "commands.h"
 #include "dds_options.h"
 
+#include "hapsim/core/error.h"
 #include "hapsim/ui/viewer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <memory>
 #include <sstream>
@@ -25,6 +27,8 @@ struct ViewArgs {
   bool no_vsync = false;
   bool no_panels = false;
   int msaa = 0;
+  std::string stereo = "off";
+  double eye_separation_m = 0.0;
   double duration_s = 0.0;
   std::string screenshot;
   std::string first_screenshot;
@@ -61,6 +65,15 @@ void view(const ViewArgs& args) {
   o.vsync = !args.no_vsync;
   o.panels = !args.no_panels;
   o.msaa_samples = args.msaa;
+  try {
+    o.stereo = parse_stereo_mode(args.stereo);
+  } catch (const Error& e) {
+    throw CommandError(e.what());
+  }
+  if (!(args.eye_separation_m >= 0.0) || !std::isfinite(args.eye_separation_m)) {
+    throw CommandError("--eye-separation: expected metres >= 0 (0: a thirtieth of the distance)");
+  }
+  o.eye_separation_m = args.eye_separation_m;
   o.duration_s = args.duration_s;
   o.screenshot = args.screenshot;
   o.first_screenshot = args.first_screenshot;
@@ -110,6 +123,11 @@ void add_view_command(CLI::App& app) {
   cmd->add_flag("--no-vsync", args->no_vsync, "Draw as fast as possible (to measure fps)");
   cmd->add_flag("--no-panels", args->no_panels,
                 "Start with the control and data areas hidden (Tab shows them)");
+  cmd->add_option("--stereo", args->stereo,
+                  "Stereo view: off (default), side-by-side (left eye left) or anaglyph "
+                  "(red-cyan); V cycles them");
+  cmd->add_option("--eye-separation", args->eye_separation_m,
+                  "Stereo eye separation, metres (default: a thirtieth of the view distance)");
   cmd->add_option("--msaa", args->msaa,
                   "Multisample anti-aliasing samples (default 0: costly on a software rasteriser)")
       ->check(CLI::Range(0, 16));

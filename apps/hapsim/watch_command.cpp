@@ -41,6 +41,8 @@ struct WatchArgs {
   double duration_s = std::numeric_limits<double>::quiet_NaN();  // NaN: until stopped
   double wait_s = 20.0;
   std::string snapshot_path;
+  std::string view;
+  std::string camera;
   std::string json_path;
 };
 
@@ -61,6 +63,8 @@ void watch(const WatchArgs& args) {
   const std::atomic<bool>& stop = session.stop();
   const RunSetup setup = net::build_served_scene(*info, DeviceChoice::external(), args.data_dir);
   const World& world = *setup.world;
+  const std::optional<OrbitCamera> chosen =
+      chosen_snapshot_camera(setup.scene, args.view, args.camera);
   std::printf("watching     %s in session '%s' (%s)\n", info->scene_file.c_str(),
               args.dds.session.c_str(), session.domain().config().c_str());
   std::fflush(stdout);
@@ -117,8 +121,9 @@ void watch(const WatchArgs& args) {
     WorldScene scene(world);
     scene.update(*at_peak);
     SnapshotWriter writer(1280, 720);
-    const OrbitCamera camera = framed_camera(scene.rest_bounds_world(), 1280.0 / 720.0,
-                                             snapshot_yaw_rad(world), snapshot_pitch_rad(world));
+    const OrbitCamera camera =
+        chosen.value_or(framed_camera(scene.rest_bounds_world(), 1280.0 / 720.0,
+                                      snapshot_yaw_rad(world), snapshot_pitch_rad(world)));
     writer.write_png(scene.scene(), camera, args.snapshot_path);
     std::printf("snapshot     %s (the view at the largest force, %.3f N, t = %.3f s)\n",
                 args.snapshot_path.c_str(), peak_force_n, at_peak->time_s);
@@ -158,9 +163,18 @@ void add_watch_command(CLI::App& app) {
       ->check(positive_seconds());
   cmd->add_option("--snapshot", args->snapshot_path,
                   "Write the view at the largest force seen to FILE.png (offscreen)");
+  cmd->add_option("--view", args->view, "Snapshot from the served scene's named view NAME");
+  cmd->add_option("--camera", args->camera,
+                  "Snapshot from EX,EY,EZ,TX,TY,TZ,FOV: eye and target (world, m) and vertical "
+                  "field of view (degrees)");
   cmd->add_option("--json", args->json_path, "Write what was seen as JSON");
   cmd->callback([args] {
     (void)net::session_partition(args->dds.session);
+    if (args->snapshot_path.empty() && (!args->view.empty() || !args->camera.empty())) {
+      throw CommandError(std::string(args->view.empty() ? "--camera" : "--view") +
+                         ": only with --snapshot FILE.png");
+    }
+    (void)chosen_snapshot_camera({}, "", args->camera);  // a bad --camera fails before waiting
     watch(*args);
   });
 }

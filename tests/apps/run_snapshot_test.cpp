@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <fstream>
 
 namespace hapsim {
@@ -67,6 +68,63 @@ TEST(RunCommand, BadSnapshotOptionsAreNamed) {
   EXPECT_NE(r.output.find("/nonexistent/dir/x.png"), std::string::npos) << r.output;
   r = test::run_hapsim("run " + kKnee + " --duration 0.1 --snapshot /tmp/x.png --display-mode x");
   EXPECT_NE(r.exit_code, 0) << r.output;
+}
+
+TEST(RunCommand, BadCameraOptionsAreOneNamedLine) {
+  const std::string hand = std::string(HAPSIM_SCENES_DIR) + "/knee_hand.json";
+  const auto one_line = [](const std::string& out) {
+    return std::count(out.begin(), out.end(), '\n') <= 1;
+  };
+  auto r = test::run_hapsim("run " + hand + " -q --duration 0.1 --snapshot /tmp/x.png --view nope");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--view nope"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("fig6"), std::string::npos) << r.output;  // the views it has
+  EXPECT_TRUE(one_line(r.output)) << r.output;
+  for (const char* spec : {"1,2,3", "0,0,1,0,0,0,500", "0,0,1,0,0,1,40", "0,0,1,0,0,0,x"}) {
+    r = test::run_hapsim("run " + hand + " -q --duration 0.1 --snapshot /tmp/x.png --camera " +
+                         spec);
+    EXPECT_EQ(r.exit_code, 2) << spec << ": " << r.output;
+    EXPECT_NE(r.output.find("--camera"), std::string::npos) << r.output;
+    EXPECT_TRUE(one_line(r.output)) << r.output;
+  }
+  r = test::run_hapsim(
+      "run " + hand +
+      " -q --duration 0.1 --snapshot /tmp/x.png --view fig6 --camera 0,0,1,0,0,0,40");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = test::run_hapsim("run " + hand + " -q --duration 0.1 --snapshot /tmp/x.png --stereo 3d");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--stereo"), std::string::npos) << r.output;
+  EXPECT_TRUE(one_line(r.output)) << r.output;
+  r = test::run_hapsim("run " + hand +
+                       " -q --duration 0.1 --snapshot /tmp/x.png --stereo anaglyph "
+                       "--eye-separation -1");
+  EXPECT_NE(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("--eye-separation"), std::string::npos) << r.output;
+  r = test::run_hapsim("run " + hand + " -q --duration 0.1 --view fig6");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--snapshot"), std::string::npos) << r.output;
+}
+
+TEST(RunCommand, NamedViewAndCameraGiveTheSamePicture) {
+  // fig6 in scenes/knee_hand.json, written out as --camera: the same picture.
+  const std::string hand = std::string(HAPSIM_SCENES_DIR) + "/knee_hand.json";
+  const auto a = test::temp_path("view.png");
+  const auto b = test::temp_path("camera.png");
+  const auto c = test::temp_path("default.png");
+  ASSERT_EQ(test::run_hapsim("run " + hand + " -q --duration 1 --size 320x180 --snapshot " +
+                             a.string() + " --view fig6")
+                .exit_code,
+            0);
+  ASSERT_EQ(test::run_hapsim("run " + hand + " -q --duration 1 --size 320x180 --snapshot " +
+                             b.string() + " --camera -0.25,0.3,0.12,0,0.06,0.02,40")
+                .exit_code,
+            0);
+  ASSERT_EQ(
+      test::run_hapsim("run " + hand + " -q --duration 1 --size 320x180 --snapshot " + c.string())
+          .exit_code,
+      0);
+  EXPECT_EQ(read_png(a.string()).rgba, read_png(b.string()).rgba);
+  EXPECT_NE(read_png(a.string()).rgba, read_png(c.string()).rgba);
 }
 
 }  // namespace

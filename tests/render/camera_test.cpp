@@ -2,6 +2,9 @@
 // the viewport centre, a full turn is the identity, panned points follow the cursor, …).
 #include "hapsim/render/camera.h"
 
+#include "hapsim/core/error.h"
+#include "hapsim/render/snapshot_writer.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -136,6 +139,30 @@ TEST(OrbitCamera, PointsBehindTheEyeDoNotProject) {
   const OrbitCamera cam = make_camera();
   const Vec3 behind = cam.eye_world() - cam.forward_world();
   EXPECT_FALSE(std::isfinite(cam.project(behind, kW, kH).x()));
+}
+
+TEST(OrbitCamera, LookingAtPutsTheEyeAndTargetWhereAsked) {
+  const Vec3 eye(-0.25, 0.3, 0.12);
+  const Vec3 target(0.0, 0.06, 0.02);
+  const OrbitCamera c = OrbitCamera::looking_at(eye, target, 0.7);
+  EXPECT_LT((c.eye_world() - eye).norm(), 1e-12);
+  EXPECT_LT((c.target_world - target).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(c.fov_y_rad, 0.7);
+  // The target projects to the viewport's centre.
+  const Vec3 px = c.project(target, 320, 180);
+  EXPECT_NEAR(px.x(), 160.0, 1e-6);
+  EXPECT_NEAR(px.y(), 90.0, 1e-6);
+}
+
+TEST(OrbitCamera, CameraSpecParsesSevenNumbersAndRefusesTheRest) {
+  const OrbitCamera c = parse_camera_spec("1,2,3,0.5,0.5,0,30");
+  EXPECT_LT((c.eye_world() - Vec3(1.0, 2.0, 3.0)).norm(), 1e-12);
+  EXPECT_NEAR(c.fov_y_rad, 30.0 * std::numbers::pi / 180.0, 1e-15);
+  for (const char* bad :
+       {"", "1,2,3", "1,2,3,4,5,6,7,8", "1,2,3,4,5,6,0.5", "1,2,3,1,2,3,40", "a,2,3,4,5,6,40",
+        "1,2,3,4,5,6,nan", "1,,3,4,5,6,40", "1,2,3,4,5,6,40x"}) {
+    EXPECT_THROW((void)parse_camera_spec(bad), Error) << bad;
+  }
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/render/image_compare.h"
 #include "hapsim/render/renderer.h"
+#include "hapsim/render/slave_figure.h"
 #include "hapsim/runtime/world_snapshot.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/scene/teleop_setup.h"
@@ -317,16 +318,27 @@ TEST(WorldSceneRig, BoxLinksJoinTheJointOrigins) {
   for (std::size_t l = 0; l < midpoints.size(); ++l) {
     const RenderMesh& m = scene.scene().mesh(links[l]);
     EXPECT_LT((bounds_centre_world(m) - midpoints[l]).norm(), 1e-9) << "link box " << l;
-    EXPECT_EQ(m.colour, RigColours{}.robot);
+    // The boxes collide; the figure draws the links: hidden.
+    EXPECT_FALSE(m.visible) << "link box " << l;
   }
-  // And a joint sphere at each joint (the first spheres drawn).
-  const auto& spheres = scene.scene().spheres;
-  ASSERT_GE(spheres.size(), static_cast<std::size_t>(chain.dof()));
+  // Drawn instead as rounded links over the same joint origins (after the base plate), then a
+  // drum centred on each joint, along its axis.
+  ASSERT_NE(scene.slave_figure(), nullptr);
+  EXPECT_TRUE(scene.slave_figure()->draws_links());
+  EXPECT_FALSE(scene.slave_figure()->uses_visual_meshes());
+  const auto& capsules = scene.scene().capsules;
+  ASSERT_GE(capsules.size(), 1 + midpoints.size() + static_cast<std::size_t>(chain.dof()));
+  for (std::size_t l = 0; l < midpoints.size(); ++l) {
+    const RenderCapsule& c = capsules[1 + l];
+    EXPECT_LT((0.5 * (c.a_world + c.b_world) - midpoints[l]).norm(), 1e-9) << "rounded link " << l;
+    EXPECT_EQ(c.colour, RigColours{}.robot);
+  }
   for (int k = 0; k < chain.dof(); ++k) {
-    EXPECT_LT((spheres[static_cast<std::size_t>(k)].centre_world -
-               frames[static_cast<std::size_t>(k)].translation())
-                  .norm(),
-              1e-12);
+    const RenderCapsule& drum = capsules[1 + midpoints.size() + static_cast<std::size_t>(k)];
+    const auto kk = static_cast<std::size_t>(k);
+    EXPECT_LT((0.5 * (drum.a_world + drum.b_world) - frames[kk].translation()).norm(), 1e-12);
+    const Vec3 axis_world = frames[kk].linear() * chain.joints()[kk].axis;
+    EXPECT_NEAR(std::abs((drum.b_world - drum.a_world).normalized().dot(axis_world)), 1.0, 1e-12);
   }
 }
 
@@ -366,8 +378,31 @@ TEST(WorldSceneRig, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
     EXPECT_EQ(m.geometry().vertices.size(), g.mesh.vertices.size()) << g.link;
   }
   EXPECT_EQ(l, links.size());
-  // Meshes drawn: no joint spheres, just the master's joints.
-  EXPECT_EQ(drawn.scene().spheres.size(), 4u);
+  // Drawn from the URDF's visual meshes (not the collision hulls, which are hidden), each at its
+  // link's chain frame, in the URDF material's colour (Yaskawa blue).
+  ASSERT_NE(drawn.slave_figure(), nullptr);
+  EXPECT_TRUE(drawn.slave_figure()->uses_visual_meshes()) << drawn.warnings().size();
+  EXPECT_TRUE(drawn.warnings().empty());
+  EXPECT_EQ(chain.link_visuals().size(), 7u);
+  for (const MeshId id : links) {
+    EXPECT_FALSE(drawn.scene().mesh(id).visible);
+  }
+  std::size_t visuals_seen = 0;
+  for (MeshId id = 0; id < drawn.scene().mesh_count(); ++id) {
+    const RenderMesh& m = drawn.scene().mesh(id);
+    for (const ChainLinkVisual& v : chain.link_visuals()) {
+      if (m.name != "slave/" + v.link) {
+        continue;
+      }
+      ++visuals_seen;
+      const Iso3 X_world_frame =
+          v.frame < 0 ? Iso3::Identity() : frames[static_cast<std::size_t>(v.frame)];
+      EXPECT_TRUE(m.X_world_mesh.isApprox(X_world_frame * v.X_frame_mesh, 1e-12)) << v.link;
+      EXPECT_NEAR(m.colour.z(), 0.749f, 1e-3) << v.link;
+      EXPECT_TRUE(m.visible);
+    }
+  }
+  EXPECT_EQ(visuals_seen, chain.link_visuals().size());
   EXPECT_TRUE(drawn.rest_bounds_world().contains(frames[0].translation()));
 }
 

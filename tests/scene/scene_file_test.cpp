@@ -685,3 +685,34 @@ TEST(ShippedScenes, RealKneeLoadsAllPartsWhenTheDataIsPresent) {
 
 }  // namespace
 }  // namespace hapsim
+
+namespace hapsim {
+namespace {
+
+// Named camera views (docs/scene-format.md#views): read as written, bad ones named by pointer.
+TEST_F(SceneFileTest, ViewsLoadByNameAndBadOnesAreNamed) {
+  Json scene = base();
+  scene["views"] = Json::parse(R"({
+    "top": {"eye_m": [0, 0, 1], "target_m": [0, 0, 0]},
+    "side": {"eye_m": [1, 0, 0.2], "target_m": [0, 0, 0.1], "fov_deg": 30}
+  })");
+  const SceneDescription d = load_scene(write("views.json", scene.dump(2)));
+  ASSERT_EQ(d.views.size(), 2u);
+  EXPECT_EQ(d.views[0].name, "side");  // name order
+  EXPECT_EQ(d.views[0].eye_m, Vec3(1.0, 0.0, 0.2));
+  EXPECT_EQ(d.views[0].target_m, Vec3(0.0, 0.0, 0.1));
+  EXPECT_DOUBLE_EQ(d.views[0].fov_deg, 30.0);
+  EXPECT_DOUBLE_EQ(d.views[1].fov_deg, 40.0);  // the default
+  scene["views"]["top"]["eye_m"] = Json::array({0, 0, 0});
+  expect_error(scene, "/views/top/eye_m", "on its target");
+  scene["views"]["top"] =
+      Json::parse(R"({"eye_m": [0, 0, 1], "target_m": [0, 0, 0], "fov_deg": 0.5})");
+  expect_error(scene, "/views/top/fov_deg", "> 1 and <= 170");
+  scene["views"]["top"] = Json::parse(R"({"eye_m": [0, 0, 1], "target_m": [0, 0, 0], "up": 1})");
+  expect_error(scene, "/views/top/up", "eye_m");  // the allowed keys are listed
+  scene["views"] = Json::array();
+  expect_error(scene, "/views", "named camera views");
+}
+
+}  // namespace
+}  // namespace hapsim

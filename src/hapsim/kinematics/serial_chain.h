@@ -47,6 +47,24 @@ struct ChainLinkGeometry {
   TriangleMesh mesh;  // metres
 };
 
+/// A link's visual shape (URDF <visual>), for display only: a mesh file, loaded by whoever draws
+/// it (the collision meshes are what the world uses), or a primitive already tessellated, with
+/// the URDF material's colour.
+struct ChainLinkVisual {
+  std::string link;
+  /// −1: the base frame; i: the frame of joint i (after its motion).
+  int frame = -1;
+  /// The visual's frame in that chain frame (fixed joints and the visual origin folded in).
+  Iso3 X_frame_mesh = Iso3::Identity();
+  /// Absolute path of the mesh file and its scale; empty for a primitive (then `mesh`).
+  std::string mesh_file;
+  Vec3 mesh_scale = Vec3::Ones();
+  TriangleMesh mesh;
+  /// RGB of the visual's material, when it has one.
+  bool has_colour = false;
+  Vec3f colour = Vec3f(0.7f, 0.7f, 0.7f);
+};
+
 using ChainVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxChainJoints, 1>;
 /// Geometric Jacobian in the base frame at the tip: rows 0–2 linear velocity of the tip origin,
 /// rows 3–5 angular velocity.
@@ -80,6 +98,9 @@ class SerialChain {
   /// Collision meshes of the links, when loaded (URDF); empty otherwise.
   [[nodiscard]] const std::vector<ChainLinkGeometry>& link_geometry() const { return links_; }
   void set_link_geometry(std::vector<ChainLinkGeometry> links);
+  /// Visual shapes of the links (URDF), for display; empty when the chain has none.
+  [[nodiscard]] const std::vector<ChainLinkVisual>& link_visuals() const { return visuals_; }
+  void set_link_visuals(std::vector<ChainLinkVisual> visuals) { visuals_ = std::move(visuals); }
 
   /// Index of the joint whose child is `link`, −1 for the base link, −2 when not in the chain.
   [[nodiscard]] int frame_of_link(const std::string& link) const;
@@ -90,6 +111,7 @@ class SerialChain {
   Iso3 X_last_tip_;
   std::string tip_link_;
   std::vector<ChainLinkGeometry> links_;
+  std::vector<ChainLinkVisual> visuals_;
 };
 
 /// The motion of one joint at position q: a rotation q about the axis or a translation q along it.

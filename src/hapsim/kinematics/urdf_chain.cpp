@@ -11,6 +11,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -312,6 +313,11 @@ class UrdfReader {
       }
       chain.set_link_geometry(std::move(links));
     }
+    std::vector<ChainLinkVisual> visuals;
+    for (const Attached& a : attached) {
+      add_visuals(*a.link, a.frame, a.X_frame_link, visuals);
+    }
+    chain.set_link_visuals(std::move(visuals));
     return chain;
   }
 
@@ -330,6 +336,52 @@ class UrdfReader {
       g.X_frame_mesh = X_frame_link * to_iso(c->origin);
       g.mesh = geometry_mesh(*c->geometry, where);
       out.push_back(std::move(g));
+    }
+  }
+
+  // A link's visuals: mesh files by path (loaded by the display), primitives tessellated here.
+  // Nothing here fails the chain: a visual that cannot be drawn is left out and the link is drawn
+  // from its collision shape.
+  void add_visuals(const urdf::Link& link, int frame, const Iso3& X_frame_link,
+                   std::vector<ChainLinkVisual>& out) const {
+    std::size_t index = 0;
+    for (const urdf::VisualSharedPtr& v : link.visual_array) {
+      if (!v || !v->geometry) {
+        continue;
+      }
+      const std::string where =
+          name_ + ": link '" + link.name + "' visual " + std::to_string(index++);
+      ChainLinkVisual visual;
+      visual.link = link.name;
+      visual.frame = frame;
+      visual.X_frame_mesh = X_frame_link * to_iso(v->origin);
+      if (v->material) {
+        const urdf::Color& c = v->material->color;
+        visual.has_colour = std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
+        visual.colour = Vec3f(std::clamp(c.r, 0.0f, 1.0f), std::clamp(c.g, 0.0f, 1.0f),
+                              std::clamp(c.b, 0.0f, 1.0f));
+      }
+      if (v->geometry->type == urdf::Geometry::MESH) {
+        const auto& m = static_cast<const urdf::Mesh&>(*v->geometry);
+        std::string file = m.filename;
+        if (file.rfind("file://", 0) == 0) {
+          file = file.substr(7);
+        }
+        std::filesystem::path p(file);
+        if (file.rfind("package://", 0) == 0 ||
+            !(m.scale.x > 0.0 && m.scale.y > 0.0 && m.scale.z > 0.0)) {
+          continue;  // needs ROS, or degenerate: the collision shape stands in
+        }
+        visual.mesh_file = (p.is_relative() ? folder_ / p : p).string();
+        visual.mesh_scale = Vec3(m.scale.x, m.scale.y, m.scale.z);
+      } else {
+        try {
+          visual.mesh = geometry_mesh(*v->geometry, where);
+        } catch (const Error&) {
+          continue;
+        }
+      }
+      out.push_back(std::move(visual));
     }
   }
 

@@ -6,6 +6,19 @@
 
 namespace hapsim {
 
+OrbitCamera OrbitCamera::looking_at(const Vec3& eye_world, const Vec3& target_world,
+                                    double fov_y_rad) {
+  OrbitCamera c;
+  const Vec3 d = eye_world - target_world;
+  c.target_world = target_world;
+  c.distance_m = std::clamp(d.norm(), kMinDistance, kMaxDistance);
+  c.yaw_rad = std::atan2(d.y(), d.x());
+  c.pitch_rad = std::clamp(std::asin(std::clamp(d.z() / std::max(d.norm(), 1e-300), -1.0, 1.0)),
+                           -kMaxPitch, kMaxPitch);
+  c.fov_y_rad = fov_y_rad;
+  return c;
+}
+
 Vec3 OrbitCamera::eye_world() const {
   return target_world - distance_m * forward_world();
 }

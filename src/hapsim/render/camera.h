@@ -32,6 +32,11 @@ class OrbitCamera {
   static constexpr double kMinDistance = 1e-4;
   static constexpr double kMaxDistance = 1e4;
 
+  /// The camera whose eye is at `eye_world` looking at `target_world` with vertical field of view
+  /// `fov_y_rad` (a view straight up or down is tilted to kMaxPitch).
+  [[nodiscard]] static OrbitCamera looking_at(const Vec3& eye_world, const Vec3& target_world,
+                                              double fov_y_rad);
+
   [[nodiscard]] Vec3 eye_world() const;
   /// Camera frame axes in the world: right, up (screen) and forward (towards the target).
   [[nodiscard]] Vec3 right_world() const;

@@ -160,6 +160,12 @@ Box3 RenderScene::bounds_world() const {
     box.extend(s.centre_world - Vec3::Constant(s.radius_m));
     box.extend(s.centre_world + Vec3::Constant(s.radius_m));
   }
+  for (const RenderCapsule& c : capsules) {
+    for (const Vec3& p : {c.a_world, c.b_world}) {
+      box.extend(p - Vec3::Constant(c.radius_m));
+      box.extend(p + Vec3::Constant(c.radius_m));
+    }
+  }
   return box;
 }
 

@@ -67,6 +67,16 @@ struct RenderSphere {
   bool wireframe = false;
 };
 
+/// A rounded rod from `a_world` to `b_world` (a phalanx, a robot link, a master arm's segment),
+/// lit: a cylinder of `radius_m` with a sphere of the same radius at each end. Drawn filled in
+/// every display mode, like the spheres.
+struct RenderCapsule {
+  Vec3 a_world = Vec3::Zero();
+  Vec3 b_world = Vec3::Zero();
+  double radius_m = 0.01;
+  Vec3f colour = Vec3f(0.8f, 0.8f, 0.8f);
+};
+
 /// A straight line from `a_world` to `b_world`, unlit, drawn RenderStyle::line_width_px wide.
 struct RenderSegment {
   Vec3 a_world = Vec3::Zero();
@@ -95,6 +105,15 @@ struct RenderFloor {
   double cell_m = 0.05;
   Vec3f colour_a = Vec3f(0.72f, 0.72f, 0.74f);
   Vec3f colour_b = Vec3f(0.62f, 0.62f, 0.65f);
+};
+
+/// The knee paper's room (001 §3.1: the hand, the knee and the room walls): two walls standing on
+/// the floor's far edges as seen from the camera (the corner behind the scene wherever the view
+/// turns), `height_m` tall, unlit, one a little darker than the other. Needs the floor.
+struct RenderRoom {
+  bool visible = false;
+  double height_m = 0.5;
+  Vec3f colour = Vec3f(0.78f, 0.76f, 0.70f);
 };
 
 /// Which frame a light's direction is given in: fixed in the world, or moving with the camera
@@ -151,15 +170,18 @@ class RenderScene {
   [[nodiscard]] const RenderMesh& mesh(MeshId id) const;
   [[nodiscard]] std::size_t mesh_count() const { return meshes_.size(); }
 
-  /// World bounds of the visible meshes and spheres (for OrbitCamera::frame); empty if none.
+  /// World bounds of the visible meshes, spheres and capsules (for OrbitCamera::frame); empty if
+  /// none.
   [[nodiscard]] Box3 bounds_world() const;
 
   /// Per-frame content: cleared and refilled by the app (vectors keep their capacity).
   std::vector<RenderSphere> spheres;
+  std::vector<RenderCapsule> capsules;
   std::vector<RenderSegment> segments;
   std::vector<ShadowMark> shadow_marks;
 
   RenderFloor floor;
+  RenderRoom room;
   Lighting lighting;
   RenderStyle style;
 

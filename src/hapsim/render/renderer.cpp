@@ -171,6 +171,28 @@ const void* byte_offset(std::size_t floats) {
 
 static_assert(sizeof(TriangleIndices) == 3 * sizeof(std::uint32_t), "indices upload as is");
 
+// An open tube of radius 1 from z = 0 to z = 1 with radial normals: a capsule's body, scaled by
+// (r, r, length) per instance (the normals stay radial under that scale, so the shader's
+// normalize() makes them right).
+TriangleMesh make_unit_tube(int segments) {
+  TriangleMesh m;
+  for (int i = 0; i < segments; ++i) {
+    const double a = 2.0 * std::numbers::pi * i / segments;
+    const Vec3 radial(std::cos(a), std::sin(a), 0.0);
+    m.vertices.push_back(radial);
+    m.vertices.push_back(radial + Vec3::UnitZ());
+    m.vertex_normals.push_back(radial);
+    m.vertex_normals.push_back(radial);
+  }
+  for (int i = 0; i < segments; ++i) {
+    const auto a0 = static_cast<std::uint32_t>(2 * i);
+    const auto a1 = static_cast<std::uint32_t>(2 * ((i + 1) % segments));
+    m.triangles.push_back({a0, a1, a0 + 1});
+    m.triangles.push_back({a1, a1 + 1, a0 + 1});
+  }
+  return m;
+}
+
 // GPU copy of one mesh.
 struct GpuMesh {
   GLuint vao = 0;
@@ -227,6 +249,7 @@ struct Renderer::Impl {
 
   std::vector<GpuMesh> meshes;  // by MeshId
   GpuMesh sphere;               // unit sphere, scaled per instance
+  GpuMesh tube;                 // unit open tube: capsules' bodies
   GLuint stream_vao = 0;
   GLuint stream_vbo = 0;
   std::size_t stream_capacity_bytes = 0;
@@ -372,6 +395,8 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
 
   s.sphere.create();
   s.upload(s.sphere, make_uv_sphere(1.0, 32, 16), {}, true);
+  s.tube.create();
+  s.upload(s.tube, make_unit_tube(32), {}, true);
 
   glGenVertexArrays(1, &s.stream_vao);
   glGenBuffers(1, &s.stream_vbo);
@@ -398,6 +423,7 @@ Renderer::~Renderer() {
     }
   }
   s.sphere.destroy();
+  s.tube.destroy();
   glDeleteBuffers(1, &s.stream_vbo);
   glDeleteVertexArrays(1, &s.stream_vao);
   glDeleteProgram(s.lit);
@@ -457,6 +483,28 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
       s.push(*corner, c);
     }
   }
+  const auto walls_first = static_cast<GLint>(s.staging.size() / kUnlitFloats);
+  if (fl.visible && scene.room.visible) {
+    // The two walls on the floor's edges away from the eye: the room's corner behind the scene.
+    const Vec3 eye = camera.eye_world();
+    const double e = fl.half_extent_m;
+    const double x = eye.x() > fl.centre_x_m ? fl.centre_x_m - e : fl.centre_x_m + e;
+    const double y = eye.y() > fl.centre_y_m ? fl.centre_y_m - e : fl.centre_y_m + e;
+    const double z0 = fl.height_m;
+    const double z1 = fl.height_m + scene.room.height_m;
+    const Vec3f c = scene.room.colour;
+    const Vec3f darker = 0.85f * c;
+    const Vec3 a(x, fl.centre_y_m - e, z0), b(x, fl.centre_y_m + e, z0),
+        d(x, fl.centre_y_m + e, z1), f(x, fl.centre_y_m - e, z1);
+    for (const Vec3* corner : {&a, &b, &d, &a, &d, &f}) {
+      s.push(*corner, c);
+    }
+    const Vec3 g(fl.centre_x_m - e, y, z0), h(fl.centre_x_m + e, y, z0),
+        k(fl.centre_x_m + e, y, z1), m(fl.centre_x_m - e, y, z1);
+    for (const Vec3* corner : {&g, &h, &k, &g, &k, &m}) {
+      s.push(*corner, darker);
+    }
+  }
   const auto marks_first = static_cast<GLint>(s.staging.size() / kUnlitFloats);
   for (const ShadowMark& mark : scene.shadow_marks) {
     const Vec3 q(mark.point_world.x(), mark.point_world.y(), fl.height_m);
@@ -491,7 +539,7 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   }
 
   glBindVertexArray(s.stream_vao);
-  if (marks_first > floor_first) {
+  if (walls_first > floor_first) {
     // Pushed back in depth so marks lying exactly on it win the depth test.
     glUseProgram(s.floor);
     set_matrix(s.floor_view_projection, view_projection);
@@ -502,11 +550,14 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
     set_vec3(s.floor_colour_b, fl.colour_b);
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(1.0f, 1.0f);
-    glDrawArrays(GL_TRIANGLES, floor_first, marks_first - floor_first);
+    glDrawArrays(GL_TRIANGLES, floor_first, walls_first - floor_first);
     glDisable(GL_POLYGON_OFFSET_FILL);
   }
   glUseProgram(s.unlit);
   set_matrix(s.unlit_view_projection, view_projection);
+  if (marks_first > walls_first) {
+    glDrawArrays(GL_TRIANGLES, walls_first, marks_first - walls_first);
+  }
   if (segments_first > marks_first) {
     glDrawArrays(GL_TRIANGLES, marks_first, segments_first - marks_first);
   }
@@ -554,22 +605,51 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   };
   draw_meshes(false);
 
-  if (!scene.spheres.empty()) {
+  glUniform1i(s.lit_u.use_vertex_colour, 0);
+  const auto draw_sphere = [&](const Vec3& centre_world, double radius_m, const Vec3f& colour) {
+    Eigen::Matrix4d X_world_sphere = Eigen::Matrix4d::Identity();
+    X_world_sphere.topLeftCorner<3, 3>() *= radius_m;
+    X_world_sphere.topRightCorner<3, 1>() = centre_world;
+    set_matrix(s.lit_u.model_view, (X_camera_world * X_world_sphere).cast<float>());
+    set_vec3(s.lit_u.colour, colour);
+    glDrawElements(GL_TRIANGLES, s.sphere.index_count, GL_UNSIGNED_INT, nullptr);
+  };
+  if (!scene.spheres.empty() || !scene.capsules.empty()) {
     glBindVertexArray(s.sphere.vao);
-    glUniform1i(s.lit_u.use_vertex_colour, 0);
     for (const RenderSphere& sphere : scene.spheres) {
-      Eigen::Matrix4d X_world_sphere = Eigen::Matrix4d::Identity();
-      X_world_sphere.topLeftCorner<3, 3>() *= sphere.radius_m;
-      X_world_sphere.topRightCorner<3, 1>() = sphere.centre_world;
-      set_matrix(s.lit_u.model_view, (X_camera_world * X_world_sphere).cast<float>());
-      set_vec3(s.lit_u.colour, sphere.colour);
       if (sphere.wireframe) {
         glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
       }
-      glDrawElements(GL_TRIANGLES, s.sphere.index_count, GL_UNSIGNED_INT, nullptr);
+      draw_sphere(sphere.centre_world, sphere.radius_m, sphere.colour);
       if (sphere.wireframe) {
         glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
       }
+    }
+    for (const RenderCapsule& c : scene.capsules) {
+      draw_sphere(c.a_world, c.radius_m, c.colour);
+      draw_sphere(c.b_world, c.radius_m, c.colour);
+    }
+  }
+  if (!scene.capsules.empty()) {
+    glBindVertexArray(s.tube.vao);
+    for (const RenderCapsule& c : scene.capsules) {
+      const Vec3 axis = c.b_world - c.a_world;
+      const double length = axis.norm();
+      if (!(length > 1e-9)) {
+        continue;  // the end spheres are the whole capsule
+      }
+      // Columns: two unit vectors across the axis, scaled by the radius, and the axis itself.
+      const Vec3 z = axis / length;
+      const Vec3 x = z.unitOrthogonal();
+      const Vec3 y = z.cross(x);
+      Eigen::Matrix4d X_world_tube = Eigen::Matrix4d::Identity();
+      X_world_tube.block<3, 1>(0, 0) = c.radius_m * x;
+      X_world_tube.block<3, 1>(0, 1) = c.radius_m * y;
+      X_world_tube.block<3, 1>(0, 2) = axis;
+      X_world_tube.topRightCorner<3, 1>() = c.a_world;
+      set_matrix(s.lit_u.model_view, (X_camera_world * X_world_tube).cast<float>());
+      set_vec3(s.lit_u.colour, c.colour);
+      glDrawElements(GL_TRIANGLES, s.tube.index_count, GL_UNSIGNED_INT, nullptr);
     }
   }
 

@@ -5,8 +5,12 @@
 #include "hapsim/render/png_image.h"
 #include "hapsim/render/renderer.h"
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <numbers>
+#include <string>
+#include <vector>
 
 namespace hapsim {
 
@@ -35,7 +39,7 @@ SnapshotWriter::~SnapshotWriter() {
 const std::vector<std::uint8_t>& SnapshotWriter::render(const RenderScene& scene,
                                                         const OrbitCamera& camera) {
   context_->make_current();
-  renderer_->draw(scene, camera, width_px_, height_px_);
+  draw_stereo(*renderer_, scene, camera, stereo_, eye_separation_m_, 0, 0, width_px_, height_px_);
   context_->read_rgba(rgba_);
   return rgba_;
 }
@@ -58,6 +62,43 @@ OrbitCamera framed_camera(const Box3& bounds_world, double aspect, double yaw_ra
     camera.frame(bounds_world, aspect, margin);
   }
   return camera;
+}
+
+OrbitCamera parse_camera_spec(const std::string& spec) {
+  const std::string usage =
+      "expected EX,EY,EZ,TX,TY,TZ,FOV (eye and target in metres, field of view in degrees), got "
+      "'" +
+      spec + "'";
+  std::vector<double> v;
+  std::size_t start = 0;
+  while (start <= spec.size()) {
+    const std::size_t comma = std::min(spec.find(',', start), spec.size());
+    const std::string item = spec.substr(start, comma - start);
+    std::size_t used = 0;
+    double x = 0.0;
+    try {
+      x = std::stod(item, &used);
+    } catch (const std::exception&) {
+      throw Error("--camera", usage);
+    }
+    if (used != item.size() || !std::isfinite(x)) {
+      throw Error("--camera", usage);
+    }
+    v.push_back(x);
+    start = comma + 1;
+  }
+  if (v.size() != 7) {
+    throw Error("--camera", usage);
+  }
+  const Vec3 eye(v[0], v[1], v[2]);
+  const Vec3 target(v[3], v[4], v[5]);
+  if (!(v[6] > 1.0 && v[6] <= 170.0)) {
+    throw Error("--camera", "field of view must be in (1, 170] degrees, got " + spec);
+  }
+  if ((eye - target).norm() < 1e-6) {
+    throw Error("--camera", "the eye is on its target: " + spec);
+  }
+  return OrbitCamera::looking_at(eye, target, v[6] * std::numbers::pi / 180.0);
 }
 
 std::string numbered_path(const std::string& path, std::uint64_t index) {

@@ -5,6 +5,7 @@
 
 #include "hapsim/render/camera.h"
 #include "hapsim/render/render_scene.h"
+#include "hapsim/render/stereo.h"
 
 #include <cstdint>
 #include <memory>
@@ -28,6 +29,13 @@ class SnapshotWriter {
   SnapshotWriter(SnapshotWriter&&) = delete;
   SnapshotWriter& operator=(SnapshotWriter&&) = delete;
 
+  /// Stereo pictures from now on (stereo.h): side by side or red–cyan anaglyph; separation ≤ 0:
+  /// the default for the camera's distance.
+  void set_stereo(StereoMode mode, double eye_separation_m) {
+    stereo_ = mode;
+    eye_separation_m_ = eye_separation_m;
+  }
+
   /// Draws `scene` from `camera` and returns the pixels (RGBA8, top row first).
   const std::vector<std::uint8_t>& render(const RenderScene& scene, const OrbitCamera& camera);
   /// Draws and writes a PNG; throws hapsim::Error naming `path` when it cannot be written.
@@ -43,12 +51,18 @@ class SnapshotWriter {
   std::unique_ptr<OffscreenContext> context_;
   std::unique_ptr<Renderer> renderer_;
   std::vector<std::uint8_t> rgba_;
+  StereoMode stereo_ = StereoMode::kOff;
+  double eye_separation_m_ = 0.0;
 };
 
 /// A camera looking at the centre of `bounds_world` from azimuth `yaw_rad` and elevation
 /// `pitch_rad`, close enough to show the whole box in a viewport of `aspect`.
 [[nodiscard]] OrbitCamera framed_camera(const Box3& bounds_world, double aspect, double yaw_rad,
                                         double pitch_rad, double margin = 1.05);
+
+/// "EX,EY,EZ,TX,TY,TZ,FOV": the eye and the target (world, metres) and the vertical field of view
+/// (degrees, in (1, 170]) of `--camera`; throws hapsim::Error saying what is wrong otherwise.
+[[nodiscard]] OrbitCamera parse_camera_spec(const std::string& spec);
 
 /// "out.png", 42 → "out_000042.png" (a series of snapshots).
 [[nodiscard]] std::string numbered_path(const std::string& path, std::uint64_t index);

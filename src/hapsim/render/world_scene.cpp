@@ -4,6 +4,10 @@
 #include "hapsim/collision/sphere_tree.h"
 #include "hapsim/core/error.h"
 #include "hapsim/kinematics/slave_shapes.h"
+#include "hapsim/render/creased_normals.h"
+#include "hapsim/render/force_scale.h"
+#include "hapsim/render/hand_figure.h"
+#include "hapsim/render/slave_figure.h"
 
 #include <algorithm>
 #include <array>
@@ -32,21 +36,6 @@ namespace {
 
 bool contains(const std::string& haystack, std::string_view needle) {
   return haystack.find(needle) != std::string::npos;
-}
-
-/// The mesh with a vertex per triangle corner, so its vertex normals are the face normals: a box
-/// drawn with flat faces and sharp edges, not smoothed round its corners.
-TriangleMesh faceted(const TriangleMesh& mesh) {
-  TriangleMesh m;
-  for (const TriangleIndices& t : mesh.triangles) {
-    const auto base = static_cast<std::uint32_t>(m.vertices.size());
-    for (const std::uint32_t v : t) {
-      m.vertices.push_back(mesh.vertices[v]);
-    }
-    m.triangles.push_back({base, base + 1, base + 2});
-  }
-  m.compute_vertex_normals();
-  return m;
 }
 
 /// How a rig draws a body, when it is one of the rig's: its colour, whether it is a box drawn
@@ -142,8 +131,8 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
       const MaterialDescription& m = d.materials.at(sd.material);
       seg->tissue_colour =
           role.colour.value_or(tissue_colour(m.name, static_cast<int>(sd.material)));
-      seg->mesh = scene_.add_mesh(role.box ? faceted(sd.mesh) : sd.mesh, seg->tissue_colour,
-                                  world.body_pose(b));
+      seg->mesh = scene_.add_mesh(role.box ? with_creased_normals(sd.mesh, 0.0) : sd.mesh,
+                                  seg->tissue_colour, world.body_pose(b));
       scene_.mesh(seg->mesh).name = seg->label;
       scene_.mesh(seg->mesh).opacity = static_cast<float>(m.opacity);
       // A rig's floor is a slab much wider than the scene: the checked floor stands for it.
@@ -157,6 +146,9 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
     }
     body_poses_.push_back(world.body_pose(b));
   }
+  scene_.room.visible = options_.show_room;
+  has_hand_ = world.model().hand() != nullptr;
+  hand_ = world.hand_reading();
   tools_.resize(d.tools.size());
   tool_force_n_.assign(d.tools.size(), 0.0);
   if (d.teleop) {
@@ -185,8 +177,17 @@ WorldScene::~WorldScene() = default;
 void WorldScene::build_rig() {
   const TeleopRigDescription& rig = *world_.description().teleop;
   rig_ = make_teleop_snapshot(world_);
-  joint_radius_m_ = slave_joint_radii_m(*rig.slave);
   frames_.resize(static_cast<std::size_t>(rig.slave->dof()));
+  slave_figure_ = std::make_unique<SlaveFigure>(*rig.slave, scene_,
+                                                SlaveLook{rig_colours_.robot, rig_colours_.joint});
+  warnings_ = slave_figure_->warnings();
+  if (slave_figure_->draws_links()) {
+    for (const TeleopRigDescription::SlaveBody& s : rig.slave_bodies) {
+      if (s.frame != kToolFrame) {
+        scene_.mesh(segments_[world_.flat_segment(s.body, 0)]->mesh).visible = false;
+      }
+    }
+  }
   scene_.style.line_width_px = 2.0f;
   Box3 bounds = rest_bounds_world_;
   const BallEnvironmentOptions& env = rig.environment;
@@ -197,13 +198,12 @@ void WorldScene::build_rig() {
       options_.master_display_scale * (g.upper_arm_m + g.forearm_m + g.finger_m);
   master_origin_world_ = Vec3(bounds.center().x(), bounds.min().y() - 0.6 * master_reach, floor_z);
   if (options_.show_master) {
-    add_master_lines(*rig_);
-    for (const RenderSegment& seg : scene_.segments) {
-      bounds.extend(seg.a_world);
-      bounds.extend(seg.b_world);
+    add_master(*rig_);
+    for (const RenderCapsule& c : scene_.capsules) {
+      bounds.extend(c.a_world);
+      bounds.extend(c.b_world);
     }
-    scene_.segments.clear();
-    scene_.spheres.clear();
+    scene_.capsules.clear();
   }
   rest_bounds_world_ = bounds;
   // A floor under everything, a little wider, 5 cm checks.
@@ -230,12 +230,55 @@ void WorldScene::shade_dent(Segment& seg) {
   scene_.set_vertex_colours(seg.mesh, scratch_colours_);
 }
 
+// The sheet's grid lines over its shaded faces, on its live surface: the dent bends them where a
+// press or a resting ball pushed it in. Lifted a little off the faces (along the sheet's normal)
+// so the depth test keeps them in front.
+void WorldScene::add_sheet_grid(const Segment& seg) {
+  constexpr double kLiftM = 3e-4;
+  const Vec3f line(0.22f, 0.36f, 0.62f);
+  const std::vector<Vec3>& v = scene_.mesh(seg.mesh).geometry().vertices;
+  const auto n =
+      static_cast<std::size_t>(world_.description().bodies[seg.body].sheet.nodes_per_side);
+  if (n < 2 || v.size() != n * n) {
+    return;
+  }
+  const Iso3& X = body_poses_[seg.body];
+  const Vec3 lift = kLiftM * X.linear().col(2);
+  const auto at = [&](std::size_t i, std::size_t j) { return Vec3(X * v[j * n + i] + lift); };
+  for (std::size_t a = 0; a < n; ++a) {
+    for (std::size_t b = 0; b + 1 < n; ++b) {
+      scene_.segments.push_back({at(b, a), at(b + 1, a), line});
+      scene_.segments.push_back({at(a, b), at(a, b + 1), line});
+    }
+  }
+}
+
+// Whether the hand's reading puts each fingertip where its tool is: a served world's views carry
+// the tools but not the glove's reading, and a hand drawn at rest elsewhere would mislead (the
+// fingertips alone are drawn then).
+bool WorldScene::hand_agrees_with_tools() const {
+  constexpr double kToleranceM = 1e-4;
+  const auto tips = world_.model().hand()->fingertips_world(hand_);
+  const WorldDescription& d = world_.description();
+  for (std::size_t t = 0; t < tools_.size() && t < d.tools.size(); ++t) {
+    const int f = d.tools[t].finger;
+    if (f >= 0 && f < kHandFingers &&
+        !((tips[static_cast<std::size_t>(f)] - tools_[t].p_world).norm() <= kToleranceM)) {
+      return false;
+    }
+  }
+  return true;
+}
+
 MeshId WorldScene::segment_mesh(std::size_t flat_segment) const {
   return segments_.at(flat_segment)->mesh;
 }
 
 void WorldScene::set_options(const WorldSceneOptions& options) {
   const bool recolour = options.colouring != options_.colouring;
+  if (options.show_room != options_.show_room) {
+    scene_.room.visible = options.show_room;
+  }
   options_ = options;
   if (recolour) {
     apply_colouring();
@@ -321,6 +364,7 @@ void WorldScene::update(const WorldSnapshot& snapshot) {
   if (rig_ && snapshot.teleop) {
     *rig_ = *snapshot.teleop;  // sized alike: no allocation after the first
   }
+  hand_ = snapshot.hand;
   rebuild_overlays(snapshot.tools, snapshot.tool_force_n);
 }
 
@@ -337,6 +381,7 @@ void WorldScene::update_from_world(const World& world) {
       }
     }
   }
+  hand_ = world.hand_reading();
   if (rig_) {
     rig_->time_s = world.rig()->result.time_s;
     fill_teleop_snapshot(*rig_, world);
@@ -358,19 +403,32 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
     tool_force_n_ = force_n;
   }
   const WorldDescription& d = world_.description();
+  if (!rest_bounds_world_.isEmpty()) {
+    scene_.room.height_m = 1.3 * (rest_bounds_world_.max().z() - scene_.floor.height_m) + 0.05;
+  }
+  const double heat_full_scale_n = options_.force_full_scale_n > 0.0
+                                       ? options_.force_full_scale_n
+                                       : force_display_scale_n(d, 0.0);
   scene_.spheres.clear();
+  scene_.capsules.clear();
   scene_.segments.clear();
   scene_.shadow_marks.clear();
+  if (has_hand_ && hand_agrees_with_tools()) {
+    add_hand_figure(*world_.model().hand(), hand_, kHandColour, scene_.capsules);
+  }
   const double scale =
       std::max(0.05, rest_bounds_world_.isEmpty() ? 0.1 : rest_bounds_world_.sizes().norm());
   for (std::size_t t = 0; t < tools_.size() && t < d.tools.size(); ++t) {
     const ToolState& tool = tools_[t];
     const double f = t < tool_force_n_.size() ? tool_force_n_[t] : 0.0;
-    // Green when free, towards red as the force grows (10 N full red).
-    const float heat = static_cast<float>(std::clamp(f / 10.0, 0.0, 1.0));
+    // Green when free (a fingertip: the hand's colour), towards red as the force grows to the
+    // display's full scale.
+    const float heat = static_cast<float>(std::clamp(f / heat_full_scale_n, 0.0, 1.0));
     const double radius = std::max(d.tools[t].radius_m, 0.002);
-    scene_.spheres.push_back(
-        {tool.p_world, radius, Vec3f(0.2f + 0.75f * heat, 0.8f - 0.6f * heat, 0.25f), false});
+    const Vec3f cool = has_hand_ ? kHandColour : Vec3f(0.2f, 0.8f, 0.25f);
+    scene_.spheres.push_back({tool.p_world, radius,
+                              Vec3f((1.0f - heat) * cool + heat * Vec3f(0.95f, 0.2f, 0.25f)),
+                              false});
     if (options_.show_proxies && (tool.proxy_world - tool.p_world).norm() > 1e-4) {
       scene_.spheres.push_back({tool.proxy_world, radius, Vec3f(0.3f, 0.6f, 1.0f), true});
       scene_.segments.push_back({tool.p_world, tool.proxy_world, Vec3f(0.3f, 0.6f, 1.0f)});
@@ -382,6 +440,21 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
     }
     scene_.shadow_marks.push_back(
         {tool.p_world, 0.04 * scale, 0.006 * scale, Vec3f(0.1f, 0.1f, 0.12f)});
+  }
+  // The floor grows to hold every tool's shadow mark (a hand comes from beyond the knee's floor).
+  RenderFloor& fl = scene_.floor;
+  for (const ShadowMark& mark : scene_.shadow_marks) {
+    const double reach = std::max(std::abs(mark.point_world.x() - fl.centre_x_m),
+                                  std::abs(mark.point_world.y() - fl.centre_y_m)) +
+                         2.0 * mark.arm_m;
+    if (std::isfinite(reach) && reach > fl.half_extent_m) {
+      fl.half_extent_m = fl.cell_m * std::ceil(reach / fl.cell_m);
+    }
+  }
+  for (const auto& seg : segments_) {
+    if (seg->sheet && scene_.mesh(seg->mesh).visible) {
+      add_sheet_grid(*seg);
+    }
   }
   if (options_.sphere_tree_level >= 0) {
     for (auto& seg : segments_) {
@@ -422,21 +495,20 @@ void WorldScene::add_rig_overlays() {
       }
     }
   }
-  if (options_.show_joints && !joint_radius_m_.empty() && s.slave_q.size() == frames_.size()) {
-    static_cast<void>(rig.slave->frames(s.slave_q, frames_));
-    for (std::size_t k = 0; k < joint_radius_m_.size() && k < frames_.size(); ++k) {
-      scene_.spheres.push_back(
-          {frames_[k].translation(), joint_radius_m_[k], rig_colours_.joint, false});
-    }
+  if (s.slave_q.size() == frames_.size()) {
+    const Iso3 tip_world = rig.slave->frames(s.slave_q, frames_);
+    slave_figure_->update(frames_, tip_world, scene_, options_.show_joints);
   }
   const Vec3 tool_point_world = s.X_world_tool * Vec3(0.0, 0.0, rig.gripper.pad_depth_m);
   scene_.shadow_marks.push_back({tool_point_world, 0.03, 0.005, rig_colours_.shadow});
   if (options_.show_master) {
-    add_master_lines(s);
+    add_master(s);
   }
 }
 
-void WorldScene::add_master_lines(const TeleopSnapshot& s) {
+// The master arm at master_display_scale beside the slave: its links as rods from the base
+// through the shoulder and elbow to the hand, its two fingers as thin rods.
+void WorldScene::add_master(const TeleopSnapshot& s) {
   const MasterArm& master = *world_.model().master();
   const MasterArmGeometry& g = master.geometry();
   std::array<Iso3, 3> f;
@@ -450,9 +522,11 @@ void WorldScene::add_master_lines(const TeleopSnapshot& s) {
   const Vec3 shoulder = at(f[1].translation());
   const Vec3 elbow = at(f[2].translation());
   const Vec3 wrist = at(hand.translation());
-  scene_.segments.push_back({base, shoulder, c});
-  scene_.segments.push_back({shoulder, elbow, c});
-  scene_.segments.push_back({elbow, wrist, c});
+  const double r = 0.02 * scale;
+  scene_.capsules.push_back({base, base + Vec3(0.0, 0.0, 0.5 * r), 2.2 * r, rig_colours_.joint});
+  scene_.capsules.push_back({base, shoulder, r, c});
+  scene_.capsules.push_back({shoulder, elbow, r, c});
+  scene_.capsules.push_back({elbow, wrist, 0.8 * r, c});
   // Fingers: pivots ± gap/2 across the hand (its y), each swung out by its angle from the
   // hand's axis (its z).
   const Vec3 y = hand.linear().col(1);
@@ -463,11 +537,7 @@ void WorldScene::add_master_lines(const TeleopSnapshot& s) {
         std::clamp(s.master_finger_rad[static_cast<std::size_t>(i)], 0.0, g.finger_open_limit_rad);
     const Vec3 pivot = hand.translation() + side * 0.5 * g.finger_gap_m * y;
     const Vec3 tip = pivot + g.finger_m * (std::cos(a) * z + side * std::sin(a) * y);
-    scene_.segments.push_back({at(pivot), at(tip), Vec3f(0.95f, 0.95f, 0.95f)});
-  }
-  const double r = 0.01 * scale;
-  for (const Vec3& p : {base, shoulder, elbow, wrist}) {
-    scene_.spheres.push_back({p, r, c, false});
+    scene_.capsules.push_back({at(pivot), at(tip), 0.4 * r, Vec3f(0.92f, 0.92f, 0.92f)});
   }
 }
 

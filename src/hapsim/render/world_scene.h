@@ -17,6 +17,7 @@
 
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 namespace hapsim {
@@ -33,29 +34,36 @@ struct WorldSceneOptions {
   int sphere_tree_level = -1;
   bool show_proxies = true;
   bool show_force_arrows = true;
+  /// A tool's force at which it is drawn full red, N; 0: the scene's largest contact force
+  /// (force_scale.h).
+  double force_full_scale_n = 0.0;
+  /// The knee paper's room: walls on the floor's far edges, a little taller than the scene.
+  bool show_room = false;
   /// Force arrow length per newton, metres.
   double arrow_m_per_n = 0.005;
   /// A rig's master arm drawn as lines beside the scene (its base on the floor, off the slave's
   /// −y side), at this fraction of its real size.
   bool show_master = true;
   double master_display_scale = 0.5;
-  /// Spheres at a rig slave's joints (only for a chain drawn as boxes).
+  /// Drums along a rig slave's joint axes (a chain drawn with rounded links).
   bool show_joints = true;
 };
 
-/// Colours of a rig's parts (RGB in [0, 1]): a Motoman-like orange robot, a red ball.
+/// Colours of a rig's parts (RGB in [0, 1]): a Motoman in Yaskawa's blue, a red ball.
 struct RigColours {
-  Vec3f robot = Vec3f(0.96f, 0.60f, 0.10f);
-  Vec3f joint = Vec3f(0.22f, 0.22f, 0.25f);
+  Vec3f robot = Vec3f(0.13f, 0.15f, 0.75f);
+  Vec3f joint = Vec3f(0.30f, 0.31f, 0.34f);
   Vec3f gripper = Vec3f(0.55f, 0.57f, 0.60f);
   Vec3f pad = Vec3f(0.30f, 0.32f, 0.35f);
   /// The pads while they hold the ball.
   Vec3f pad_holding = Vec3f(0.25f, 0.70f, 0.30f);
   Vec3f ball = Vec3f(0.86f, 0.12f, 0.10f);
   Vec3f sheet = Vec3f(0.55f, 0.75f, 0.95f);
-  Vec3f master = Vec3f(0.35f, 0.85f, 0.95f);
+  Vec3f master = Vec3f(0.35f, 0.80f, 0.90f);
   Vec3f shadow = Vec3f(0.10f, 0.10f, 0.12f);
 };
+
+class SlaveFigure;
 
 class WorldScene {
  public:
@@ -91,6 +99,10 @@ class WorldScene {
   [[nodiscard]] MeshId segment_mesh(std::size_t flat_segment) const;
   /// With a rig: where its master's base is drawn (p_world = origin + scale · p_master).
   [[nodiscard]] const Vec3& master_display_origin_world() const { return master_origin_world_; }
+  /// With a rig: how its slave is drawn (visual meshes, rounded links or collision meshes).
+  [[nodiscard]] const SlaveFigure* slave_figure() const { return slave_figure_.get(); }
+  /// What the scene could not draw as asked (a URDF visual mesh that did not load), once each.
+  [[nodiscard]] const std::vector<std::string>& warnings() const { return warnings_; }
 
   /// The colour of a material by its name (what kTissue uses), for legends.
   [[nodiscard]] static Vec3f tissue_colour(std::string_view material_name, int material_index);
@@ -100,9 +112,11 @@ class WorldScene {
   void build_rig();
   void apply_colouring();
   void shade_dent(Segment& seg);
+  void add_sheet_grid(const Segment& seg);
+  [[nodiscard]] bool hand_agrees_with_tools() const;
   void rebuild_overlays(const std::vector<ToolState>& tools, const std::vector<double>& force_n);
   void add_rig_overlays();
-  void add_master_lines(const TeleopSnapshot& s);
+  void add_master(const TeleopSnapshot& s);
 
   const World& world_;
   WorldSceneOptions options_;
@@ -115,10 +129,14 @@ class WorldScene {
   std::vector<double> tool_force_n_;
   std::vector<Iso3> body_poses_;  // where each body is drawn (dynamic bodies move)
   Box3 rest_bounds_world_;
-  // A rig's part: its latest state, the joint spheres' radii (a slave drawn as boxes), the
-  // slave's joint frames (scratch), where the master is drawn.
+  // A glove world's hand, as the last update saw it.
+  bool has_hand_ = false;
+  GloveReading hand_;
+  // A rig's part: its latest state, how the slave is drawn, the slave's joint frames (scratch),
+  // where the master is drawn.
   std::optional<TeleopSnapshot> rig_;
-  std::vector<double> joint_radius_m_;
+  std::unique_ptr<SlaveFigure> slave_figure_;
+  std::vector<std::string> warnings_;
   std::vector<Iso3> frames_;
   Vec3 master_origin_world_ = Vec3::Zero();
 };

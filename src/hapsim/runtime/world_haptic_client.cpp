@@ -149,6 +149,7 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
   s.world_time_s = world_.state().time_s;
   s.input = *cycle.input;
   s.output = *cycle.output;
+  s.hand = world_.hand_reading();
   const WorldDescription& d = world_.description();
   if (last_result_ != nullptr) {
     const StepResult& r = *last_result_;

@@ -38,6 +38,8 @@ struct WorldSnapshot {
   std::vector<std::uint64_t> positions_version;
   /// Per body: where it is now (dynamic bodies move).
   std::vector<Iso3> body_poses_world;
+  /// A glove world's hand: its pose and finger angles (World::hand_reading).
+  GloveReading hand;
   /// The teleoperation rig (slave, gripper, ball, sheet, master), when the world has one.
   std::optional<TeleopSnapshot> teleop;
 };

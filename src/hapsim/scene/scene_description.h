@@ -133,6 +133,15 @@ struct RunDescription {
   double dt_s = 0.001;
 };
 
+/// A named camera view of the scene (docs/scene-format.md#views): `--view NAME` on snapshots.
+struct SceneView {
+  std::string name;
+  /// Where the eye is and what it looks at, world frame, metres; vertical field of view.
+  Vec3 eye_m = Vec3(0.0, -1.0, 0.5);
+  Vec3 target_m = Vec3::Zero();
+  double fov_deg = 40.0;
+};
+
 struct SceneDescription {
   std::filesystem::path file;  // where it was read from (empty when built in code)
   std::string description;
@@ -142,6 +151,8 @@ struct SceneDescription {
   WorldDescription world;
   DeviceDescription device;
   RunDescription run;
+  /// Named camera views ("views"), in name order.
+  std::vector<SceneView> views;
   /// What the load and the run's assembly let through but a user should know, one line each,
   /// "<where>: <what>" (docs/scene-format.md, "Warnings"): a mesh implausibly sized at its scale
   /// (scene_file.h), a scripted trajectory that never comes within reach of a body

@@ -9,6 +9,7 @@
 #include "hapsim/scene/json_text.h"
 #include "hapsim/scene/scene_reader.h"
 #include "hapsim/scene/teleop_reader.h"
+#include "hapsim/scene/view_reader.h"
 
 #include <nlohmann/json.hpp>
 
@@ -58,11 +59,12 @@ SceneDescription Parser::parse(const Json& root) {
   object(root, "", "a scene");
   const bool teleop = root.is_object() && root.contains("teleop");
   if (teleop) {
-    allow_keys(root, "", {"$schema", "format", "description", "data", "teleop", "device", "run"});
+    allow_keys(root, "",
+               {"$schema", "format", "description", "data", "teleop", "device", "run", "views"});
   } else {
     allow_keys(root, "",
                {"$schema", "format", "description", "data", "world", "materials", "bodies", "tools",
-                "device", "run"});
+                "device", "run", "views"});
   }
   const Json& format = required(root, "", "format");
   if (!format.is_string() || format.get<std::string>() != "hapsim-scene/1") {
@@ -435,6 +437,9 @@ ToolDescription Parser::parse_tool(const Json& j, const std::string& ptr) const 
 }
 
 void Parser::parse_run(const Json& root, SceneDescription& scene) const {
+  if (root.contains("views")) {
+    scene.views = read_views(*this, root["views"], "/views");
+  }
   if (root.contains("run")) {
     const Json& run = object(root["run"], "/run", "run settings");
     allow_keys(run, "/run", {"duration_s", "dt_s"});

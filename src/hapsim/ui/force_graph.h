@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,8 +20,19 @@ class ForceGraph {
 
   /// Adds this frame's values (label, newtons) to the history.
   void push(const std::vector<std::pair<std::string, double>>& bars);
-  /// Draws the bars (0..full_scale_n) and the plot inside the current ImGui window.
+  /// Draws the bars and the plots inside the current ImGui window, full scale `full_scale_n`,
+  /// or display_scale_n() once a force went past it. Each bar's value and label are fitted to
+  /// its slot (fit_text), so neighbours never overlap.
   void draw(double full_scale_n) const;
+  /// `full_scale_n`, or the next nice value (force_scale.h) above the largest force pushed when
+  /// that went past it: a bar is never clipped unnoticed.
+  [[nodiscard]] double display_scale_n(double full_scale_n) const;
+
+  /// The first of `candidates` whose width (by `width_px`) fits `max_px`, else the last one cut
+  /// short with a '.' until it fits (possibly empty).
+  [[nodiscard]] static std::string fit_text(
+      const std::vector<std::string>& candidates, float max_px,
+      const std::function<float(const std::string&)>& width_px);
   /// Largest value ever pushed, per series, and whether any was non-finite.
   [[nodiscard]] const std::vector<double>& peaks() const { return peaks_; }
   [[nodiscard]] bool saw_nonfinite() const { return saw_nonfinite_; }

@@ -120,6 +120,7 @@ class Viewer {
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
     panels_ = options.panels;
+    stereo_ = options.stereo;
     renderer_ = std::make_unique<Renderer>();
     gl_version_ = renderer_->gl_version();
     scene_choices_ = options.scene_choices;
@@ -181,7 +182,8 @@ class Viewer {
       glViewport(0, 0, fb_w, fb_h);
       glClearColor(0.1f, 0.1f, 0.12f, 1.0f);
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-      renderer_->draw_in(session_->render_scene(), camera_, v.x, v.y, v.w, v.h);
+      draw_stereo(*renderer_, session_->render_scene(), camera_, stereo_, options_.eye_separation_m,
+                  v.x, v.y, v.w, v.h);
       draw_panels(fb_w, fb_h);
       const double draw_ms = std::chrono::duration<double, std::milli>(Clock::now() - d0).count();
       draw_ms_sum += draw_ms;
@@ -362,6 +364,11 @@ class Viewer {
             : m == DisplayMode::kLines ? DisplayMode::kPoints
                                        : DisplayMode::kFaces;
       });
+      key_edge(GLFW_KEY_V, [this] {
+        stereo_ = stereo_ == StereoMode::kOff          ? StereoMode::kSideBySide
+                  : stereo_ == StereoMode::kSideBySide ? StereoMode::kAnaglyph
+                                                       : StereoMode::kOff;
+      });
       key_edge(GLFW_KEY_TAB, [this] {
         panels_ = !panels_;
         frame_view();
@@ -500,6 +507,8 @@ class Viewer {
       ImGui::RadioButton("faces", &mode, static_cast<int>(DisplayMode::kFaces));
       scene.style.display_mode = static_cast<DisplayMode>(mode);
       ImGui::Checkbox("floor", &scene.floor.visible);
+      ImGui::SameLine();
+      ImGui::Checkbox("room", &scene.room.visible);
       int lights = static_cast<int>(scene.lighting.lights.size());
       if (ImGui::SliderInt("lights", &lights, 1, Lighting::kMaxLights)) {
         resize_lights(scene.lighting, lights);
@@ -597,7 +606,7 @@ class Viewer {
     for (const double p : forces_.peaks()) {
       peak = std::max(peak, p);
     }
-    const bool over = peak > session_->readout().bar_full_scale_n + 1e-9;
+    const bool over = peak > session_->readout().rated_force_n + 1e-9;
     const bool ok = !over && !forces_.saw_nonfinite();
     if (!options_.quiet) {
       std::printf("viewer       %s, %s\n", session_->title().c_str(), gl_version_.c_str());
@@ -620,7 +629,7 @@ class Viewer {
       std::printf(
           "forces       peak shown %.3f N (device rating %.1f N); largest deflection "
           "%.2f mm\n",
-          peak, session_->readout().bar_full_scale_n, peak_deflection_m_ * 1e3);
+          peak, session_->readout().rated_force_n, peak_deflection_m_ * 1e3);
       if (!options_.screenshot.empty()) {
         std::printf("screenshot   %s\n", options_.screenshot.string().c_str());
       }
@@ -684,6 +693,7 @@ class Viewer {
   bool paused_ = false;
   bool built_once_ = false;
   bool panels_ = true;
+  StereoMode stereo_ = StereoMode::kOff;
   bool screenshot_requested_ = false;
   std::array<bool, 512> key_down_{};
   double peak_deflection_m_ = 0.0;

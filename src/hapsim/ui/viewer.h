@@ -8,9 +8,11 @@
 // Mouse: left-drag moves the probe in the view plane, the wheel pushes it in or pulls it out;
 // right-drag rotates the view, middle-drag (or shift+right) pans, ctrl+wheel zooms.
 // Keys: 1-5 curl fingers (glove scenes), G closes/opens the grasp, space pauses, R resets,
-// M cycles the display mode, F frames the scene, Tab hides the panels, Esc quits.
+// M cycles the display mode, V cycles stereo (off, side by side, anaglyph), F frames the scene,
+// Tab hides the panels, Esc quits.
 #pragma once
 
+#include "hapsim/render/stereo.h"
 #include "hapsim/ui/viewer_session.h"
 
 #include <filesystem>
@@ -29,6 +31,10 @@ struct ViewerOptions {
   int msaa_samples = 0;
   /// Show the control and data areas (Tab toggles them): off gives the 3D view the window.
   bool panels = true;
+  /// Stereo 3D view (render/stereo.h; the V key cycles off / side by side / anaglyph) and the
+  /// eyes' separation in metres (0: a thirtieth of the view distance).
+  StereoMode stereo = StereoMode::kOff;
+  double eye_separation_m = 0.0;
   /// Close after this many seconds (0: when the window is closed).
   double duration_s = 0.0;
   /// Write the last frame (the whole window) to this PNG when closing.

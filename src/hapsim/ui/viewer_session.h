@@ -61,7 +61,10 @@ struct SessionReadout {
   std::vector<std::pair<std::string, std::string>> lines;
   /// Bars of the force column graph: label and newtons (one per finger, or grasp and tip).
   std::vector<std::pair<std::string, double>> bars;
-  /// Full scale of the bars: the device's rated force, N.
+  /// The device's rated force, N: a force shown above it is a failure (the viewer's exit 1).
+  double rated_force_n = 10.0;
+  /// Full scale of the bars and plots: what the scene can push with, within the rating
+  /// (force_scale.h), N; the graph grows past it if a force ever does.
   double bar_full_scale_n = 10.0;
   double max_deflection_m = 0.0;
   std::size_t contact_count = 0;

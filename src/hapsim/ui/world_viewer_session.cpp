@@ -7,6 +7,7 @@
 #include "hapsim/device/master_probe_device.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/kinematics/hand_model.h"
+#include "hapsim/render/force_scale.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/scene/run_setup.h"
@@ -138,13 +139,14 @@ class WorldViewerSession final : public ViewerSession {
     }
     title_ = scene_.file.filename().string() + " — " +
              (setup.slave_name.empty() ? "" : setup.slave_name + ", ") + device_name_;
-    if (world_->rig() != nullptr) {
-      readout_.bar_full_scale_n = world_->description().teleop->gripper.max_force_n;
-    } else {
-      readout_.bar_full_scale_n = profile.finger_count > 0 && profile.max_finger_force_n > 0.0
-                                      ? std::max(profile.max_finger_force_n, profile.max_force_n)
-                                      : profile.max_force_n;
-    }
+    readout_.rated_force_n = world_->rig() != nullptr
+                                 ? world_->description().teleop->gripper.max_force_n
+                                 : device_rated_force_n(profile);
+    readout_.bar_full_scale_n =
+        force_display_scale_n(world_->description(), readout_.rated_force_n);
+    WorldSceneOptions o = view_->options();
+    o.force_full_scale_n = readout_.bar_full_scale_n;
+    view_->set_options(o);
     start_loop();
   }
   ~WorldViewerSession() override {

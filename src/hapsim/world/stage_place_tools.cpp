@@ -253,9 +253,10 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
     Iso3 X_world_hand = Iso3::Identity();
     X_world_hand.linear() = q.toRotationMatrix();
     X_world_hand.translation() = input.p_world;
-    tips = hand->fingertips_world(glove_reading(
+    state.hand = glove_reading(
         X_world_hand, {input.joint_rad.data(), static_cast<std::size_t>(std::clamp(
-                                                   input.joint_count, 0, kMaxDeviceJoints))}));
+                                                   input.joint_count, 0, kMaxDeviceJoints))});
+    tips = hand->fingertips_world(state.hand);
   }
   for (std::size_t t = 0; t < state.tools.size(); ++t) {
     ToolRuntime& tool = state.tools[t];

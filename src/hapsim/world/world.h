@@ -72,6 +72,9 @@ class World {
   /// The teleoperation rig's state (slave, gripper, ball, sheet, last step), or null when the
   /// world has none. Only the thread that steps may read it while the world runs.
   [[nodiscard]] const RigState* rig() const { return state_.rig.get(); }
+  /// The glove hand's pose and finger angles from the last usable input (a world with a hand;
+  /// the tools sit at its fingertips). Only the thread that steps may read it while it runs.
+  [[nodiscard]] const GloveReading& hand_reading() const { return state_.hand; }
   [[nodiscard]] std::size_t segment_count(std::size_t body) const;
   /// Where a body is now (a dynamic body moves; the others stay at their description's pose).
   /// Only the thread that steps may read it while the world runs.

@@ -371,6 +371,9 @@ struct WorldState {
   bool input_usable = false;
   /// The proxies have been placed at a first position (reset() clears it).
   bool tools_placed = false;
+  /// Place stage: the glove hand's tracker pose and finger angles from the last usable input
+  /// (a world with a hand; what a display draws the hand from).
+  GloveReading hand;
 
   // Outputs of the step (respond and safety stages).
   std::vector<ToolState> tool_states;
