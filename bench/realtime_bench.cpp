@@ -22,7 +22,8 @@ namespace hapsim {
 namespace {
 
 struct Knee {
-  SceneDescription scene = load_scene(std::filesystem::path(HAPSIM_BENCH_SCENES_DIR) / "knee_procedural.json");
+  SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_BENCH_SCENES_DIR) / "knee_procedural.json");
   World world{scene.world};
   std::unique_ptr<SimulatedDevice> device = make_scene_device(scene, world);
 };

@@ -9,7 +9,8 @@ namespace {
 
 TEST(StepBench, MethodsRunTheSamePalpationBesideTheExactBaseline) {
   StepBenchOptions options;
-  options.cases.push_back({"knee", std::string(HAPSIM_SCENES_DIR) + "/knee_procedural.json", std::nullopt});
+  options.cases.push_back(
+      {"knee", std::string(HAPSIM_SCENES_DIR) + "/knee_procedural.json", std::nullopt});
   options.methods = {"spheretree", "exact"};  // exact is moved first
   options.duration_s = 3.0;                   // the first press (the medial ligament)
   int progress_calls = 0;
@@ -45,7 +46,8 @@ TEST(StepBench, MethodsRunTheSamePalpationBesideTheExactBaseline) {
 // exactly: its error is rounding only); the exact row has none.
 TEST(StepBench, ApproximateMethodsReportTheirErrorAgainstExact) {
   StepBenchOptions options;
-  options.cases.push_back({"knee", std::string(HAPSIM_SCENES_DIR) + "/knee_procedural.json", std::nullopt});
+  options.cases.push_back(
+      {"knee", std::string(HAPSIM_SCENES_DIR) + "/knee_procedural.json", std::nullopt});
   options.methods = {"exact", "spheretree", "knee"};
   options.duration_s = 0.2;
   const std::vector<StepRow> rows = run_step_bench(options);

@@ -76,10 +76,10 @@ TEST(TeleopRun, RecordingReplaysBitForBit) {
   EXPECT_TRUE(j.at("grasped").get<bool>());
   // A recording of the knee is not a recording of the teleop scene.
   const auto knee_rec = temp_path("knee.rec");
-  ASSERT_EQ(
-      run_hapsim("run " + kScenes + "/knee_procedural.json -q --duration 0.05 --record " + knee_rec.string())
-          .exit_code,
-      0);
+  ASSERT_EQ(run_hapsim("run " + kScenes + "/knee_procedural.json -q --duration 0.05 --record " +
+                       knee_rec.string())
+                .exit_code,
+            0);
   const RunResult wrong =
       run_hapsim("run " + kScenes + "/teleop.json -q --replay " + knee_rec.string());
   EXPECT_EQ(wrong.exit_code, 2) << wrong.output;

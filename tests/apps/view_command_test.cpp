@@ -88,10 +88,10 @@ TEST(ViewCommand, PrintsTheScenesWarningsOnceAndListsThemInItsJson) {
                                     "t,x,y,z,qw,qx,qy,qz\n0,0,0,100,1,0,0,0\n1,0,0,100,1,0,0,0\n");
   const auto json = test::temp_path("view_warnings.json");
   const auto log = test::temp_path("view_warnings.log");
-  const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' ") + HAPSIM_BIN_PATH +
-                          " view " + HAPSIM_SCENES_DIR + "/knee_procedural.json --device sim:" + far.string() +
-                          " --duration 2 --size 640x480 --json " + json.string() + " > " +
-                          log.string() + " 2>&1";
+  const std::string cmd =
+      std::string("xvfb-run -a -s '-screen 0 1280x720x24' ") + HAPSIM_BIN_PATH + " view " +
+      HAPSIM_SCENES_DIR + "/knee_procedural.json --device sim:" + far.string() +
+      " --duration 2 --size 640x480 --json " + json.string() + " > " + log.string() + " 2>&1";
   const int status = std::system(cmd.c_str());
   std::ifstream log_in(log);
   const std::string output((std::istreambuf_iterator<char>(log_in)), {});

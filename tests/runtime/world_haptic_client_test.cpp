@@ -406,9 +406,10 @@ TEST(Session, RealtimeRecordingReplaysBitForBitOffline) {
   std::filesystem::remove(again);
 }
 
-// `hapsim run scenes/knee_procedural.json --realtime --record F` then `--replay F`: the shipped scene with its
-// palpation script on the real-time loop, stalled once while the fingertip presses, replays bit for
-// bit the way the command replays it (make_run_setup with the recording, an inline run).
+// `hapsim run scenes/knee_procedural.json --realtime --record F` then `--replay F`: the shipped
+// scene with its palpation script on the real-time loop, stalled once while the fingertip presses,
+// replays bit for bit the way the command replays it (make_run_setup with the recording, an inline
+// run).
 TEST(Session, RealtimeKneeRecordingReplaysBitForBitAfterAStall) {
   const SceneDescription scene =
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_procedural.json");

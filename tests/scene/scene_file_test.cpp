@@ -629,7 +629,8 @@ TEST_F(SceneFileTest, GloveScenesNameTheirMistakes) {
 }
 
 TEST(ShippedScenes, KneeLoadsElevenSegmentsWithTissueMaterials) {
-  const SceneDescription s = load_scene(fs::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_procedural.json");
+  const SceneDescription s =
+      load_scene(fs::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_procedural.json");
   ASSERT_EQ(s.world.bodies.size(), 1u);
   const BodyDescription& knee = s.world.bodies[0];
   EXPECT_EQ(knee.kind, BodyKind::kDeformable);
