@@ -160,7 +160,9 @@ TEST(HostileInput, DevZeroAsTrajectoryIsRefusedAtOnce) {
 }
 
 TEST(HostileInput, WritingToAFullDiskFails) {
-  const std::string gp7 = std::string(HAPSIM_TEST_DATA_DIR) + "/motoman_gp7/gp7.urdf";
+  // The GP7's URDF as the fuzz corpus ships it (BSD-3-Clause, attributed in the file): a real
+  // chain that needs no ../shared.
+  const std::string gp7 = std::string(HAPSIM_SOURCE_DIR) + "/fuzz/corpus/urdf/gp7.urdf";
   const fs::path joints = write("gp7_joints.csv", "0,0,0,0,0,0\n");
   if (fs::exists("/dev/full")) {
     expect_one_line_error(run_limited("info builtin:box --json /dev/full"), {"/dev/full"});
