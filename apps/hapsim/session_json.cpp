@@ -15,6 +15,9 @@ nlohmann::json realtime_json(const RealtimeSummary& rt) {
           {"stall_events", rt.stall_events},
           {"ramp_cycles", rt.ramp_cycles},
           {"failed_steps", rt.failed_steps},
+          {"resume_gaps", rt.resume_gaps},
+          {"memory_locked", rt.memory_locked},
+          {"haptic_page_faults", rt.haptic_page_faults},
           {"dropped_records", rt.dropped_records}};
 }
 

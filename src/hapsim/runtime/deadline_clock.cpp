@@ -2,6 +2,9 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <sys/mman.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
@@ -39,6 +42,34 @@ bool try_set_realtime_priority(int priority) noexcept {
   param.sched_priority =
       std::clamp(priority, sched_get_priority_min(SCHED_FIFO), sched_get_priority_max(SCHED_FIFO));
   return pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
+}
+
+bool try_lock_process_memory() noexcept {
+  rlimit limit{};
+  const bool unlimited = getrlimit(RLIMIT_MEMLOCK, &limit) == 0 && limit.rlim_cur == RLIM_INFINITY;
+  if (geteuid() != 0 && !unlimited) {
+    return false;
+  }
+  return mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+}
+
+void prefault_stack(std::size_t bytes) noexcept {
+  constexpr std::size_t kMax = 512 * 1024;
+  volatile unsigned char stack[kMax];
+  const std::size_t n = std::min(bytes, kMax);
+  for (std::size_t i = 0; i < n; i += 4096) {
+    stack[i] = 0;
+  }
+  // Read one back: the writes are not dead stores the compiler may drop.
+  (void)stack[n > 0 ? n - 1 : 0];
+}
+
+long thread_page_faults() noexcept {
+  rusage usage{};
+  if (getrusage(RUSAGE_THREAD, &usage) != 0) {
+    return -1;
+  }
+  return usage.ru_minflt + usage.ru_majflt;
 }
 
 DeadlineClock::DeadlineClock(std::int64_t period_ns, std::int64_t spin_ns) noexcept

@@ -2,6 +2,7 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/core/triple_buffer.h"
+#include "hapsim/device/resume_ceiling.h"
 #include "hapsim/runtime/deadline_clock.h"
 
 #include <spdlog/spdlog.h>
@@ -39,12 +40,16 @@ struct HapticLoop::Shared {
   std::atomic<double> supervisor_gain{1.0};
   std::atomic<bool> device_healthy{true};
   std::atomic<bool> realtime_priority{false};
+  std::atomic<bool> memory_locked{false};
+  std::atomic<long> haptic_page_faults{-1};
   std::atomic<std::uint64_t> cycles{0};
   std::atomic<std::uint64_t> missed{0};
   std::atomic<std::uint64_t> stall_events{0};
   std::atomic<std::uint64_t> ramp_cycles{0};
   std::atomic<std::uint64_t> health_losses{0};
   std::atomic<std::uint64_t> failed_steps{0};
+  std::atomic<std::uint64_t> resume_gaps{0};  // haptic thread: gaps its ceiling cut for
+  std::atomic<std::int64_t> last_gap_ns{0};   // the latest such gap (stored before the count)
   std::atomic<double> last_output_force_n{0.0};
 };
 
@@ -97,6 +102,9 @@ void HapticLoop::start() {
     throw Error("haptic loop", "already started (a loop runs once)");
   }
   started_ = true;
+  if (options_.realtime_priority && options_.lock_memory) {
+    shared_->memory_locked.store(try_lock_process_memory());
+  }
   stop_requested_.store(false);
   shared_->start_ns.store(monotonic_ns());
   shared_->heartbeat_ns.store(shared_->start_ns.load());
@@ -146,14 +154,18 @@ void HapticLoop::haptic_thread_main() noexcept {
   const bool realtime =
       options_.realtime_priority && try_set_realtime_priority(options_.fifo_priority);
   s.realtime_priority.store(realtime);
+  if (options_.realtime_priority && options_.lock_memory) {
+    prefault_stack(256 * 1024);
+  }
+  long faults_after_first_cycle = -1;
   const auto period_ns = static_cast<std::int64_t>(std::llround(options_.period_s * 1e9));
   DeadlineClock clock(
       period_ns, realtime ? static_cast<std::int64_t>(std::llround(options_.spin_s * 1e9)) : 0);
   const double nominal_us = options_.period_s * 1e6;
   const double missed_us = options_.missed_period_s * 1e6;
-  const double resume_per_cycle =
-      options_.ramp.ramp_duration_s > 0.0 ? options_.period_s / options_.ramp.ramp_duration_s : 1.0;
-  double resume_limit = 1.0;  // ceiling on the output while force comes back after a ramp
+  // The haptic thread's own ceiling while force comes back: it also measures the gap since its
+  // previous write itself, so a whole-process freeze is ramped whichever thread resumes first.
+  ResumeCeiling resume(options_.period_s, options_.ramp);
   bool was_healthy = true;
   std::int64_t previous_wake_ns = 0;
   const std::int64_t start_ns = s.start_ns.load();
@@ -163,6 +175,9 @@ void HapticLoop::haptic_thread_main() noexcept {
                             (options_.max_cycles == 0 || i < options_.max_cycles);
        ++i) {
     const std::int64_t wake_ns = clock.wait_next();
+    if (i == 1) {
+      faults_after_first_cycle = thread_page_faults();
+    }
     double period_us = 0.0;
     if (i > 0) {
       period_us = 1e-3 * static_cast<double>(wake_ns - previous_wake_ns);
@@ -186,19 +201,7 @@ void HapticLoop::haptic_thread_main() noexcept {
     }
     const double now_s = 1e-9 * static_cast<double>(c0 - start_ns);
     DeviceCommand out = s.watchdog.update(now_s, fresh, healthy);
-    if (client_.take_soft_start()) {
-      resume_limit = 0.0;
-    }
-    // Force comes back gradually after any ramp (the supervisor's or the watchdog's own).
-    resume_limit = std::min(1.0, resume_limit + resume_per_cycle);
-    resume_limit = std::min(resume_limit, s.supervisor_gain.exchange(1.0));
-    if (s.watchdog.ramping()) {
-      resume_limit = std::min(resume_limit, s.watchdog.output_gain());
-      bump(s.ramp_cycles);
-    } else if (resume_limit < 1.0) {
-      out = scaled_command(out, resume_limit);
-      bump(s.ramp_cycles);
-    }
+    const bool soft_start = client_.take_soft_start();
     if (healthy != was_healthy) {
       if (!healthy) {
         bump(s.health_losses);
@@ -206,7 +209,29 @@ void HapticLoop::haptic_thread_main() noexcept {
       s.device_healthy.store(healthy, std::memory_order_relaxed);
       was_healthy = healthy;
     }
-    s.heartbeat_ns.store(monotonic_ns(), std::memory_order_release);
+    // The ceiling is taken as late as possible before the write, so that a freeze anywhere in the
+    // cycle (the sleep, the read, the step) shows as a gap since the previous write.
+    const std::int64_t write_ns = monotonic_ns();
+    const double ceiling = resume.update(1e-9 * static_cast<double>(write_ns - start_ns),
+                                         s.supervisor_gain.exchange(1.0), soft_start);
+    if (resume.gap_cut()) {
+      s.last_gap_ns.store(std::llround(resume.last_gap_s() * 1e9), std::memory_order_relaxed);
+      s.resume_gaps.store(resume.gaps(), std::memory_order_release);
+    }
+    if (s.watchdog.ramping()) {
+      // Already the last good command scaled by the watchdog's gain: at most the ceiling, and
+      // force comes back from the lower of the two.
+      const double watchdog_gain = s.watchdog.output_gain();
+      if (ceiling < watchdog_gain) {
+        out = scaled_command(out, ceiling / watchdog_gain);
+      }
+      resume.lower_to(watchdog_gain);
+      bump(s.ramp_cycles);
+    } else if (ceiling < 1.0) {
+      out = scaled_command(out, ceiling);
+      bump(s.ramp_cycles);
+    }
+    s.heartbeat_ns.store(write_ns, std::memory_order_release);
     if (try_write(out)) {
       s.last_written.write_slot() = out;
       s.last_written.publish();
@@ -226,6 +251,10 @@ void HapticLoop::haptic_thread_main() noexcept {
     cycle.period_us = period_us;
     cycle.healthy = healthy;
     client_.after_cycle(cycle);
+  }
+  if (faults_after_first_cycle >= 0) {
+    const long faults = thread_page_faults();
+    s.haptic_page_faults.store(faults >= 0 ? faults - faults_after_first_cycle : -1);
   }
   // Leave the device pushing nothing before anyone can stop watching it (the caller may not
   // reach wait() for a while). The supervisor's ramp base becomes zero too.
@@ -255,6 +284,7 @@ void HapticLoop::supervisor_thread_main() noexcept {
   bool stalled = false;
   std::int64_t stall_start_ns = 0;
   bool healthy_seen = true;
+  std::uint64_t gaps_seen = 0;
   std::int64_t next_ns = monotonic_ns();
   while (running_.load(std::memory_order_acquire)) {
     next_ns += period_ns;
@@ -303,6 +333,22 @@ void HapticLoop::supervisor_thread_main() noexcept {
       } catch (...) {
       }
     }
+    const std::uint64_t gaps = s.resume_gaps.load(std::memory_order_acquire);
+    if (gaps != gaps_seen) {
+      gaps_seen = gaps;
+      // Only the gaps that cut the force to zero (a freeze): shorter ones are a busy machine's.
+      const double gap_s = 1e-9 * static_cast<double>(s.last_gap_ns.load());
+      if (gap_s >= options_.ramp.zero_by_s()) {
+        try {
+          spdlog::warn(
+              "haptic loop: {:.1f} ms since the haptic thread's previous write (the process was "
+              "frozen or not scheduled): its force restarted from zero and comes back over "
+              "{:.0f} ms",
+              gap_s * 1e3, options_.ramp.ramp_duration_s * 1e3);
+        } catch (...) {
+        }
+      }
+    }
     const bool healthy = s.device_healthy.load(std::memory_order_relaxed);
     if (healthy != healthy_seen) {
       healthy_seen = healthy;
@@ -325,6 +371,8 @@ HapticLoopStatus HapticLoop::status() const noexcept {
   HapticLoopStatus st;
   st.running = running();
   st.realtime_priority = s.realtime_priority.load();
+  st.memory_locked = s.memory_locked.load();
+  st.haptic_page_faults = s.haptic_page_faults.load();
   st.cycles = s.cycles.load(std::memory_order_acquire);
   const std::int64_t start = s.start_ns.load();
   const std::int64_t end = st.running || s.end_ns.load() == 0 ? monotonic_ns() : s.end_ns.load();
@@ -337,6 +385,7 @@ HapticLoopStatus HapticLoop::status() const noexcept {
   st.ramp_cycles = s.ramp_cycles.load();
   st.device_health_losses = s.health_losses.load();
   st.failed_steps = s.failed_steps.load();
+  st.resume_gaps = s.resume_gaps.load();
   st.last_output_force_n = s.last_output_force_n.load();
   if (!st.running) {
     // The watchdog is the haptic thread's; read it only when that thread is done.

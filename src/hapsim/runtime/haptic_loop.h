@@ -1,20 +1,25 @@
-// The real-time haptic loop (architecture.md#real-time, issue 5): a thread that runs one haptic cycle every period
-// (1 ms) on an absolute-deadline clock — read the device, step the simulation, make the command
-// safe, write the device, publish — plus a supervisor thread that takes over the device output
-// when a cycle stalls.
+// The real-time haptic loop (architecture.md#real-time, issue 5): a thread that runs one haptic
+// cycle every period (1 ms) on an absolute-deadline clock — read the device, step the simulation,
+// make the command safe, write the device, publish — plus a supervisor thread that takes over the
+// device output when a cycle stalls.
 //
 // The haptic path allocates nothing, takes no lock and does no I/O: the simulation is a
 // HapticClient whose step() is allocation-free (World::step), metrics go to fixed histograms
 // and atomics, and the client publishes its snapshots through lock-free buffers
 // (triple_buffer.h, spsc_ring.h) in after_cycle().
 //
-// Safety (architecture.md#force-and-safety): every command goes through ForceWatchdog (clamped to the device profile, NaN
+// Safety (architecture.md#force-and-safety): every command goes through ForceWatchdog (clamped to
+// the device profile, NaN
 // -> zero, ramp to zero when the device reports itself unhealthy). When no cycle completes for
 // ramp.stale_timeout_s (the step overran, stalled, or the device read hung) the supervisor ramps
 // the last good command to zero so that the output is zero by ramp.zero_by_s() (10 ms by
 // default) after the last good cycle, and logs the event. When cycles resume, the force comes
-// back over ramp.ramp_duration_s instead of jumping (no kick in the user's hand). When the loop
-// ends (max_cycles or stop()), the haptic thread's last write is a zero command.
+// back over ramp.ramp_duration_s instead of jumping (no kick in the user's hand). The haptic
+// thread does not rely on the supervisor for that: right before each write it measures the time
+// since its own previous write (ResumeCeiling), and a gap beyond the grace cuts its force to what
+// the supervisor's ramp would have left by then, so a whole-process freeze (SIGSTOP, a VM pause),
+// after which either thread may run first, restarts the force from zero too. When the loop ends
+// (max_cycles or stop()), the haptic thread's last write is a zero command.
 #pragma once
 
 #include "hapsim/device/device.h"
@@ -40,6 +45,10 @@ struct HapticLoopOptions {
   double spin_s = 200e-6;
   /// A period longer than this counts as a missed deadline.
   double missed_period_s = 0.002;
+  /// With realtime_priority: lock the process's memory where that is safe
+  /// (try_lock_process_memory) and pre-fault the haptic thread's stack, so no cycle waits for a
+  /// page fault.
+  bool lock_memory = true;
   ForceRampParams ramp;
   /// How often the supervisor looks at the haptic thread's heartbeat.
   double supervisor_period_s = 0.001;
@@ -89,6 +98,11 @@ class HapticClient {
 struct HapticLoopStatus {
   bool running = false;
   bool realtime_priority = false;
+  /// The process's memory was locked (HapticLoopOptions::lock_memory).
+  bool memory_locked = false;
+  /// Page faults the haptic thread took after its first cycle (-1: unknown; counted when the
+  /// loop ends): each one a cycle that waited for the kernel.
+  long haptic_page_faults = -1;
   std::uint64_t cycles = 0;
   double elapsed_s = 0.0;
   /// cycles / elapsed wall time.
@@ -107,6 +121,10 @@ struct HapticLoopStatus {
   std::uint64_t device_health_losses = 0;
   /// Steps that threw (each yields zero fresh force).
   std::uint64_t failed_steps = 0;
+  /// Cycles that found more than the grace (ramp.stale_timeout_s) since the haptic thread's own
+  /// previous write and cut their force for it (a whole-process freeze, a long preemption):
+  /// counted whether or not the supervisor saw the gap too.
+  std::uint64_t resume_gaps = 0;
   std::uint64_t clamped_cycles = 0;
   std::uint64_t nonfinite_commands = 0;
   double last_output_force_n = 0.0;

@@ -427,6 +427,9 @@ RealtimeSummary realtime_summary(const HapticLoopStatus& status, std::size_t dro
   rt.stall_events = status.stall_events;
   rt.ramp_cycles = status.ramp_cycles;
   rt.failed_steps = status.failed_steps;
+  rt.resume_gaps = status.resume_gaps;
+  rt.memory_locked = status.memory_locked;
+  rt.haptic_page_faults = status.haptic_page_faults;
   rt.dropped_records = dropped_records;
   return rt;
 }
@@ -435,10 +438,10 @@ std::string format_realtime_summary(const RealtimeSummary& rt) {
   char line[320];
   std::snprintf(line, sizeof line,
                 "real time: %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f us; "
-                "missed deadlines (period > 2x): %zu; stalls ramped: %zu\n",
+                "missed deadlines (period > 2x): %zu; stalls ramped: %zu; gaps ramped: %zu\n",
                 rt.rate_hz, rt.realtime_priority ? "SCHED_FIFO" : "normal scheduling",
                 rt.period_jitter_us.p50, rt.period_jitter_us.p99, rt.period_jitter_us.max,
-                rt.missed_deadlines, rt.stall_events);
+                rt.missed_deadlines, rt.stall_events, rt.resume_gaps);
   std::string text = line;
   if (rt.dropped_records > 0 || rt.failed_steps > 0) {
     text += "real time: " + std::to_string(rt.dropped_records) +

@@ -102,6 +102,12 @@ struct RealtimeSummary {
   std::size_t stall_events = 0;
   std::size_t ramp_cycles = 0;
   std::size_t failed_steps = 0;
+  /// Writes the haptic thread cut itself for a gap since its previous write beyond the grace
+  /// (HapticLoopStatus::resume_gaps: a freeze of the whole process, a long preemption).
+  std::size_t resume_gaps = 0;
+  /// HapticLoopStatus::memory_locked and haptic_page_faults.
+  bool memory_locked = false;
+  long haptic_page_faults = -1;
   /// Cycle records the bookkeeping could not keep up with (not accounted, not recorded).
   std::size_t dropped_records = 0;
 };
