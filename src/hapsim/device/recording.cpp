@@ -290,9 +290,11 @@ SessionRecorder::SessionRecorder(std::filesystem::path path, std::string scene_h
   put(header, fnv1a(header.data(), header.size()));
   out_.write(reinterpret_cast<const char*>(header.data()),
              static_cast<std::streamsize>(header.size()));
+  out_.flush();
   if (!out_) {
     throw Error(where, "cannot write recording header");
   }
+  header_bytes_ = header.size();
   buffer_.reserve(capacity_frames_);
   bytes_.resize(recorded_frame_size_bytes());
 }
@@ -337,11 +339,31 @@ void SessionRecorder::write_buffer() {
   }
   out_.flush();
   if (!out_) {
-    throw Error(path_.string(),
-                "write failed after frame " + std::to_string(frames_written_) + " (disk full?)");
+    keep_complete_frames();
+    throw Error(path_.string(), "write failed (disk full?): the recording keeps its first " +
+                                    std::to_string(frames_written_) +
+                                    " frame(s), readable and replayable; later ones are lost");
   }
   frames_written_ += buffer_.size();
   buffer_.clear();  // keeps the capacity
+}
+
+void SessionRecorder::keep_complete_frames() noexcept {
+  // A full disk takes what fits: whole frames and maybe part of one. Cut the part (its checksum
+  // would make the reader refuse the file) so every frame recorded up to the fault stays usable.
+  closed_ = true;
+  out_.close();
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(path_, ec);
+  const std::size_t frame_bytes = bytes_.size();
+  std::size_t frames = 0;
+  if (!ec && size >= header_bytes_ && frame_bytes > 0) {
+    frames = std::min<std::size_t>(static_cast<std::size_t>((size - header_bytes_) / frame_bytes),
+                                   frames_written_ + buffer_.size());
+  }
+  std::filesystem::resize_file(path_, header_bytes_ + frames * frame_bytes, ec);
+  frames_written_ = ec ? std::min(frames, frames_written_) : frames;
+  buffer_.clear();
 }
 
 void SessionRecorder::flush() {

@@ -88,7 +88,8 @@ class SessionRecorder {
   bool record(const RecordedFrame& frame) noexcept;
 
   /// Not on the haptic path: writes the buffered frames. Throws hapsim::Error on a write error
-  /// (also one remembered from an inline flush).
+  /// (also one remembered from an inline flush); the file then keeps the header and every whole
+  /// frame that reached the disk (a partial one is cut off), and the recorder is closed.
   void flush();
   /// Flushes and closes the file; further record() calls drop.
   void close();
@@ -102,12 +103,16 @@ class SessionRecorder {
 
  private:
   void write_buffer();
+  /// After a failed write: closes the file, cut back to the header and the whole frames on disk
+  /// (frames_written() says how many), and drops the rest of the buffer.
+  void keep_complete_frames() noexcept;
 
   std::filesystem::path path_;
   std::ofstream out_;
   std::vector<RecordedFrame> buffer_;
   std::vector<unsigned char> bytes_;  // one encoded frame, reused
   std::size_t capacity_frames_ = 0;
+  std::size_t header_bytes_ = 0;
   Overflow overflow_ = Overflow::kDrop;
   std::size_t frames_written_ = 0;
   std::size_t frames_dropped_ = 0;
