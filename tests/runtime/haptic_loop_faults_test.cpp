@@ -371,9 +371,11 @@ TEST_P(StalledStep, ForceFallsThenComesBackOverTheRamp) {
   }
   const HapticLoopStatus st = loop.status();
   EXPECT_GE(st.resume_gaps, 1u);  // the haptic thread's own measure of every stall past the grace
-  // A stall well past the ramp's end (5x and 50x): the supervisor got the force to exactly zero
-  // while the step slept.
-  if (stall >= 5 * std::chrono::duration<double>(options.ramp.zero_by_s())) {
+  // A stall well past the ramp's end: the supervisor got the force to exactly zero while the step
+  // slept. With real-time priority its wake-ups are reliable at 5x the bound (50 ms); without it
+  // (an ordinary user's ctest on a busy machine) only the 500 ms stall is asserted.
+  const double margin = st.realtime_priority ? 5.0 : 50.0;
+  if (stall >= margin * std::chrono::duration<double>(options.ramp.zero_by_s())) {
     bool zero = false;
     for (const auto& write : w) {
       zero = zero || (!write.haptic && write.t_ns > fault.begin_ns && write.t_ns < fault.end_ns &&

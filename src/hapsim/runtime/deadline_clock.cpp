@@ -44,13 +44,33 @@ bool try_set_realtime_priority(int priority) noexcept {
   return pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
 }
 
+// Sanitizers reserve terabytes of shadow memory: never lock those processes.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
+    __has_feature(memory_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
 bool try_lock_process_memory() noexcept {
+  if (kSanitized) {
+    return false;
+  }
   rlimit limit{};
   const bool unlimited = getrlimit(RLIMIT_MEMLOCK, &limit) == 0 && limit.rlim_cur == RLIM_INFINITY;
   if (geteuid() != 0 && !unlimited) {
     return false;
   }
-  return mlockall(MCL_CURRENT | MCL_FUTURE) == 0;
+  // MCL_ONFAULT: pages are locked as they are touched, so large reservations nobody touches
+  // (allocator arenas, thread stacks) cost nothing; what the loop uses is touched before its
+  // first cycle, and its stack by prefault_stack().
+  return mlockall(MCL_CURRENT | MCL_FUTURE | MCL_ONFAULT) == 0;
 }
 
 void prefault_stack(std::size_t bytes) noexcept {

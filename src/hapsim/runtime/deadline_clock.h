@@ -23,10 +23,11 @@ void sleep_until_ns(std::int64_t deadline_ns) noexcept;
 /// when not permitted (EPERM for non-root, containers without CAP_SYS_NICE) or unsupported.
 [[nodiscard]] bool try_set_realtime_priority(int priority) noexcept;
 
-/// Locks the process's pages in RAM, present and future (mlockall), so no cycle waits for a page
-/// to be read back or first touched; only where it cannot make a later allocation fail: as root
-/// or with an unlimited RLIMIT_MEMLOCK (a small limit would turn a big allocation into bad_alloc).
-/// Returns true if locked. Call before the real-time threads start.
+/// Locks the process's pages in RAM as they are touched, present and future (mlockall with
+/// MCL_ONFAULT), so no cycle waits for a page to be read back from swap; only where it cannot make
+/// a later allocation fail (as root or with an unlimited RLIMIT_MEMLOCK: a small limit would turn a
+/// big allocation into bad_alloc) and never under a sanitizer. Returns true if locked. Call before
+/// the real-time threads start.
 [[nodiscard]] bool try_lock_process_memory() noexcept;
 
 /// Touches `bytes` of the calling thread's stack below this frame, so the cycle's deeper calls
