@@ -20,7 +20,8 @@ export CMAKE_C_COMPILER_LAUNCHER="${CMAKE_C_COMPILER_LAUNCHER:-ccache}"
 if ! command -v ccache >/dev/null; then
   unset CMAKE_CXX_COMPILER_LAUNCHER CMAKE_C_COMPILER_LAUNCHER
 fi
-nice_level="${HAPSIM_SANITIZER_NICE:-10}"
+# Idle CPU only by default: a developer's other work (and other people's builds) come first.
+nice_level="${HAPSIM_SANITIZER_NICE:-19}"
 
 parts=("$@")
 if [[ ${#parts[@]} -eq 0 || "${parts[0]}" == all ]]; then
