@@ -73,6 +73,7 @@ SoakResult run_soak(const SoakOptions& options) {
   result.scene = options.scene.filename().string();
   result.script_s = setup.duration_s;
   std::vector<Channels> first(script_steps);
+  std::vector<Channels> second(script_steps);
   std::vector<double> step_us;
   step_us.reserve(minute_steps);
   double rep_drift = 0.0;
@@ -104,9 +105,17 @@ SoakResult run_soak(const SoakOptions& options) {
         result.peak_force_n = std::max(result.peak_force_n, step.command.finger_force_n[f]);
       }
     } else {
+      if (rep == 1) {
+        second[in_script] = c;
+      }
       for (std::size_t i = 0; i < kChannels; ++i) {
         const double d = std::abs(c[i] - first[in_script][i]);
         rep_drift = std::max(rep_drift, std::isfinite(d) ? d : HUGE_VAL);
+        if (rep >= 2) {
+          const double d2 = std::abs(c[i] - second[in_script][i]);
+          result.max_drift_from_second_n =
+              std::max(result.max_drift_from_second_n, std::isfinite(d2) ? d2 : HUGE_VAL);
+        }
       }
       result.max_force_drift_n = std::max(result.max_force_drift_n, rep_drift);
     }
@@ -161,8 +170,9 @@ std::string format_soak(const SoakResult& r) {
   }
   std::snprintf(line, sizeof line,
                 "  force drift against the first repetition: max %.3g N over all, %.3g N in the "
-                "last (peak force %.2f N)\n",
-                r.max_force_drift_n, r.last_force_drift_n, r.peak_force_n);
+                "last (peak force %.2f N); against the second: max %.3g N\n",
+                r.max_force_drift_n, r.last_force_drift_n, r.peak_force_n,
+                r.max_drift_from_second_n);
   out << line;
   return out.str();
 }
@@ -183,6 +193,7 @@ nlohmann::json soak_to_json(const SoakResult& r) {
           {"wall_s", r.wall_s},
           {"max_force_drift_n", r.max_force_drift_n},
           {"last_force_drift_n", r.last_force_drift_n},
+          {"max_drift_from_second_n", r.max_drift_from_second_n},
           {"peak_force_n", r.peak_force_n},
           {"minutes", minutes}};
 }

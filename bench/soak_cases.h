@@ -47,6 +47,11 @@ struct SoakResult {
   /// repetition, and in the last one.
   double max_force_drift_n = 0.0;
   double last_force_drift_n = 0.0;
+  /// The same against the second repetition, over the third on: the first starts from a fresh
+  /// world, the others from where the script left it (a script that ends elsewhere than it starts
+  /// jumps back in one step), so a difference between the first two that never grows is the start,
+  /// and drift is what grows after.
+  double max_drift_from_second_n = 0.0;
   /// The first repetition's largest force (the scale the drift compares with).
   double peak_force_n = 0.0;
 };

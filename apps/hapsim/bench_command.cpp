@@ -7,6 +7,7 @@
 #ifdef HAPSIM_WITH_BENCH
 
 #include "commands.h"
+#include "json_output.h"
 #include "network_dds_bench.h"
 #include "progress_printer.h"
 
@@ -205,13 +206,7 @@ struct PassivityArgs {
 };
 
 void run_passivity(const PassivityArgs& args) {
-  std::unique_ptr<std::ofstream> json_out;
-  if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
-  }
+  JsonOutput json_out(args.json_path);
   bench::PassivityOptions options;
   options.profiles = args.profiles;
   options.surfaces = args.surfaces;
@@ -242,11 +237,8 @@ void run_passivity(const PassivityArgs& args) {
   std::snprintf(setup, sizeof setup, "%zu runs in %.1f s\n", result.rows.size(), watch.elapsed_s());
   std::cout << setup;
   if (json_out) {
-    *json_out << bench::passivity_to_json(result).dump(2) << '\n';
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": write failed");
-    }
-    std::cout << "wrote " << args.json_path << '\n';
+    std::cout << std::flush;
+    json_out.write(bench::passivity_to_json(result));
   }
 }
 
@@ -257,13 +249,7 @@ struct SoakArgs {
 };
 
 void run_soak(const SoakArgs& args) {
-  std::unique_ptr<std::ofstream> json_out;
-  if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
-  }
+  JsonOutput json_out(args.json_path);
   std::vector<std::string> scenes = args.scenes;
   if (scenes.empty()) {
     scenes = {(bench::default_scenes_dir() / "knee.json").string(),
@@ -285,11 +271,7 @@ void run_soak(const SoakArgs& args) {
     rows.push_back(bench::soak_to_json(result));
   }
   if (json_out) {
-    *json_out << rows.dump(2) << '\n';
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": write failed");
-    }
-    std::cout << "wrote " << args.json_path << '\n';
+    json_out.write(rows);
   }
 }
 
