@@ -32,8 +32,8 @@ cmake --build build/fuzz -j2 --target "${targets[@]/#/hapsim_fuzz_}" || exit 2
 # mesh is parsed in a child process with its own 30 s limit, below libFuzzer's).
 declare -A max_len=([scene]=8192 [scene_step]=8192 [mesh]=4096 [recording]=16384 [urdf]=8192)
 declare -A timeout=([scene]=60 [scene_step]=60 [mesh]=60 [urdf]=20)
-# Leaks inside a library we cannot fix, each with its reason (fuzz/lsan.supp).
-export LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+# Leaks inside a library we cannot fix, each with its reason (config/sanitizers/lsan.supp).
+export LSAN_OPTIONS="suppressions=$PWD/config/sanitizers/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 status=0
 for t in "${targets[@]}"; do
   found="build/fuzz/found/$t"

@@ -7,14 +7,18 @@
 #ifdef HAPSIM_WITH_BENCH
 
 #include "commands.h"
+#include "json_output.h"
 #include "network_dds_bench.h"
 #include "progress_printer.h"
 
 #include "bench/collision_cases.h"
+#include "bench/passivity_cases.h"
+#include "bench/soak_cases.h"
 #include "bench/step_cases.h"
 #include "hapsim/core/data_dir.h"
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/net/link_sweep.h"
+#include "hapsim/scene/scene_file.h"
 
 #include <unistd.h>
 #include <nlohmann/json.hpp>
@@ -187,6 +191,87 @@ void run_step(const StepArgs& args) {
       throw CommandError("--json " + args.json_path + ": write failed");
     }
     std::cout << "wrote " << args.json_path << '\n';
+  }
+}
+
+struct PassivityArgs {
+  std::vector<std::string> profiles;
+  std::vector<std::string> surfaces;
+  double device_mass_kg = 0.1;
+  double hand_stiffness_n_per_m = 200.0;
+  double hand_damping_n_s_per_m = 2.0;
+  double hand_press_n = 1.0;
+  int bisection_steps = 8;
+  std::string json_path;
+};
+
+void run_passivity(const PassivityArgs& args) {
+  JsonOutput json_out(args.json_path);
+  bench::PassivityOptions options;
+  options.profiles = args.profiles;
+  options.surfaces = args.surfaces;
+  options.scenes_dir = bench::default_scenes_dir();
+  options.port.device_mass_kg = args.device_mass_kg;
+  options.port.hand_stiffness_n_per_m = args.hand_stiffness_n_per_m;
+  options.port.hand_damping_n_s_per_m = args.hand_damping_n_s_per_m;
+  options.port.hand_press_n = args.hand_press_n;
+  options.bisection_steps = args.bisection_steps;
+  ProgressPrinter printer;
+  options.progress = [&printer](std::string_view label, double fraction) {
+    printer(label, fraction);
+  };
+  const Stopwatch watch;
+  const bench::PassivityResult result = bench::run_passivity_sweep(options);
+  char setup[400];
+  std::snprintf(setup, sizeof setup,
+                "Port: device %.3g kg, hand %.0f N/m and %.2g N s/m pressing %.2g N, 10 s from "
+                "2 mm above; the world sampled at 1 kHz, its force held (ZOH), clamped to the "
+                "profile's force (and rate)\n",
+                args.device_mass_kg, args.hand_stiffness_n_per_m, args.hand_damping_n_s_per_m,
+                args.hand_press_n);
+  std::cout << setup
+            << "E = work the rendered force did on the device + F^2/2K (<= 0 when passive); late: "
+               "E's growth over the last 5 s; motion: peak to peak over the last second; stable: "
+               "late <= 0.1 mJ and motion <= 0.1 mm\n";
+  std::cout << bench::format_passivity_table(result);
+  std::snprintf(setup, sizeof setup, "%zu runs in %.1f s\n", result.rows.size(), watch.elapsed_s());
+  std::cout << setup;
+  if (json_out) {
+    std::cout << std::flush;
+    json_out.write(bench::passivity_to_json(result));
+  }
+}
+
+struct SoakArgs {
+  double minutes = 60.0;
+  std::vector<std::string> scenes;
+  std::string json_path;
+};
+
+void run_soak(const SoakArgs& args) {
+  JsonOutput json_out(args.json_path);
+  std::vector<std::string> scenes = args.scenes;
+  if (scenes.empty()) {
+    scenes = {(bench::default_scenes_dir() / "knee.json").string(),
+              (bench::default_scenes_dir() / "teleop.json").string()};
+  }
+  nlohmann::json rows = nlohmann::json::array();
+  for (const std::string& scene : scenes) {
+    bench::SoakOptions options;
+    options.scene = scene;
+    options.duration_s = args.minutes * 60.0;
+    // A rig's pick-and-place moves the ball: each repetition starts from the scene's start.
+    options.reset_between = load_scene(scene).is_teleop;
+    ProgressPrinter printer;
+    options.progress = [&printer](std::string_view label, double fraction) {
+      printer(label, fraction);
+    };
+    const bench::SoakResult result = bench::run_soak(options);
+    std::cout << bench::format_soak(result) << std::flush;
+    rows.push_back(bench::soak_to_json(result));
+  }
+  if (json_out) {
+    json_out.write(rows);
   }
 }
 
@@ -470,6 +555,56 @@ void add_bench_command(CLI::App& app) {
       ->check(positive_seconds());
   step->add_option("--json", step_args->json_path, "Write the rows as a JSON array to FILE");
   step->callback([step_args] { run_step(*step_args); });
+
+  auto passivity_args = std::make_shared<PassivityArgs>();
+  CLI::App* passivity = bench->add_subcommand(
+      "passivity",
+      "Energy generated at the device port: every device profile at 1.0x and 1.5x its rated "
+      "stiffness on a plane, a sphere, the sheet and the knee, held by a simulated device and "
+      "hand; the largest stable stiffness (Z-width) beside the rating");
+  passivity->add_option("--profiles", passivity_args->profiles, "Device profiles (default: all)")
+      ->delimiter(',');
+  passivity
+      ->add_option("--surfaces", passivity_args->surfaces,
+                   "plane, sphere, sheet, knee (default: all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"plane", "sphere", "sheet", "knee"}));
+  passivity
+      ->add_option("--device-mass", passivity_args->device_mass_kg,
+                   "The device's apparent mass at the handle, kg (default 0.1: no profile states "
+                   "one)")
+      ->check(CLI::Range(1e-3, 100.0));
+  passivity
+      ->add_option("--hand-stiffness", passivity_args->hand_stiffness_n_per_m,
+                   "The hand's spring, N/m (default 200)")
+      ->check(CLI::Range(1.0, 1e5));
+  passivity
+      ->add_option("--hand-damping", passivity_args->hand_damping_n_s_per_m,
+                   "The hand's damper, N s/m (default 2)")
+      ->check(CLI::Range(0.0, 1e3));
+  passivity
+      ->add_option("--hand-press", passivity_args->hand_press_n,
+                   "How hard the hand presses at rest, N (default 1)")
+      ->check(CLI::Range(0.01, 100.0));
+  passivity
+      ->add_option("--bisection-steps", passivity_args->bisection_steps,
+                   "Bisection steps for the Z-width (default 8; 0: none)")
+      ->check(CLI::Range(0, 30));
+  passivity->add_option("--json", passivity_args->json_path, "Write the rows as JSON to FILE");
+  passivity->callback([passivity_args] { run_passivity(*passivity_args); });
+
+  auto soak_args = std::make_shared<SoakArgs>();
+  CLI::App* soak = bench->add_subcommand(
+      "soak",
+      "An hour of simulated time, fast-forward, of the knee palpation and the teleoperation "
+      "script repeated: step cost and peak RSS per minute, force drift between repetitions");
+  soak->add_option("--minutes", soak_args->minutes, "Simulated minutes per scene (default 60)")
+      ->check(CLI::Range(0.1, 1440.0));
+  soak->add_option("--scenes", soak_args->scenes,
+                   "Scene files (default: scenes/knee.json and scenes/teleop.json)")
+      ->delimiter(',');
+  soak->add_option("--json", soak_args->json_path, "Write the results as JSON to FILE");
+  soak->callback([soak_args] { run_soak(*soak_args); });
 
   auto network_args = std::make_shared<NetworkArgs>();
   CLI::App* network = bench->add_subcommand(

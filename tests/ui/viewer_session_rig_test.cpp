@@ -58,6 +58,20 @@ void run_for(ViewerSession& session, double seconds) {
   }
 }
 
+// Updates the session (a frame every 16 ms) until its loop has stepped `sim_seconds` more of
+// simulated time: what the assertions after it need, however slow the machine (a sanitizer build
+// steps several times slower than real time). Gives up after 120 s of wall-clock time, and the
+// assertions that follow then say what was missing.
+void run_simulated(ViewerSession& session, double sim_seconds) {
+  session.update();
+  const double until_s = session.readout().time_s + sim_seconds;
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (session.readout().time_s < until_s && std::chrono::steady_clock::now() < give_up) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(16));
+    session.update();
+  }
+}
+
 std::array<double, 3> first_arm_rad(const TeleopSetup& setup) {
   const DeviceInput first = setup.trajectory.sample_at(setup.trajectory.start_time_s());
   return {first.joint_rad[0], first.joint_rad[1], first.joint_rad[2]};
@@ -69,7 +83,7 @@ TEST(TeleopViewerSession, ScriptedMasterRunsOnTheLoopAndFillsTheReadout) {
   EXPECT_EQ(session->mouse_device(), nullptr);
   EXPECT_GT(session->render_scene().mesh_count(), 0u);
   EXPECT_TRUE(session->bounds_world().volume() > 0.0);
-  run_for(*session, 1.5);
+  run_simulated(*session, 1.1);
   const SessionReadout& r = session->readout();
   EXPECT_GT(r.time_s, 1.0);
   ASSERT_NE(line(r, "ball (mm)"), nullptr);
@@ -119,7 +133,7 @@ TEST(TeleopViewerSession, MouseProbeIsTheSlaveToolsTargetAndTheSlaveFollowsIt) {
   EXPECT_LT((p0 - start_target).norm(), 1e-9);
 
   // At the start the slave is still, at its solved start pose.
-  run_for(*session, 0.2);
+  run_simulated(*session, 0.2);
   const Vec3 tool0 = tool(session->readout(), "slave tool")->p_world;
   EXPECT_LT((tool0 - start_target).norm(), 1e-3);
 
@@ -127,7 +141,7 @@ TEST(TeleopViewerSession, MouseProbeIsTheSlaveToolsTargetAndTheSlaveFollowsIt) {
   DeviceInput in;
   in.p_world = p0 + Vec3(0.0, 0.02, 0.0);
   mouse->set_input(in);
-  run_for(*session, 1.0);
+  run_simulated(*session, 1.0);
   const SessionReadout& r = session->readout();
 
   // Independent: the same conversion, then the master's and the slave's geometry.

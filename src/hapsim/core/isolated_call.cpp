@@ -49,13 +49,16 @@ bool write_all(int fd, const char* data, std::size_t size) {
   return true;
 }
 
-// Bytes of address space this process holds now (the child starts with a copy of it).
+#ifndef HAPSIM_SANITIZED
+// Bytes of address space this process holds now (the child starts with a copy of it). Not in a
+// sanitized build, which sets no address-space limit (its shadow memory reserves terabytes).
 std::size_t current_address_space() {
   std::ifstream statm("/proc/self/statm");
   std::size_t pages = 0;
   statm >> pages;
   return pages * static_cast<std::size_t>(::sysconf(_SC_PAGESIZE));
 }
+#endif
 
 [[noreturn]] void child_main(int fd, int said_fd, const IsolationLimits& limits,
                              const std::function<std::string()>& work) {
