@@ -23,7 +23,7 @@ METHODS = ("exact", "spheretree", "knee")
 
 
 def record(scene, seconds, path):
-    world = hapsim.World(str(scene))
+    world = hapsim.World(scene)
     world.record(str(path))
     for i in range(int(round(seconds / world.dt_s))):
         world.step(world.script_input(i * world.dt_s))
@@ -31,7 +31,7 @@ def record(scene, seconds, path):
 
 
 def replay_forces(scene, recording, method):
-    world = hapsim.World(str(scene), method=method)
+    world = hapsim.World(scene, method=method)
     forces = np.empty(len(recording))
     for i in range(len(recording)):
         world.step(recording.input(i))
@@ -43,15 +43,16 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scene", default=str(ROOT / "scenes" / "knee.json"))
     parser.add_argument("--out", default=str(ROOT / "docs" / "images"))
-    parser.add_argument("--quick", action="store_true", help="the first 3 s only (tests)")
+    parser.add_argument("--quick", action="store_true", help="the first 1.5 s only (tests)")
     args = parser.parse_args()
-    seconds = 3.0 if args.quick else hapsim.World(args.scene).duration_s
+    scene = hapsim.load_scene(args.scene)  # read once: every world below copies it
+    seconds = 1.5 if args.quick else hapsim.World(scene).duration_s
     with tempfile.TemporaryDirectory() as tmp:
         path = pathlib.Path(tmp) / "palpation.rec"
-        record(args.scene, seconds, path)
+        record(scene, seconds, path)
         recording = hapsim.read_recording(str(path))
     t = recording.time_s
-    forces = {m: replay_forces(args.scene, recording, m) for m in METHODS}
+    forces = {m: replay_forces(scene, recording, m) for m in METHODS}
 
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6), dpi=110, sharex=True,
                                       gridspec_kw={"height_ratios": [2, 1]})

@@ -2,7 +2,8 @@
 
 The hand's pressing pose is the one the scene's own script solved (its pose and finger angles
 when its press begins); the motion is Python's: the hand comes in from 80 mm away, presses in,
-then rocks the index and middle fingers against each other (flexion ±0.2 rad) and lets go. The
+then rocks the index and middle fingers against each other (MCP and PIP flexion
+±0.2 rad each) and lets go (back out to where it came from). The
 plot shows each finger's force on the glove's actuators and the two fingers' flexion.
 
     PYTHONPATH=build/release/python python3 examples/python/glove_palpation.py \
@@ -23,6 +24,14 @@ import hapsim  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 INDEX, MIDDLE = 1, 2
+# A glove's reading: joint_rad holds three angles per finger (abduction, MCP, PIP), thumb first.
+ANGLES_PER_FINGER = 3
+MCP, PIP = 1, 2
+
+
+def flexion_slots(finger):
+    """joint_rad indices of a finger's MCP and PIP flexion."""
+    return [finger * ANGLES_PER_FINGER + MCP, finger * ANGLES_PER_FINGER + PIP]
 
 
 def smooth(s):
@@ -35,18 +44,18 @@ def script(start, press, away_m, rock_rad, rock_cycles):
     """(total seconds, f(t) -> DeviceInput, phases) of the palpation, from the scene script's
     first input `start` and its pressing pose `press`."""
     p_press = press.p_world
-    fingers = press.finger_rad
+    angles = press.joint_rad
     # The scene's script comes in along the direction it pressed: from where the hand starts.
     start = start.p_world
     out = (start - p_press) / np.linalg.norm(start - p_press)
     p_far = p_press + out * away_m
     p_stand = p_press + out * 0.02
     phases = [("approach", 0.8), ("press", 0.6), ("hold", 0.3), ("rock", 0.6 * rock_cycles),
-              ("release", 0.6)]
+              ("release", 0.8)]
 
     def at(t):
         p = p_press.copy()
-        flex = fingers.copy()
+        flex = angles.copy()
         t0 = 0.0
         for name, duration in phases:
             s = (t - t0) / duration
@@ -57,13 +66,13 @@ def script(start, press, away_m, rock_rad, rock_cycles):
                     p = p_stand + (p_press - p_stand) * smooth(s)
                 elif name == "rock":
                     swing = rock_rad * math.sin(2.0 * math.pi * rock_cycles * s)
-                    flex[INDEX] += swing
-                    flex[MIDDLE] -= swing
+                    flex[flexion_slots(INDEX)] += swing
+                    flex[flexion_slots(MIDDLE)] -= swing
                 elif name == "release":
-                    p = p_press + (p_stand - p_press) * smooth(s)
+                    p = p_press + (p_far - p_press) * smooth(s)
                 break
             t0 += duration
-        return hapsim.DeviceInput(p_world=p, q_world=press.q_world, finger_rad=flex, time_s=t)
+        return hapsim.DeviceInput(p_world=p, q_world=press.q_world, joint_rad=flex, time_s=t)
 
     return sum(d for _, d in phases), at, phases
 
@@ -75,14 +84,15 @@ def main():
     parser.add_argument("--out", default=str(ROOT / "docs" / "images"))
     parser.add_argument("--quick", action="store_true", help="one rocking cycle (tests)")
     args = parser.parse_args()
-    world = hapsim.World(args.scene)
+    scene = hapsim.load_scene(args.scene)
+    world = hapsim.World(scene)
     # The scene's own script: where it starts and the pose it presses with (move 0.8 s, press
     # 0.6 s in knee_hand.json: the hold begins at 1.4 s).
     start = world.script_input(0.0)
     press = start
     for i in range(1, 1401):
         press = world.script_input(i * world.dt_s)
-    world = hapsim.World(args.scene)  # fresh, untouched by reading its script
+    world = hapsim.World(scene)  # fresh, untouched by reading its script
     total_s, at, phases = script(start, press, away_m=0.08, rock_rad=0.2,
                                  rock_cycles=1 if args.quick else 3)
     steps = int(round(total_s / world.dt_s))
@@ -94,7 +104,7 @@ def main():
         world.step(inp)
         f = world.finger_force_n
         finger_force[i, : len(f)] = f
-        flex[i] = inp.finger_rad[[INDEX, MIDDLE]]
+        flex[i] = inp.joint_rad[[flexion_slots(INDEX)[0], flexion_slots(MIDDLE)[0]]]
 
     names = ["thumb", "index", "middle", "ring", "little"]
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6), dpi=110, sharex=True,
@@ -105,9 +115,9 @@ def main():
     top.set_ylabel("finger actuator force (N)")
     top.set_title("Glove palpation scripted in Python on the knee (patella and patellar tendon)")
     top.grid(alpha=0.3)
-    top.legend(fontsize=8, loc="upper left")
-    bottom.plot(t, np.degrees(flex[:, 0]), lw=1.2, label="index flexion")
-    bottom.plot(t, np.degrees(flex[:, 1]), lw=1.2, label="middle flexion")
+    top.legend(fontsize=8, loc="center left")
+    bottom.plot(t, np.degrees(flex[:, 0]), lw=1.2, label="index MCP flexion")
+    bottom.plot(t, np.degrees(flex[:, 1]), lw=1.2, label="middle MCP flexion")
     bottom.set_ylabel("flexion (deg)")
     bottom.set_xlabel("time (s)")
     bottom.grid(alpha=0.3)

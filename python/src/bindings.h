@@ -4,10 +4,18 @@
 #pragma once
 
 #include "hapsim/core/error.h"
+#include "hapsim/scene/scene_description.h"
 
 #include <pybind11/pybind11.h>
 
+#include <memory>
+
 namespace hapsim::python {
+
+/// hapsim.Scene: a loaded scene file, shared by the worlds and runs built from it.
+struct Scene {
+  std::shared_ptr<const SceneDescription> description;
+};
 
 /// hapsim.Error (a ValueError) and hapsim.SceneError (an Error from loading a scene), each with
 /// `where`, `file`, `pointer` and `detail`; hapsim::Error is translated to hapsim.Error.

@@ -41,7 +41,8 @@ std::pair<std::string, std::string> split_where(const std::string& where) {
   return {where, ""};
 }
 
-[[noreturn]] void raise(PyObject* type, const Error& e) {
+// Sets the Python error `type` for `e`, with its parts as attributes.
+void set_error(PyObject* type, const Error& e) {
   const auto [file, pointer] = split_where(e.where());
   py::object error = py::reinterpret_borrow<py::object>(type)(e.what());
   error.attr("where") = e.where();
@@ -49,13 +50,12 @@ std::pair<std::string, std::string> split_where(const std::string& where) {
   error.attr("file") = file;
   error.attr("pointer") = pointer.empty() ? py::object(py::none()) : py::object(py::str(pointer));
   PyErr_SetObject(type, error.ptr());
-  throw py::error_already_set();
 }
 
-// A scene path or a Scene object, as a description to build from.
-struct Scene {
-  std::shared_ptr<const SceneDescription> description;
-};
+[[noreturn]] void raise(PyObject* type, const Error& e) {
+  set_error(type, e);
+  throw py::error_already_set();
+}
 
 SceneDescription load(const std::string& path, const std::optional<std::string>& data_dir) {
   SceneLoadOptions options;
@@ -182,11 +182,7 @@ void bind_errors(py::module_& m) {
         std::rethrow_exception(p);
       }
     } catch (const Error& e) {
-      try {
-        raise(g_error, e);
-      } catch (const py::error_already_set&) {
-        // raise() set the Python error; the translator's job is done.
-      }
+      set_error(g_error, e);
     }
   });
 }

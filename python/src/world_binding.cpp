@@ -96,18 +96,23 @@ std::unique_ptr<PyWorld> make_world(const py::object& scene,
       throw Error("method", "expected 'exact', 'spheretree' or 'knee', got '" + *method + "'");
     }
   }
-  // A Scene object comes back through the Python wrapper as its file (scenes are cheap to read
-  // again next to building a world).
-  const std::string path = py::str(py::hasattr(scene, "file") ? scene.attr("file") : scene);
+  auto w = std::make_unique<PyWorld>();
+  // A Scene object's description is copied (its meshes are not read again); a path is loaded.
+  std::optional<SceneDescription> loaded;
+  if (py::isinstance<Scene>(scene)) {
+    loaded = *scene.cast<const Scene&>().description;
+  }
+  const std::string path = loaded ? std::string() : std::string(py::str(scene));
   SceneLoadOptions load_options;
   if (data_dir) {
     load_options.data_dir = *data_dir;
   }
-  auto w = std::make_unique<PyWorld>();
   try {
     py::gil_scoped_release release;
-    w->setup =
-        make_run_setup(load_scene(path, load_options), DeviceChoice::scene_script(), options);
+    if (!loaded) {
+      loaded = load_scene(path, load_options);
+    }
+    w->setup = make_run_setup(std::move(*loaded), DeviceChoice::scene_script(), options);
   } catch (const Error& e) {
     raise_scene_error(e);
   }
