@@ -38,6 +38,9 @@ HAPSIM_PACKAGES=(
   # reference oracles for tests and benchmarks only (HAPSIM_REQUIRE_ORACLES: configure fails
   # without them rather than skipping their tests): CGAL, FCL, Embree 3, orocos-kdl
   libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev
+  # the Python module (python/): Python's headers and find_package(pybind11) build it; NumPy for
+  # its arrays; pytest runs its tests under ctest; matplotlib draws the examples' plots
+  python3-dev python3-numpy pybind11-dev python3-pytest python3-matplotlib
 )
 
 hapsim_install_packages() {

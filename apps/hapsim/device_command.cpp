@@ -7,13 +7,13 @@
 #include "commands.h"
 #include "dds_options.h"
 #include "json_output.h"
-#include "session_json.h"
 #include "stop_signal.h"
 
 #include "hapsim/core/error.h"
 #include "hapsim/device/plugin_device.h"
 #include "hapsim/net/legacy_force_udp.h"
 #include "hapsim/net/link_shim_spec.h"
+#include "hapsim/runtime/session_json.h"
 #if defined(HAPSIM_WITH_SPNAV)
 #include "hapsim/device/spacenav_device.h"
 #endif

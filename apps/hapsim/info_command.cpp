@@ -2,10 +2,10 @@
 // both acceleration structures built over it.
 #include "checked_output.h"
 #include "commands.h"
-#include "mesh_argument.h"
 
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/collision/sphere_tree.h"
+#include "hapsim/geometry/mesh_argument.h"
 
 #include <nlohmann/json.hpp>
 

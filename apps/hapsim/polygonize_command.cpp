@@ -6,9 +6,9 @@
 // knee region, and a skin a few millimetres over everything (scripts/derive-knee.sh).
 #include "commands.h"
 #include "json_output.h"
-#include "mesh_argument.h"
 
 #include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/geometry/mesh_argument.h"
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/mesh_simplify.h"
 #include "hapsim/geometry/mesh_validation.h"

@@ -4,7 +4,6 @@
 #include "commands.h"
 #include "json_output.h"
 #include "progress_printer.h"
-#include "session_json.h"
 #include "snapshot_view.h"
 
 #include "hapsim/core/error.h"
@@ -14,6 +13,7 @@
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/session.h"
+#include "hapsim/runtime/session_json.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 
@@ -386,49 +386,16 @@ void run(const RunArgs& args) {
     snapshots->final(*world);
   }
 
-  bool failed = false;
-  nlohmann::json j = session_summary_json(scene, *world, summary, device_name);
-  if (summary.teleop) {
-    const TeleopSummary& t = *summary.teleop;
-    j["slave"] = setup.slave_name;
-    j["grasped"] = t.grasped;
-    j["grasp_time_s"] = t.grasped ? nlohmann::json(t.grasp_time_s) : nlohmann::json(nullptr);
-    j["release_time_s"] =
-        t.release_time_s >= 0.0 ? nlohmann::json(t.release_time_s) : nlohmann::json(nullptr);
-    j["ball_lift_m"] = t.ball_lift_m;
-    j["ball_final_position_m"] = {t.ball_final_world.x(), t.ball_final_world.y(),
-                                  t.ball_final_world.z()};
-    j["ball_target_error_m"] =
-        t.target_error_m ? nlohmann::json(*t.target_error_m) : nlohmann::json(nullptr);
-    j["peak_grasp_force_n"] = t.peak_grasp_force_n;
-    j["max_sheet_deflection_m"] = t.max_sheet_deflection_m;
-    j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
-    j["slave_collisions"] = {
-        {"steps", t.slave_collision_steps},
-        {"pairs", t.slave_collisions},
-        {"first_s", t.slave_collision_steps > 0 ? nlohmann::json(t.first_slave_collision_s)
-                                                : nlohmann::json(nullptr)},
-        {"bodies", t.slave_collision_bodies}};
-    // A scripted pick-and-place must end with the ball within 5 mm of its target (a replay of one
-    // is judged by its bit-for-bit comparison instead).
-    if (t.target_error_m && !replayed && !t.placed()) {
-      std::printf(
-          "FAILED: the pick-and-place did not end with the ball within 5 mm of the target\n");
-      failed = true;
-    }
-  }
+  std::optional<RecordingDifference> replay_difference;
   if (replayed) {
     const Recording again = read_recording(record_path);
-    const RecordingDifference d = compare_recordings(*replayed, again);
-    j["replay_identical"] = d.identical;
-    if (d.identical) {
+    replay_difference = compare_recordings(*replayed, again);
+    if (replay_difference->identical) {
       std::printf("replay       identical to %s, bit for bit (%zu frames)\n",
                   args.replay_path.c_str(), again.frames.size());
     } else {
       std::printf("replay       DIFFERS from %s: %s\n", args.replay_path.c_str(),
-                  d.message.c_str());
-      j["replay_difference"] = d.message;
-      failed = true;
+                  replay_difference->message.c_str());
     }
     if (temporary_record) {
       std::error_code ec;
@@ -438,17 +405,12 @@ void run(const RunArgs& args) {
     std::printf("recorded     %s (%zu frames)\n", record_path.string().c_str(),
                 recorder->frames_written());
   }
-  if (summary.pop_throughs > 0) {
-    std::printf("FAILED: %zu pop-through(s): a tool went through a segment\n",
-                summary.pop_throughs);
-    failed = true;
+  for (const std::string& failure : run_failures(setup, summary)) {
+    std::printf("FAILED: %s\n", failure.c_str());
   }
-  if (summary.max_force_limit_violations > 0) {
-    std::printf("FAILED: %zu command(s) above the device's rated force\n",
-                summary.max_force_limit_violations);
-    failed = true;
-  }
-  j["ok"] = !failed;
+  const nlohmann::json j =
+      run_summary_json(setup, summary, replay_difference ? &*replay_difference : nullptr);
+  const bool failed = !j["ok"].get<bool>();
   if (json_out) {
     json_out.write(j);
   }

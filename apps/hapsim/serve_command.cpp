@@ -12,7 +12,6 @@
 #include "commands.h"
 #include "dds_options.h"
 #include "json_output.h"
-#include "session_json.h"
 #include "stop_signal.h"
 
 #include "hapsim/net/command_receiver.h"
@@ -27,6 +26,7 @@
 #include "hapsim/net/topic_writer.h"
 #include "hapsim/net/view_state_codec.h"
 #include "hapsim/runtime/session.h"
+#include "hapsim/runtime/session_json.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 

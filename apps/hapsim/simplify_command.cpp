@@ -4,9 +4,9 @@
 // written in the input's units.
 #include "commands.h"
 #include "json_output.h"
-#include "mesh_argument.h"
 
 #include "hapsim/collision/hausdorff.h"
+#include "hapsim/geometry/mesh_argument.h"
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/mesh_simplify.h"
 #include "hapsim/geometry/mesh_validation.h"

@@ -1,8 +1,8 @@
-#include "session_json.h"
+#include "hapsim/runtime/session_json.h"
 
 #include <vector>
 
-namespace hapsim::app {
+namespace hapsim {
 
 nlohmann::json realtime_json(const RealtimeSummary& rt) {
   return {{"rate_hz", rt.rate_hz},
@@ -100,4 +100,60 @@ nlohmann::json session_summary_json(const SceneDescription& scene, const World& 
   return j;
 }
 
-}  // namespace hapsim::app
+std::vector<std::string> run_failures(const RunSetup& setup, const SessionSummary& summary) {
+  std::vector<std::string> failures;
+  // A scripted pick-and-place must end with the ball within 5 mm of its target (a replay of one
+  // is judged by its bit-for-bit comparison instead).
+  if (summary.teleop && summary.teleop->target_error_m && !setup.replayed &&
+      !summary.teleop->placed()) {
+    failures.emplace_back("the pick-and-place did not end with the ball within 5 mm of the target");
+  }
+  if (summary.pop_throughs > 0) {
+    failures.push_back(std::to_string(summary.pop_throughs) +
+                       " pop-through(s): a tool went through a segment");
+  }
+  if (summary.max_force_limit_violations > 0) {
+    failures.push_back(std::to_string(summary.max_force_limit_violations) +
+                       " command(s) above the device's rated force");
+  }
+  return failures;
+}
+
+nlohmann::json run_summary_json(const RunSetup& setup, const SessionSummary& summary,
+                                const RecordingDifference* replay) {
+  nlohmann::json j = session_summary_json(setup.scene, *setup.world, summary, setup.device_name);
+  if (summary.teleop) {
+    const TeleopSummary& t = *summary.teleop;
+    j["slave"] = setup.slave_name;
+    j["grasped"] = t.grasped;
+    j["grasp_time_s"] = t.grasped ? nlohmann::json(t.grasp_time_s) : nlohmann::json(nullptr);
+    j["release_time_s"] =
+        t.release_time_s >= 0.0 ? nlohmann::json(t.release_time_s) : nlohmann::json(nullptr);
+    j["ball_lift_m"] = t.ball_lift_m;
+    j["ball_final_position_m"] = {t.ball_final_world.x(), t.ball_final_world.y(),
+                                  t.ball_final_world.z()};
+    j["ball_target_error_m"] =
+        t.target_error_m ? nlohmann::json(*t.target_error_m) : nlohmann::json(nullptr);
+    j["peak_grasp_force_n"] = t.peak_grasp_force_n;
+    j["max_sheet_deflection_m"] = t.max_sheet_deflection_m;
+    j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
+    j["slave_collisions"] = {
+        {"steps", t.slave_collision_steps},
+        {"pairs", t.slave_collisions},
+        {"first_s", t.slave_collision_steps > 0 ? nlohmann::json(t.first_slave_collision_s)
+                                                : nlohmann::json(nullptr)},
+        {"bodies", t.slave_collision_bodies}};
+  }
+  bool ok = run_failures(setup, summary).empty();
+  if (replay != nullptr) {
+    j["replay_identical"] = replay->identical;
+    if (!replay->identical) {
+      j["replay_difference"] = replay->message;
+      ok = false;
+    }
+  }
+  j["ok"] = ok;
+  return j;
+}
+
+}  // namespace hapsim

@@ -1,4 +1,4 @@
-#include "mesh_argument.h"
+#include "hapsim/geometry/mesh_argument.h"
 
 #include "hapsim/core/error.h"
 #include "hapsim/geometry/mesh_io.h"
@@ -9,7 +9,7 @@
 #include <functional>
 #include <string_view>
 
-namespace hapsim::app {
+namespace hapsim {
 namespace {
 
 struct Builtin {
@@ -86,4 +86,4 @@ MeshArgument load_mesh_argument(const std::string& spec, double scale) {
   return out;
 }
 
-}  // namespace hapsim::app
+}  // namespace hapsim

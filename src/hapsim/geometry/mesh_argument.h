@@ -1,5 +1,6 @@
-// Resolving a MESH argument of the CLI: a file (through geometry/mesh_io) or a built-in mesh
-// (`builtin:NAME`), scaled to metres.
+// A mesh named the way a user names one (the CLI's MESH arguments, the Python module's
+// load_mesh): a file (through geometry/mesh_io) or a built-in mesh (`builtin:NAME`), scaled to
+// metres.
 #pragma once
 
 #include "hapsim/geometry/triangle_mesh.h"
@@ -7,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace hapsim::app {
+namespace hapsim {
 
 struct MeshArgument {
   TriangleMesh mesh;       // metres
@@ -24,4 +25,4 @@ std::vector<std::pair<std::string, std::string>> builtin_meshes();
 /// file (or the unknown built-in, listing the known ones).
 MeshArgument load_mesh_argument(const std::string& spec, double scale);
 
-}  // namespace hapsim::app
+}  // namespace hapsim
