@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Install what is missing, build everything (tests and benchmarks), run the quick sanitizer part
-# (docs/sanitizers.md: the packet and reader fuzz entry points under ASan +
-# UBSan in build/sanitize-quick, about 2 minutes cold), then the whole suite. HAPSIM_SKIP_SANITIZERS=1 skips that part
-# (a developer's quick loop); CI (.ci/run) runs it.
+# (docs/sanitizers.md: the packet and reader fuzz entry points under ASan + UBSan in
+# build/sanitize-quick, about 2 minutes cold), then the whole suite. HAPSIM_SKIP_SANITIZERS=1
+# skips the sanitizer part (a developer's quick loop); CI (.ci/run) runs it.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/setup.sh"
 hapsim_install_packages
