@@ -1,6 +1,6 @@
 #include "hapsim/render/world_scene.h"
 
-#include "hapsim/collision/knee_groups.h"
+#include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/sphere_tree.h"
 #include "hapsim/core/error.h"
 #include "hapsim/kinematics/slave_shapes.h"
@@ -29,7 +29,9 @@ struct WorldScene::Segment {
   int pad = -1;          // a rig's gripper pad (0, 1): green while it holds
   std::uint64_t version = ~std::uint64_t{0};  // none from a snapshot yet
   std::unique_ptr<SphereTree> tree;           // built when a sphere-tree level is first shown
-  std::vector<Vec3f> group_colours;           // built when group colouring is first asked for
+  std::unique_ptr<KneeIndex> knee;            // built when groups or their overlays are first shown
+  int group_colour_base = 0;                  // group g's colour: palette_colour(base + g)
+  std::vector<Vec3f> group_colours;           // per vertex, built with `knee`
 };
 
 namespace {
@@ -298,9 +300,84 @@ const std::string& WorldScene::segment_label(std::size_t flat_segment) const {
   return segments_.at(flat_segment)->label;
 }
 
-void WorldScene::apply_colouring() {
+const KneeIndex& WorldScene::knee_index(Segment& seg) {
+  if (!seg.knee) {
+    const TriangleMesh& rest =
+        world_.description().bodies[seg.body].segments[seg.index_in_body].mesh;
+    seg.knee = std::make_unique<KneeIndex>(rest);
+    seg.group_colour_base = next_group_colour_;
+    next_group_colour_ += static_cast<int>(seg.knee->group_count());
+    seg.group_colours.resize(rest.vertices.size());
+    for (std::size_t v = 0; v < rest.vertices.size(); ++v) {
+      seg.group_colours[v] =
+          palette_colour(seg.group_colour_base +
+                         static_cast<int>(seg.knee->vertex_group(static_cast<std::uint32_t>(v))));
+    }
+  }
+  return *seg.knee;
+}
+
+// The knee method's overlays belong to the segments it could answer for: shown, and neither a
+// sheet (its own field answers) nor a box drawn with flat faces.
+bool WorldScene::knee_overlays_apply(const Segment& seg) const {
+  return scene_.mesh(seg.mesh).visible && !seg.sheet && !seg.faceted;
+}
+
+// The knee paper's Fig. 3: "the dark lines represent the spheres of influence of each group" and
+// "the three dark spheres near the tip of the finger represent the three vertices closest to the
+// point of possible contact".
+void WorldScene::add_knee_overlays() {
+  const auto dark = [](const Vec3f& c) { return Vec3f(0.45f * c); };
+  if (options_.show_influence_spheres) {
+    for (auto& seg : segments_) {
+      if (!knee_overlays_apply(*seg)) {
+        continue;
+      }
+      const KneeIndex& knee = knee_index(*seg);
+      const Iso3& X = body_poses_[seg->body];
+      for (std::uint32_t g = 0; g < knee.group_count(); ++g) {
+        scene_.spheres.push_back(
+            {X * knee.group_centroid(g), knee.group_radius(g),
+             dark(palette_colour(seg->group_colour_base + static_cast<int>(g))), true});
+      }
+    }
+  }
+  if (!options_.show_contact_vertices) {
+    return;
+  }
   const WorldDescription& d = world_.description();
-  int next_group_colour = 0;
+  const Vec3f marker(0.06f, 0.06f, 0.08f);
+  for (const WorldContact& c : contacts_) {
+    if (c.tool < 0 || static_cast<std::size_t>(c.tool) >= tools_.size() || c.body < 0 ||
+        c.segment < 0) {
+      continue;
+    }
+    Segment& seg = *segments_[world_.flat_segment(static_cast<std::size_t>(c.body),
+                                                  static_cast<std::size_t>(c.segment))];
+    if (!knee_overlays_apply(seg)) {
+      continue;
+    }
+    // The method queries the tool's centre: the same point gives the same group here.
+    const Iso3& X = body_poses_[seg.body];
+    const KneeQueryTrace t =
+        knee_index(seg).trace(X.inverse() * tools_[static_cast<std::size_t>(c.tool)].p_world);
+    // Where the vertices are drawn now (a deformed segment's dent moves them).
+    const std::vector<Vec3>& now = scene_.mesh(seg.mesh).geometry().vertices;
+    const double r = std::max(0.0008, 0.2 * d.tools[static_cast<std::size_t>(c.tool)].radius_m);
+    std::array<Vec3, 3> p;
+    for (std::size_t k = 0; k < t.vertex_count; ++k) {
+      p[k] = X * now[t.closest_vertices[k]];
+      scene_.spheres.push_back({p[k], r, marker, false});
+    }
+    if (t.vertex_count == 3) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        scene_.segments.push_back({p[k], p[(k + 1) % 3], marker});
+      }
+    }
+  }
+}
+
+void WorldScene::apply_colouring() {
   for (std::size_t i = 0; i < segments_.size(); ++i) {
     Segment& seg = *segments_[i];
     RenderMesh& mesh = scene_.mesh(seg.mesh);
@@ -322,16 +399,7 @@ void WorldScene::apply_colouring() {
           scene_.set_vertex_colours(seg.mesh, {});
           break;
         }
-        if (seg.group_colours.empty()) {
-          const TriangleMesh& rest = d.bodies[seg.body].segments[seg.index_in_body].mesh;
-          const KneeGrouping grouping = build_knee_groups(rest);
-          seg.group_colours.resize(rest.vertices.size(), seg.tissue_colour);
-          for (std::size_t v = 0; v < grouping.vertex_group.size(); ++v) {
-            seg.group_colours[v] =
-                palette_colour(next_group_colour + static_cast<int>(grouping.vertex_group[v]));
-          }
-          next_group_colour += static_cast<int>(grouping.groups.size());
-        }
+        (void)knee_index(seg);
         scene_.set_vertex_colours(seg.mesh, seg.group_colours);
         break;
       }
@@ -365,6 +433,10 @@ void WorldScene::update(const WorldSnapshot& snapshot) {
     *rig_ = *snapshot.teleop;  // sized alike: no allocation after the first
   }
   hand_ = snapshot.hand;
+  contacts_.assign(
+      snapshot.contacts.begin(),
+      snapshot.contacts.begin() +
+          static_cast<std::ptrdiff_t>(std::min(snapshot.contact_count, snapshot.contacts.size())));
   rebuild_overlays(snapshot.tools, snapshot.tool_force_n);
 }
 
@@ -387,6 +459,7 @@ void WorldScene::update_from_world(const World& world) {
     fill_teleop_snapshot(*rig_, world);
   }
   const StepResult& r = world.last_result();
+  contacts_.assign(r.contacts.begin(), r.contacts.end());
   std::vector<double> force_n(r.tools.size());
   for (std::size_t t = 0; t < r.tools.size(); ++t) {
     force_n[t] = r.tools[t].force_world_n.norm();
@@ -478,6 +551,7 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
       }
     }
   }
+  add_knee_overlays();
   if (rig_) {
     add_rig_overlays();
   }
