@@ -577,7 +577,7 @@ void add_run_command(CLI::App& app) {
          "--overlay", args->overlays,
          "Snapshot overlays of the knee method (the knee paper's Fig. 3), comma-separated: "
          "influence (each vertex group's sphere of influence), contact-vertices (the "
-         "three vertices closest in angle to a touching tool)")
+         "three vertices closest in angle to a touching tool within 1 cm of a shown segment)")
       ->delimiter(',')
       ->check(CLI::IsMember({"influence", "contact-vertices"}));
   cmd->add_option("--only-segments", args->only_segments,

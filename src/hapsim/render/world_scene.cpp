@@ -13,6 +13,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace hapsim {
@@ -323,6 +324,23 @@ bool WorldScene::knee_overlays_apply(const Segment& seg) const {
   return scene_.mesh(seg.mesh).visible && !seg.sheet && !seg.faceted;
 }
 
+// A sphere as three great circles (in the world's xy, yz and zx planes): lines light enough
+// that a dozen overlapping spheres still let the surface they wrap be seen.
+void WorldScene::add_circles(const Vec3& centre_world, double radius_m, const Vec3f& colour) {
+  constexpr int kSteps = 48;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Vec3 u = Vec3::Unit((axis + 1) % 3);
+    const Vec3 v = Vec3::Unit((axis + 2) % 3);
+    const auto at = [&](int k) {
+      const double a = 2.0 * std::numbers::pi * k / kSteps;
+      return Vec3(centre_world + radius_m * (std::cos(a) * u + std::sin(a) * v));
+    };
+    for (int k = 0; k < kSteps; ++k) {
+      scene_.segments.push_back({at(k), at(k + 1), colour});
+    }
+  }
+}
+
 // The knee paper's Fig. 3: "the dark lines represent the spheres of influence of each group" and
 // "the three dark spheres near the tip of the finger represent the three vertices closest to the
 // point of possible contact".
@@ -336,9 +354,8 @@ void WorldScene::add_knee_overlays() {
       const KneeIndex& knee = knee_index(*seg);
       const Iso3& X = body_poses_[seg->body];
       for (std::uint32_t g = 0; g < knee.group_count(); ++g) {
-        scene_.spheres.push_back(
-            {X * knee.group_centroid(g), knee.group_radius(g),
-             dark(palette_colour(seg->group_colour_base + static_cast<int>(g))), true});
+        add_circles(X * knee.group_centroid(g), knee.group_radius(g),
+                    dark(palette_colour(seg->group_colour_base + static_cast<int>(g))));
       }
     }
   }
@@ -347,29 +364,43 @@ void WorldScene::add_knee_overlays() {
   }
   const WorldDescription& d = world_.description();
   const Vec3f marker(0.06f, 0.06f, 0.08f);
-  for (const WorldContact& c : contacts_) {
-    if (c.tool < 0 || static_cast<std::size_t>(c.tool) >= tools_.size() || c.body < 0 ||
-        c.segment < 0) {
+  for (std::size_t tool = 0; tool < tools_.size() && tool < d.tools.size(); ++tool) {
+    // The paper's "point of possible contact": the centre of a tool that touches something (the
+    // skin over a shown muscle counts), as the method queries it, against the shown segment whose
+    // surface the method finds nearest, within a centimetre of the tool's surface.
+    if (tools_[tool].contact_count == 0) {
       continue;
     }
-    Segment& seg = *segments_[world_.flat_segment(static_cast<std::size_t>(c.body),
-                                                  static_cast<std::size_t>(c.segment))];
-    if (!knee_overlays_apply(seg)) {
+    const double radius = d.tools[tool].radius_m;
+    Segment* nearest = nullptr;
+    KneeQueryTrace trace;
+    double nearest_gap_m = 0.01;
+    for (auto& seg : segments_) {
+      if (!knee_overlays_apply(*seg)) {
+        continue;
+      }
+      const Vec3 p_body = body_poses_[seg->body].inverse() * tools_[tool].p_world;
+      const KneeIndex& knee = knee_index(*seg);
+      const SurfacePoint sp = knee.closest_point(p_body);
+      if (sp.found() && sp.signed_distance - radius < nearest_gap_m) {
+        nearest_gap_m = sp.signed_distance - radius;
+        nearest = seg.get();
+        trace = knee.trace(p_body);
+      }
+    }
+    if (nearest == nullptr) {
       continue;
     }
-    // The method queries the tool's centre: the same point gives the same group here.
-    const Iso3& X = body_poses_[seg.body];
-    const KneeQueryTrace t =
-        knee_index(seg).trace(X.inverse() * tools_[static_cast<std::size_t>(c.tool)].p_world);
     // Where the vertices are drawn now (a deformed segment's dent moves them).
-    const std::vector<Vec3>& now = scene_.mesh(seg.mesh).geometry().vertices;
-    const double r = std::max(0.0008, 0.2 * d.tools[static_cast<std::size_t>(c.tool)].radius_m);
+    const std::vector<Vec3>& now = scene_.mesh(nearest->mesh).geometry().vertices;
+    const Iso3& X = body_poses_[nearest->body];
+    const double r = std::max(0.0008, 0.2 * radius);
     std::array<Vec3, 3> p;
-    for (std::size_t k = 0; k < t.vertex_count; ++k) {
-      p[k] = X * now[t.closest_vertices[k]];
+    for (std::size_t k = 0; k < trace.vertex_count; ++k) {
+      p[k] = X * now[trace.closest_vertices[k]];
       scene_.spheres.push_back({p[k], r, marker, false});
     }
-    if (t.vertex_count == 3) {
+    if (trace.vertex_count == 3) {
       for (std::size_t k = 0; k < 3; ++k) {
         scene_.segments.push_back({p[k], p[(k + 1) % 3], marker});
       }
@@ -433,10 +464,6 @@ void WorldScene::update(const WorldSnapshot& snapshot) {
     *rig_ = *snapshot.teleop;  // sized alike: no allocation after the first
   }
   hand_ = snapshot.hand;
-  contacts_.assign(
-      snapshot.contacts.begin(),
-      snapshot.contacts.begin() +
-          static_cast<std::ptrdiff_t>(std::min(snapshot.contact_count, snapshot.contacts.size())));
   rebuild_overlays(snapshot.tools, snapshot.tool_force_n);
 }
 
@@ -459,7 +486,6 @@ void WorldScene::update_from_world(const World& world) {
     fill_teleop_snapshot(*rig_, world);
   }
   const StepResult& r = world.last_result();
-  contacts_.assign(r.contacts.begin(), r.contacts.end());
   std::vector<double> force_n(r.tools.size());
   for (std::size_t t = 0; t < r.tools.size(); ++t) {
     force_n[t] = r.tools[t].force_world_n.norm();

@@ -49,11 +49,12 @@ struct WorldSceneOptions {
   /// Drums along a rig slave's joint axes (a chain drawn with rounded links).
   bool show_joints = true;
   /// The knee method's overlays (the knee paper's Fig. 3), on the visible segments: each vertex
-  /// group's sphere of influence as a wire sphere in a dark shade of the group's colour ...
+  /// group's sphere of influence as three great circles in a dark shade of the group's colour ...
   bool show_influence_spheres = false;
-  /// ... and, for each tool touching a visible segment, the three vertices closest in angle to
-  /// the tool about its group's centroid (whose plane the method tests) as dark spheres joined by
-  /// the triangle they span.
+  /// ... and, for each tool touching something within a centimetre of a visible segment (the
+  /// paper's "point of possible contact"; the nearest such segment), the three vertices closest in
+  /// angle to the tool about its group's centroid, whose plane the method tests, as dark spheres
+  /// joined by the triangle they span.
   bool show_contact_vertices = false;
 };
 
@@ -128,6 +129,7 @@ class WorldScene {
   const KneeIndex& knee_index(Segment& seg);
   [[nodiscard]] bool knee_overlays_apply(const Segment& seg) const;
   void add_knee_overlays();
+  void add_circles(const Vec3& centre_world, double radius_m, const Vec3f& colour);
   void rebuild_overlays(const std::vector<ToolState>& tools, const std::vector<double>& force_n);
   void add_rig_overlays();
   void add_master(const TeleopSnapshot& s);
@@ -141,9 +143,8 @@ class WorldScene {
   std::vector<Vec3f> scratch_colours_;
   std::vector<ToolState> tools_;
   std::vector<double> tool_force_n_;
-  std::vector<WorldContact> contacts_;  // the latest update's tool contacts
-  int next_group_colour_ = 0;           // palette index of the next segment's first group
-  std::vector<Iso3> body_poses_;        // where each body is drawn (dynamic bodies move)
+  int next_group_colour_ = 0;     // palette index of the next segment's first group
+  std::vector<Iso3> body_poses_;  // where each body is drawn (dynamic bodies move)
   Box3 rest_bounds_world_;
   // A glove world's hand, as the last update saw it.
   bool has_hand_ = false;
