@@ -412,8 +412,12 @@ void run(const RunArgs& args) {
             o.show_contact_vertices |= overlay == "contact-vertices";
           }
           auto drawn = std::make_unique<WorldScene>(w, o);
+          // Only ever hidden here: what the scene itself does not draw (a rig's floor slab, links
+          // drawn by the slave's figure) stays hidden.
           for (std::size_t i = 0; i < drawn->segment_count(); ++i) {
-            drawn->set_segment_visible(i, segment_shown(drawn->segment_label(i), args));
+            if (!segment_shown(drawn->segment_label(i), args)) {
+              drawn->set_segment_visible(i, false);
+            }
           }
           drawn->set_options(o);  // the overlays again, for the segments now shown
           return drawn;
