@@ -301,7 +301,7 @@ TEST(SceneReference, GloveHandScenesMatchTheReferences) {
     GTEST_SKIP() << "no EGL context on this machine";
   }
   // The knee paper's Fig. 6: the hand's index and middle fingers pressing the knee, 1.6 s in.
-  glove_scene_picture(*writer, "knee_hand_procedural.json", 1600, 1.2, 0.35, "knee_hand_procedural");
+  glove_scene_picture(*writer, "knee_hand_procedural.json", 1600, 1.2, 0.35, "knee_hand");
   // The hand carrying the ball between thumb and index.
   glove_scene_picture(*writer, "hand_ball_sheet.json", 2500, -1.2, 0.6, "hand_ball_sheet");
 }
