@@ -35,6 +35,9 @@ HAPSIM_PACKAGES=(
   # tests and benchmarks: find_package(GTest) with GMock, find_package(benchmark), and
   # find_package(ZLIB) for the golden run traces (tests/golden/*.trace.gz)
   libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev
+  # the papers' figures (scripts/make-figures.sh, and its test): the Gaussian profile plot is drawn
+  # by Debian's python3 with matplotlib
+  python3-matplotlib
   # reference oracles for tests and benchmarks only (HAPSIM_REQUIRE_ORACLES: configure fails
   # without them rather than skipping their tests): CGAL, FCL, Embree 3, orocos-kdl
   libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev

@@ -22,6 +22,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -62,7 +63,47 @@ struct RunArgs {
   bool room = false;
   double eye_separation_m = 0.0;
   int sphere_tree_level = -1;
+  std::vector<std::string> overlays;
+  std::vector<std::string> only_segments;
+  std::vector<std::string> hide_segments;
 };
+
+// Whether a segment labelled "body/segment" is drawn under --only-segments / --hide-segments
+// (each a list of parts of names).
+bool segment_shown(const std::string& label, const RunArgs& args) {
+  const auto named = [&label](const std::vector<std::string>& names) {
+    return std::any_of(names.begin(), names.end(), [&label](const std::string& n) {
+      return label.find(n) != std::string::npos;
+    });
+  };
+  return (args.only_segments.empty() || named(args.only_segments)) && !named(args.hide_segments);
+}
+
+// Each name of --only-segments and --hide-segments must name a segment of the scene: a typo would
+// otherwise show everything (or hide nothing) without a word.
+void check_segment_names(const WorldDescription& d, const RunArgs& args) {
+  std::vector<std::string> labels;
+  for (const BodyDescription& b : d.bodies) {
+    for (const SegmentDescription& seg : b.segments) {
+      labels.push_back(b.name + "/" + seg.name);
+    }
+  }
+  for (const auto* list : {&args.only_segments, &args.hide_segments}) {
+    for (const std::string& name : *list) {
+      if (std::none_of(labels.begin(), labels.end(), [&name](const std::string& l) {
+            return l.find(name) != std::string::npos;
+          })) {
+        std::string all;
+        for (const std::string& l : labels) {
+          all += (all.empty() ? "" : ", ") + l;
+        }
+        throw CommandError(
+            std::string(list == &args.only_segments ? "--only-segments " : "--hide-segments ") +
+            name + ": no segment's name contains it (the segments: " + all + ")");
+      }
+    }
+  }
+}
 
 SegmentColouring parse_colouring(const std::string& name) {
   if (name == "segments") {
@@ -229,8 +270,13 @@ void run(const RunArgs& args) {
     if (!(args.eye_separation_m >= 0.0) || !std::isfinite(args.eye_separation_m)) {
       throw CommandError("--eye-separation: expected metres >= 0 (0: a thirtieth of the distance)");
     }
-  } else if (!args.view.empty() || !args.camera.empty()) {
-    throw CommandError(std::string(args.view.empty() ? "--camera" : "--view") +
+  } else if (!args.view.empty() || !args.camera.empty() || !args.overlays.empty() ||
+             !args.only_segments.empty() || !args.hide_segments.empty()) {
+    throw CommandError(std::string(!args.view.empty()            ? "--view"
+                                   : !args.camera.empty()        ? "--camera"
+                                   : !args.overlays.empty()      ? "--overlay"
+                                   : !args.only_segments.empty() ? "--only-segments"
+                                                                 : "--hide-segments") +
                        ": only with --snapshot FILE.png");
   }
   std::optional<std::filesystem::path> trajectory;
@@ -278,6 +324,7 @@ void run(const RunArgs& args) {
     }
   }();
   const SceneDescription& scene = setup.scene;
+  check_segment_names(scene.world, args);
   const std::optional<OrbitCamera> chosen_camera =
       args.snapshot_path.empty() ? std::nullopt
                                  : chosen_snapshot_camera(scene, args.view, args.camera);
@@ -360,7 +407,20 @@ void run(const RunArgs& args) {
           o.colouring = parse_colouring(args.colours);
           o.show_room = args.room;
           o.sphere_tree_level = args.sphere_tree_level;
-          return std::make_unique<WorldScene>(w, o);
+          for (const std::string& overlay : args.overlays) {
+            o.show_influence_spheres |= overlay == "influence";
+            o.show_contact_vertices |= overlay == "contact-vertices";
+          }
+          auto drawn = std::make_unique<WorldScene>(w, o);
+          // Only ever hidden here: what the scene itself does not draw (a rig's floor slab, links
+          // drawn by the slave's figure) stays hidden.
+          for (std::size_t i = 0; i < drawn->segment_count(); ++i) {
+            if (!segment_shown(drawn->segment_label(i), args)) {
+              drawn->set_segment_visible(i, false);
+            }
+          }
+          drawn->set_options(o);  // the overlays again, for the segments now shown
+          return drawn;
         },
         snapshot_yaw_rad(*world), snapshot_pitch_rad(*world), chosen_camera);
   }
@@ -479,6 +539,21 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--sphere-tree-level", args->sphere_tree_level,
                   "Draw the sphere tree's spheres at this level in the snapshot (root = 0)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option(
+         "--overlay", args->overlays,
+         "Snapshot overlays of the knee method (the knee paper's Fig. 3), comma-separated: "
+         "influence (each vertex group's sphere of influence), contact-vertices (the "
+         "three vertices closest in angle to a touching tool within 1 cm of a shown segment)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"influence", "contact-vertices"}));
+  cmd->add_option("--only-segments", args->only_segments,
+                  "Snapshot only the segments whose body/segment name contains one of these "
+                  "(comma-separated); the world still has them all")
+      ->delimiter(',');
+  cmd->add_option("--hide-segments", args->hide_segments,
+                  "Snapshot without the segments whose body/segment name contains one of these "
+                  "(comma-separated), e.g. Skin")
+      ->delimiter(',');
   cmd->callback([args] { run(*args); });
 }
 

@@ -66,9 +66,9 @@ TEST(RunCommand, KneePalpationReportsAndWritesJson) {
 // The hand variant: two fingers press at once, the index on the patella and the middle finger on
 // the patellar tendon, each feeling its own segment through its own glove actuator.
 TEST(RunCommand, KneeHandPressesTwoSegmentsWithTwoFingers) {
-  const auto json_path = temp_path("knee_hand.json");
+  const auto json_path = temp_path("knee_hand_procedural.json");
   const RunResult r = run_hapsim("run " + std::string(HAPSIM_SCENES_DIR) +
-                                 "/knee_hand.json -q --json " + json_path.string());
+                                 "/knee_hand_procedural.json -q --json " + json_path.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(json_path);
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -114,8 +114,9 @@ TEST(RunCommand, GlovePlaysARecordedFile) {
   }
   const auto traj = write_file("glove.csv", csv);
   const auto json_path = temp_path("glove_run.json");
-  const RunResult r = run_hapsim("run " + std::string(HAPSIM_SCENES_DIR) + "/knee_hand.json -q " +
-                                 "--device sim:" + traj.string() + " --json " + json_path.string());
+  const RunResult r =
+      run_hapsim("run " + std::string(HAPSIM_SCENES_DIR) + "/knee_hand_procedural.json -q " +
+                 "--device sim:" + traj.string() + " --json " + json_path.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(json_path);
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -245,7 +246,7 @@ TEST(RunCommand, AMisScaledMeshAndAFarTrajectoryWarnOnceEach) {
 // materials above that are named once in the summary and listed in the JSON, each with its own
 // stiffness read from the scene file.
 TEST(RunCommand, KneeHandNamesTheMaterialsClampedToTheGlovesStiffness) {
-  const std::string scene_file = std::string(HAPSIM_SCENES_DIR) + "/knee_hand.json";
+  const std::string scene_file = std::string(HAPSIM_SCENES_DIR) + "/knee_hand_procedural.json";
   const auto json_path = temp_path("knee_hand_clamps.json");
   const RunResult r =
       run_hapsim("run " + scene_file + " --duration 0.05 -q --json " + json_path.string());
@@ -283,7 +284,7 @@ TEST(RunCommand, KneeHandNamesTheMaterialsClampedToTheGlovesStiffness) {
 TEST(RunCommand, ShippedScenesRunWithoutWarnings) {
   const std::optional<std::filesystem::path> root = hapsim::find_data_dir(HAPSIM_TEST_DATA_DIR);
   for (const auto& [name, data] :
-       {std::pair{"knee", ""}, std::pair{"knee_hand", ""}, std::pair{"csg_block", ""},
+       {std::pair{"knee", ""}, std::pair{"knee_hand_procedural", ""}, std::pair{"csg_block", ""},
         std::pair{"teleop", ""}, std::pair{"teleop_gp7", "motoman_gp7"},
         std::pair{"knee_vhf", "knee_vhf_left"}}) {
     SCOPED_TRACE(name);
@@ -303,7 +304,7 @@ TEST(RunCommand, ShippedScenesRunWithoutWarnings) {
     std::ifstream in(json_path);
     const nlohmann::json j = nlohmann::json::parse(in);
     EXPECT_TRUE(j.at("warnings").empty()) << j["warnings"];
-    if (std::string(name) != "knee_hand") {
+    if (std::string(name) != "knee_hand_procedural") {
       EXPECT_TRUE(j.at("stiffness_clamps").empty()) << j["stiffness_clamps"];
       EXPECT_EQ(r.output.find("stiffness clamped"), std::string::npos) << r.output;
     }

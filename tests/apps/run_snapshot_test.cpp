@@ -71,7 +71,7 @@ TEST(RunCommand, BadSnapshotOptionsAreNamed) {
 }
 
 TEST(RunCommand, BadCameraOptionsAreOneNamedLine) {
-  const std::string hand = std::string(HAPSIM_SCENES_DIR) + "/knee_hand.json";
+  const std::string hand = std::string(HAPSIM_SCENES_DIR) + "/knee_hand_procedural.json";
   const auto one_line = [](const std::string& out) {
     return std::count(out.begin(), out.end(), '\n') <= 1;
   };
@@ -106,8 +106,8 @@ TEST(RunCommand, BadCameraOptionsAreOneNamedLine) {
 }
 
 TEST(RunCommand, NamedViewAndCameraGiveTheSamePicture) {
-  // fig6 in scenes/knee_hand.json, written out as --camera: the same picture.
-  const std::string hand = std::string(HAPSIM_SCENES_DIR) + "/knee_hand.json";
+  // fig6 in scenes/knee_hand_procedural.json, written out as --camera: the same picture.
+  const std::string hand = std::string(HAPSIM_SCENES_DIR) + "/knee_hand_procedural.json";
   const auto a = test::temp_path("view.png");
   const auto b = test::temp_path("camera.png");
   const auto c = test::temp_path("default.png");

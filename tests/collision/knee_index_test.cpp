@@ -366,6 +366,60 @@ TEST(KneeIndex, ExposesGroupsRadialDirectionsAndSpheresOfInfluence) {
   }
 }
 
+TEST(KneeIndex, TraceNamesTheAnsweringGroupAndItsThreeVerticesClosestInAngle) {
+  // Under the paper's rule the answer is the plane through the three vertices closest in angle
+  // about the answering group's centroid: the trace's vertices, found here by brute force over
+  // the group's own and halo vertices (build_knee_groups), must give that same plane.
+  const TriangleMesh bumpy = make_bumpy_sphere(8000, 0.05, 0.05, 4);
+  KneeIndexOptions opt;
+  opt.triple_rule = KneeTripleRule::kClosestThree;
+  const KneeIndex knee(bumpy, opt);
+  const KneeGrouping kg = build_knee_groups(bumpy);
+  const std::vector<Vec3> points = sample_surface_band(bumpy, 300, kBand, 11);
+  std::size_t planes_checked = 0;
+  for (const Vec3& p : points) {
+    const KneeQueryTrace t = knee.trace(p);
+    const SurfacePoint sp = knee.closest_point(p);
+    ASSERT_EQ(t.group != KneeQueryTrace::kNoGroup, sp.found());
+    if (!sp.found()) {
+      continue;
+    }
+    ASSERT_EQ(t.vertex_count, 3u);
+    const KneeGroup& g = kg.groups[t.group];
+    const Vec3 d = (p - g.centroid_m).normalized();
+    std::vector<std::pair<double, std::uint32_t>> by_angle;
+    for (const auto* list : {&g.owned, &g.halo}) {
+      for (std::uint32_t v : *list) {
+        by_angle.emplace_back(-(bumpy.vertices[v] - g.centroid_m).normalized().dot(d), v);
+      }
+    }
+    std::sort(by_angle.begin(), by_angle.end());
+    for (std::size_t k = 0; k < 3; ++k) {
+      // Float directions: a near-tie may swap, so the trace's vertex is within 1e-6 of the k-th.
+      const double want = -by_angle[k].first;
+      const double got = (bumpy.vertices[t.closest_vertices[k]] - g.centroid_m).normalized().dot(d);
+      EXPECT_NEAR(got, want, 1e-6) << "vertex " << k << " of the trace at " << p.transpose();
+    }
+    const Vec3& a = bumpy.vertices[t.closest_vertices[0]];
+    const Vec3& b = bumpy.vertices[t.closest_vertices[1]];
+    const Vec3& c = bumpy.vertices[t.closest_vertices[2]];
+    Vec3 n = (b - a).cross(c - a);
+    const double e2 =
+        std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+    if (n.norm() < 0.12 * e2) {
+      continue;  // (nearly) degenerate: below 0.1 the index swaps in the fourth vertex
+    }
+    n.normalize();
+    if ((a - g.centroid_m).dot(n) < 0.0) {
+      n = -n;
+    }
+    EXPECT_NEAR(sp.signed_distance, (p - a).dot(n), 1e-12) << p.transpose();
+    ++planes_checked;
+  }
+  EXPECT_GT(planes_checked, points.size() / 3);
+  EXPECT_EQ(knee.trace(Vec3(1.0, 1.0, 1.0)).group, KneeQueryTrace::kNoGroup);
+}
+
 // ---------------------------------------------------------------------------------------------
 // knee_index vs the exact query on non-convex meshes.
 

@@ -159,7 +159,7 @@ TEST(GoldenRun, Knee) {
   check_scene("knee");
 }
 TEST(GoldenRun, KneeHand) {
-  check_scene("knee_hand");
+  check_scene("knee_hand_procedural");
 }
 TEST(GoldenRun, Teleop) {
   check_scene("teleop");

@@ -82,7 +82,7 @@ TEST(HandFigure, FingertipsSitWhereTheHandModelPutsThemAndTheDipFollowsThePip) {
 
 TEST(HandFigure, KneeHandSceneDrawsTheHandAtItsTools) {
   const SceneDescription scene =
-      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_hand.json");
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_hand_procedural.json");
   World world(scene.world);
   auto device = make_scene_device(scene, world);
   // 1.6 s in: the hand has come to the knee and the fingers press.

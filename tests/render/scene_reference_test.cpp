@@ -278,7 +278,7 @@ TEST(SceneReference, NamedViewMatchesTheReference) {
     GTEST_SKIP() << "no EGL context on this machine";
   }
   RunSetup run = make_run_setup(
-      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_hand.json"),
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_hand_procedural.json"),
       DeviceChoice{});
   World& world = *run.world;
   for (int i = 0; i < 1600; ++i) {
@@ -301,7 +301,7 @@ TEST(SceneReference, GloveHandScenesMatchTheReferences) {
     GTEST_SKIP() << "no EGL context on this machine";
   }
   // The knee paper's Fig. 6: the hand's index and middle fingers pressing the knee, 1.6 s in.
-  glove_scene_picture(*writer, "knee_hand.json", 1600, 1.2, 0.35, "knee_hand");
+  glove_scene_picture(*writer, "knee_hand_procedural.json", 1600, 1.2, 0.35, "knee_hand");
   // The hand carrying the ball between thumb and index.
   glove_scene_picture(*writer, "hand_ball_sheet.json", 2500, -1.2, 0.6, "hand_ball_sheet");
 }

@@ -178,7 +178,7 @@ TEST_F(SceneWarningsTest, ATrajectoryThatNeverReachesABodySaysHowFarItStays) {
 // long) stays more than 2.5 m away.
 TEST_F(SceneWarningsTest, AGloveTrajectoryFarFromTheKneeWarns) {
   const SceneDescription scene =
-      load_scene(fs::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_hand.json");
+      load_scene(fs::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_hand_procedural.json");
   // Appended piece by piece: `",j" + std::to_string(j)` trips GCC 12's -Wrestrict false
   // positive at -O3 (GCC bug 105651).
   std::string csv = "t,x,y,z,qw,qx,qy,qz";
@@ -214,8 +214,8 @@ TEST(SceneWarnings, ShippedScenesLoadAndAssembleWithoutWarnings) {
   const fs::path scenes = fs::path(HAPSIM_SOURCE_DIR) / "scenes";
   const std::optional<fs::path> root = find_data_dir(HAPSIM_TEST_DATA_DIR);
   for (const auto& [name, data] :
-       {std::pair{"knee", ""}, std::pair{"knee_hand", ""}, std::pair{"csg_block", ""},
-        std::pair{"teleop", ""}, std::pair{"teleop_gp7", "motoman_gp7"},
+       {std::pair{"knee", ""}, std::pair{"knee_hand", ""}, std::pair{"knee_hand_procedural", ""},
+        std::pair{"csg_block", ""}, std::pair{"teleop", ""}, std::pair{"teleop_gp7", "motoman_gp7"},
         std::pair{"knee_vhf", "knee_vhf_left"}}) {
     SCOPED_TRACE(name);
     SceneLoadOptions options;

@@ -38,7 +38,7 @@ TEST(ForceScale, ShippedScenesFitTheirForcesNotAHundredNewtons) {
   EXPECT_DOUBLE_EQ(force_display_scale_n(knee.world, 100.0), nice_force_ceiling_n(largest));
   EXPECT_LT(force_display_scale_n(knee.world, 100.0), 100.0);
   // The glove: each finger is rated 4 N, less than the knee's materials.
-  const SceneDescription hand = scene("knee_hand.json");
+  const SceneDescription hand = scene("knee_hand_procedural.json");
   EXPECT_DOUBLE_EQ(force_display_scale_n(hand.world, 4.0), 4.0);
   // A scene softer than its device: the scene's own ceiling.
   WorldDescription soft;

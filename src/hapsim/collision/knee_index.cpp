@@ -385,9 +385,17 @@ bool KneeIndex::plane_for_group(const Vec3& p, std::uint32_t gi, KneeCounters* c
 }
 
 // haptic path
-SurfacePoint KneeIndex::query(const Vec3& p, double margin_m, KneeCounters* counters) const {
+SurfacePoint KneeIndex::query(const Vec3& p, double margin_m, KneeCounters* counters,
+                              std::uint32_t* answered_group) const {
   SurfacePoint outside;   // best answer from a covering group that says "no contact"
   SurfacePoint fallback;  // first answer from a non-covering group
+  std::uint32_t outside_group = KneeQueryTrace::kNoGroup;
+  std::uint32_t fallback_group = KneeQueryTrace::kNoGroup;
+  const auto answered = [answered_group](std::uint32_t g) {
+    if (answered_group != nullptr) {
+      *answered_group = g;
+    }
+  };
   // The candidate whose cone the point's direction missed by the least: near a group border the ray
   // from each nearby centroid can pass beside that group's patch (the centroids differ, so the
   // cones leave gaps between them); rather than report "nothing here" for a point right at the
@@ -444,24 +452,61 @@ SurfacePoint KneeIndex::query(const Vec3& p, double margin_m, KneeCounters* coun
       }
       if (covers) {
         if (ans.signed_distance < 0.0) {
+          answered(cand[i].group);
           return ans;  // contact: the point is on the centroid's side of the plane
         }
         if (ans.signed_distance < outside.signed_distance) {
           outside = ans;
+          outside_group = cand[i].group;
         }
       } else if (!fallback.found()) {
         fallback = ans;
+        fallback_group = cand[i].group;
       }
     }
   }
   if (outside.found()) {
+    answered(outside_group);
     return outside;
   }
   if (!fallback.found() && uncovered != kNoTriangle) {
     bool covers = false;
     (void)plane_for_group(p, uncovered, counters, &fallback, &covers, /*use_cone=*/false);
+    fallback_group = uncovered;
   }
+  answered(fallback.found() ? fallback_group : KneeQueryTrace::kNoGroup);
   return fallback;
+}
+
+KneeQueryTrace KneeIndex::trace(const Vec3& p) const {
+  KneeQueryTrace t;
+  (void)query(p, options_.influence_margin_m, nullptr, &t.group);
+  if (t.group == KneeQueryTrace::kNoGroup) {
+    return t;
+  }
+  // The same angular selection as plane_for_group: largest dot product of the rest directions.
+  const Group& g = groups_[t.group];
+  const Vec3 d = (p - g.centroid_m).normalized();
+  const auto dx = static_cast<float>(d.x());
+  const auto dy = static_cast<float>(d.y());
+  const auto dz = static_cast<float>(d.z());
+  std::array<float, 3> best_dot;
+  best_dot.fill(-2.0f);
+  for (std::uint32_t e = g.entry_begin; e < g.entry_end; ++e) {
+    const float dot = ux_[e] * dx + uy_[e] * dy + uz_[e] * dz;
+    std::size_t k = std::min<std::size_t>(t.vertex_count, 2);
+    if (t.vertex_count == 3 && !(dot > best_dot[2])) {
+      continue;
+    }
+    for (; k > 0 && dot > best_dot[k - 1]; --k) {
+      best_dot[k] = best_dot[k - 1];
+      t.closest_vertices[k] = t.closest_vertices[k - 1];
+    }
+    best_dot[k] = dot;
+    t.closest_vertices[k] = entry_vertex_[e];
+    t.vertex_count = std::min<std::size_t>(t.vertex_count + 1, 3);
+  }
+  return t;
 }
 
 SurfacePoint KneeIndex::closest_point(const Vec3& p, QueryHint* hint) const {

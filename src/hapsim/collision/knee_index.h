@@ -1,4 +1,5 @@
-// The knee method (Burdea et al. 1994, §3.1.1; architecture.md#contact) as a selectable ProximityQuery:
+// The knee method (Burdea et al. 1994, §3.1.1; architecture.md#contact) as a selectable
+// ProximityQuery:
 //   segment bounding sphere → groups whose sphere of influence holds the point, deepest first →
 //   the group's vertices in spherical coordinates about its centroid → the three vertices
 //   closest in angle to the point → the plane through them → if the point is on the centroid's
@@ -19,6 +20,7 @@
 #include "hapsim/collision/proximity_query.h"
 #include "hapsim/geometry/triangle_mesh.h"
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -37,6 +39,18 @@ enum class KneeTripleRule : std::uint8_t {
   /// point's direction: the plane of the triangle the centroid's ray actually crosses. Falls
   /// back to kEnclosingOfFour.
   kEnclosingTriangle,
+};
+
+/// What one query looked at (the knee paper's Fig. 3, for display and tests): the group that
+/// answered and the three vertices closest in angle to the point about that group's centroid.
+struct KneeQueryTrace {
+  static constexpr std::uint32_t kNoGroup = ~std::uint32_t{0};
+  /// The group whose plane gave the answer; kNoGroup when the query found nothing.
+  std::uint32_t group = kNoGroup;
+  /// Mesh vertex ids (the group's owned and halo vertices), closest in angle first.
+  std::array<std::uint32_t, 3> closest_vertices{};
+  /// How many of closest_vertices are set: 3, fewer only for a group of fewer vertices.
+  std::size_t vertex_count = 0;
 };
 
 struct KneeIndexOptions {
@@ -89,6 +103,10 @@ class KneeIndex final : public ProximityQuery {
   /// As closest_point, also counting the work done.
   [[nodiscard]] SurfacePoint closest_point_counted(const Vec3& p, KneeCounters* counters) const;
 
+  /// The group closest_point(p) answers from and its three vertices closest in angle to p.
+  /// Not for the haptic path (a second scan of the group).
+  [[nodiscard]] KneeQueryTrace trace(const Vec3& p) const;
+
   /// The group that owns vertex `v`, and its unit radial direction about that group's centroid
   /// at rest: the direction the deformation model moves it along.
   [[nodiscard]] std::uint32_t vertex_group(std::uint32_t v) const { return vertex_group_[v]; }
@@ -125,7 +143,9 @@ class KneeIndex final : public ProximityQuery {
     double normal_spread_rad;  // largest angle between normals of triangles sharing a vertex
   };
 
-  SurfacePoint query(const Vec3& p, double margin_m, KneeCounters* counters) const;
+  /// `answered_group`, when given, gets the group whose plane answered (kNoGroup: none).
+  SurfacePoint query(const Vec3& p, double margin_m, KneeCounters* counters,
+                     std::uint32_t* answered_group = nullptr) const;
   /// Plane test of one group. Returns false when the point's direction from the centroid is
   /// outside the group's cone (nothing computed); otherwise fills `answer`, and `covers` tells
   /// whether the direction falls in the group's own patch (owned nearest vertex, enclosing

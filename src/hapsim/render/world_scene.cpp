@@ -1,6 +1,6 @@
 #include "hapsim/render/world_scene.h"
 
-#include "hapsim/collision/knee_groups.h"
+#include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/sphere_tree.h"
 #include "hapsim/core/error.h"
 #include "hapsim/kinematics/slave_shapes.h"
@@ -13,6 +13,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace hapsim {
@@ -29,7 +30,9 @@ struct WorldScene::Segment {
   int pad = -1;          // a rig's gripper pad (0, 1): green while it holds
   std::uint64_t version = ~std::uint64_t{0};  // none from a snapshot yet
   std::unique_ptr<SphereTree> tree;           // built when a sphere-tree level is first shown
-  std::vector<Vec3f> group_colours;           // built when group colouring is first asked for
+  std::unique_ptr<KneeIndex> knee;            // built when groups or their overlays are first shown
+  int group_colour_base = 0;                  // group g's colour: palette_colour(base + g)
+  std::vector<Vec3f> group_colours;           // per vertex, built with `knee`
 };
 
 namespace {
@@ -298,9 +301,114 @@ const std::string& WorldScene::segment_label(std::size_t flat_segment) const {
   return segments_.at(flat_segment)->label;
 }
 
-void WorldScene::apply_colouring() {
+const KneeIndex& WorldScene::knee_index(Segment& seg) {
+  if (!seg.knee) {
+    const TriangleMesh& rest =
+        world_.description().bodies[seg.body].segments[seg.index_in_body].mesh;
+    seg.knee = std::make_unique<KneeIndex>(rest);
+    seg.group_colour_base = next_group_colour_;
+    next_group_colour_ += static_cast<int>(seg.knee->group_count());
+    seg.group_colours.resize(rest.vertices.size());
+    for (std::size_t v = 0; v < rest.vertices.size(); ++v) {
+      seg.group_colours[v] =
+          palette_colour(seg.group_colour_base +
+                         static_cast<int>(seg.knee->vertex_group(static_cast<std::uint32_t>(v))));
+    }
+  }
+  return *seg.knee;
+}
+
+// The knee method's overlays belong to the segments it could answer for: shown, and neither a
+// sheet (its own field answers) nor a box drawn with flat faces.
+bool WorldScene::knee_overlays_apply(const Segment& seg) const {
+  return scene_.mesh(seg.mesh).visible && !seg.sheet && !seg.faceted;
+}
+
+// A sphere as three great circles (in the world's xy, yz and zx planes): lines light enough
+// that a dozen overlapping spheres still let the surface they wrap be seen.
+void WorldScene::add_circles(const Vec3& centre_world, double radius_m, const Vec3f& colour) {
+  constexpr int kSteps = 48;
+  for (int axis = 0; axis < 3; ++axis) {
+    const Vec3 u = Vec3::Unit((axis + 1) % 3);
+    const Vec3 v = Vec3::Unit((axis + 2) % 3);
+    const auto at = [&](int k) {
+      const double a = 2.0 * std::numbers::pi * k / kSteps;
+      return Vec3(centre_world + radius_m * (std::cos(a) * u + std::sin(a) * v));
+    };
+    for (int k = 0; k < kSteps; ++k) {
+      scene_.segments.push_back({at(k), at(k + 1), colour});
+    }
+  }
+}
+
+// The knee paper's Fig. 3: "the dark lines represent the spheres of influence of each group" and
+// "the three dark spheres near the tip of the finger represent the three vertices closest to the
+// point of possible contact".
+void WorldScene::add_knee_overlays() {
+  const auto dark = [](const Vec3f& c) { return Vec3f(0.45f * c); };
+  if (options_.show_influence_spheres) {
+    for (auto& seg : segments_) {
+      if (!knee_overlays_apply(*seg)) {
+        continue;
+      }
+      const KneeIndex& knee = knee_index(*seg);
+      const Iso3& X = body_poses_[seg->body];
+      for (std::uint32_t g = 0; g < knee.group_count(); ++g) {
+        add_circles(X * knee.group_centroid(g), knee.group_radius(g),
+                    dark(palette_colour(seg->group_colour_base + static_cast<int>(g))));
+      }
+    }
+  }
+  if (!options_.show_contact_vertices) {
+    return;
+  }
   const WorldDescription& d = world_.description();
-  int next_group_colour = 0;
+  const Vec3f marker(0.06f, 0.06f, 0.08f);
+  for (std::size_t tool = 0; tool < tools_.size() && tool < d.tools.size(); ++tool) {
+    // The paper's "point of possible contact": the centre of a tool that touches something (the
+    // skin over a shown muscle counts), as the method queries it, against the shown segment whose
+    // surface the method finds nearest, within a centimetre of the tool's surface.
+    if (tools_[tool].contact_count == 0) {
+      continue;
+    }
+    const double radius = d.tools[tool].radius_m;
+    Segment* nearest = nullptr;
+    KneeQueryTrace trace;
+    double nearest_gap_m = 0.01;
+    for (auto& seg : segments_) {
+      if (!knee_overlays_apply(*seg)) {
+        continue;
+      }
+      const Vec3 p_body = body_poses_[seg->body].inverse() * tools_[tool].p_world;
+      const KneeIndex& knee = knee_index(*seg);
+      const SurfacePoint sp = knee.closest_point(p_body);
+      if (sp.found() && sp.signed_distance - radius < nearest_gap_m) {
+        nearest_gap_m = sp.signed_distance - radius;
+        nearest = seg.get();
+        trace = knee.trace(p_body);
+      }
+    }
+    if (nearest == nullptr) {
+      continue;
+    }
+    // Where the vertices are drawn now (a deformed segment's dent moves them).
+    const std::vector<Vec3>& now = scene_.mesh(nearest->mesh).geometry().vertices;
+    const Iso3& X = body_poses_[nearest->body];
+    const double r = std::max(0.0008, 0.2 * radius);
+    std::array<Vec3, 3> p;
+    for (std::size_t k = 0; k < trace.vertex_count; ++k) {
+      p[k] = X * now[trace.closest_vertices[k]];
+      scene_.spheres.push_back({p[k], r, marker, false});
+    }
+    if (trace.vertex_count == 3) {
+      for (std::size_t k = 0; k < 3; ++k) {
+        scene_.segments.push_back({p[k], p[(k + 1) % 3], marker});
+      }
+    }
+  }
+}
+
+void WorldScene::apply_colouring() {
   for (std::size_t i = 0; i < segments_.size(); ++i) {
     Segment& seg = *segments_[i];
     RenderMesh& mesh = scene_.mesh(seg.mesh);
@@ -322,16 +430,7 @@ void WorldScene::apply_colouring() {
           scene_.set_vertex_colours(seg.mesh, {});
           break;
         }
-        if (seg.group_colours.empty()) {
-          const TriangleMesh& rest = d.bodies[seg.body].segments[seg.index_in_body].mesh;
-          const KneeGrouping grouping = build_knee_groups(rest);
-          seg.group_colours.resize(rest.vertices.size(), seg.tissue_colour);
-          for (std::size_t v = 0; v < grouping.vertex_group.size(); ++v) {
-            seg.group_colours[v] =
-                palette_colour(next_group_colour + static_cast<int>(grouping.vertex_group[v]));
-          }
-          next_group_colour += static_cast<int>(grouping.groups.size());
-        }
+        (void)knee_index(seg);
         scene_.set_vertex_colours(seg.mesh, seg.group_colours);
         break;
       }
@@ -478,6 +577,7 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
       }
     }
   }
+  add_knee_overlays();
   if (rig_) {
     add_rig_overlays();
   }

@@ -3,13 +3,14 @@
 // per segment / per vertex group (the knee paper's Fig. 3), deformed surfaces and sheets (their
 // live dent) re-uploaded when they change, the tools as spheres with their god-object proxies and
 // force arrows, an 'x' shadow mark on the floor under each tool, and optionally the sphere tree's
-// spheres at one level. A teleoperation rig's bodies are drawn as bodies too (the slave's links
-// robot orange, the palm and stem grey, the pads grey or green while they hold, the ball red, the
-// sheet light blue, darker where it is dented; its floor as the checked floor); what only a rig has
-// is drawn from the snapshot's teleop part: the master arm small as lines beside the scene, spheres
-// at the joints of a slave drawn as boxes, the shadow mark under the gripper. Updated each frame
-// from a WorldSnapshot (the viewer, off the haptic thread) or straight from the World (a headless
-// run, on the thread that steps it).
+// spheres at one level or the knee method's spheres of influence and a contact's three vertices. A
+// teleoperation rig's bodies are drawn as bodies too (the slave's links robot orange, the palm and
+// stem grey, the pads grey or green while they hold, the ball red, the sheet light blue, darker
+// where it is dented; its floor as the checked floor); what only a rig has is drawn from the
+// snapshot's teleop part: the master arm small as lines beside the scene, spheres at the joints of
+// a slave drawn as boxes, the shadow mark under the gripper. Updated each frame from a
+// WorldSnapshot (the viewer, off the haptic thread) or straight from the World (a headless run, on
+// the thread that steps it).
 #pragma once
 
 #include "hapsim/render/render_scene.h"
@@ -47,6 +48,14 @@ struct WorldSceneOptions {
   double master_display_scale = 0.5;
   /// Drums along a rig slave's joint axes (a chain drawn with rounded links).
   bool show_joints = true;
+  /// The knee method's overlays (the knee paper's Fig. 3), on the visible segments: each vertex
+  /// group's sphere of influence as three great circles in a dark shade of the group's colour ...
+  bool show_influence_spheres = false;
+  /// ... and, for each tool touching something within a centimetre of a visible segment (the
+  /// paper's "point of possible contact"; the nearest such segment), the three vertices closest in
+  /// angle to the tool about its group's centroid, whose plane the method tests, as dark spheres
+  /// joined by the triangle they span.
+  bool show_contact_vertices = false;
 };
 
 /// Colours of a rig's parts (RGB in [0, 1]): a Motoman in Yaskawa's blue, a red ball.
@@ -63,6 +72,7 @@ struct RigColours {
   Vec3f shadow = Vec3f(0.10f, 0.10f, 0.12f);
 };
 
+class KneeIndex;
 class SlaveFigure;
 
 class WorldScene {
@@ -114,6 +124,12 @@ class WorldScene {
   void shade_dent(Segment& seg);
   void add_sheet_grid(const Segment& seg);
   [[nodiscard]] bool hand_agrees_with_tools() const;
+  /// The segment's knee-method index on its rest mesh, built on first use (its groups colour the
+  /// segment and give the overlays).
+  const KneeIndex& knee_index(Segment& seg);
+  [[nodiscard]] bool knee_overlays_apply(const Segment& seg) const;
+  void add_knee_overlays();
+  void add_circles(const Vec3& centre_world, double radius_m, const Vec3f& colour);
   void rebuild_overlays(const std::vector<ToolState>& tools, const std::vector<double>& force_n);
   void add_rig_overlays();
   void add_master(const TeleopSnapshot& s);
@@ -127,6 +143,7 @@ class WorldScene {
   std::vector<Vec3f> scratch_colours_;
   std::vector<ToolState> tools_;
   std::vector<double> tool_force_n_;
+  int next_group_colour_ = 0;     // palette index of the next segment's first group
   std::vector<Iso3> body_poses_;  // where each body is drawn (dynamic bodies move)
   Box3 rest_bounds_world_;
   // A glove world's hand, as the last update saw it.
