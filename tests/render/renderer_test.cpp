@@ -3,6 +3,7 @@
 // pixels, per-vertex (Gouraud) interpolation, shadow marks where the floor point projects.
 #include "hapsim/render/renderer.h"
 
+#include "hapsim/geometry/mesh_validation.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/render/image_compare.h"
 #include "render/gl_test_context.h"
@@ -349,6 +350,22 @@ TEST(RenderScene, UpdatePositionsChecksTheVertexCount) {
   std::vector<Vec3> moved = scene.mesh(id).geometry().vertices;
   scene.update_positions(id, moved);
   EXPECT_NE(scene.mesh(id).vertex_stamp(), stamp);
+}
+
+// Only a closed, outward surface has its back faces culled: an open one (a cut mesh, a sheet)
+// and an inside-out one show their back faces, which culling would hide.
+TEST(RenderScene, OnlyClosedOutwardMeshesAreMarkedClosed) {
+  RenderScene scene;
+  const TriangleMesh box = make_box(Vec3::Ones());
+  EXPECT_TRUE(scene.mesh(scene.add_mesh(box, Vec3f::Ones())).closed());
+  EXPECT_TRUE(scene.mesh(scene.add_mesh(make_uv_sphere(1.0, 16, 8), Vec3f::Ones())).closed());
+  TriangleMesh open = box;
+  open.triangles.pop_back();
+  open.vertex_normals.clear();
+  EXPECT_FALSE(scene.mesh(scene.add_mesh(open, Vec3f::Ones())).closed());
+  TriangleMesh inside_out = box;
+  flip_orientation(inside_out);
+  EXPECT_FALSE(scene.mesh(scene.add_mesh(inside_out, Vec3f::Ones())).closed());
 }
 
 }  // namespace

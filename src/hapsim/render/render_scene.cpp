@@ -1,6 +1,7 @@
 #include "hapsim/render/render_scene.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/geometry/mesh_validation.h"
 
 #include <array>
 #include <atomic>
@@ -82,6 +83,8 @@ MeshId RenderScene::add_mesh(const TriangleMesh& mesh_M, const Vec3f& colour,
   if (m.geometry_.vertex_normals.size() != m.geometry_.vertices.size()) {
     m.geometry_.compute_vertex_normals();
   }
+  const MeshReport report = validate_mesh(m.geometry_);
+  m.closed_ = report.closed && report.inverted_components == 0 && report.signed_volume > 0.0;
   m.topology_stamp_ = next_stamp();
   m.vertex_stamp_ = next_stamp();
   return static_cast<MeshId>(meshes_.size() - 1);

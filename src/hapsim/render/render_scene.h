@@ -44,6 +44,10 @@ class RenderMesh {
 
   /// Positions (mesh frame, metres), triangles and vertex normals (kept current).
   [[nodiscard]] const TriangleMesh& geometry() const { return geometry_; }
+  /// A closed, consistently oriented surface with its normals outward (checked when added): its
+  /// back faces can never be seen from outside, so the renderer culls them (half the triangles a
+  /// software rasteriser must set up) and shades one side. Open sheets and cut meshes are false.
+  [[nodiscard]] bool closed() const { return closed_; }
   /// Per-vertex RGB colours, empty or one per vertex.
   [[nodiscard]] const std::vector<Vec3f>& vertex_colours() const { return vertex_colours_; }
   /// Unique stamps of the current triangles and of the current positions/normals/colours; the
@@ -57,6 +61,7 @@ class RenderMesh {
   std::vector<Vec3f> vertex_colours_;
   std::uint64_t topology_stamp_ = 0;
   std::uint64_t vertex_stamp_ = 0;
+  bool closed_ = false;
 };
 
 struct RenderSphere {

@@ -33,6 +33,7 @@ uniform vec3 u_ambient;
 uniform float u_specular;
 uniform float u_shininess;
 uniform float u_point_size;
+uniform bool u_two_sided;
 out vec3 v_front_colour;
 out vec3 v_back_colour;
 
@@ -57,7 +58,8 @@ void main() {
   vec3 n_camera = dot(n, n) > 0.0 ? normalize(n) : to_eye_camera;
   vec3 base = u_use_vertex_colour ? a_colour : u_colour;
   v_front_colour = shade(n_camera, to_eye_camera, base);
-  v_back_colour = shade(-n_camera, to_eye_camera, base);
+  // A closed mesh's back faces are culled: its back side needs no lighting.
+  v_back_colour = u_two_sided ? shade(-n_camera, to_eye_camera, base) : v_front_colour;
   gl_Position = u_projection * p_camera;
   gl_PointSize = u_point_size;
 }
@@ -232,7 +234,7 @@ struct GpuMesh {
 struct LitUniforms {
   GLint model_view = -1, projection = -1, colour = -1, use_vertex_colour = -1, light_count = -1,
         light_dir = -1, light_colour = -1, ambient = -1, specular = -1, shininess = -1,
-        point_size = -1, opacity = -1;
+        point_size = -1, opacity = -1, two_sided = -1;
 };
 
 }  // namespace
@@ -377,6 +379,7 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   s.lit_u.specular = loc(s.lit, "u_specular");
   s.lit_u.shininess = loc(s.lit, "u_shininess");
   s.lit_u.point_size = loc(s.lit, "u_point_size");
+  s.lit_u.two_sided = loc(s.lit, "u_two_sided");
   s.unlit_view_projection = loc(s.unlit, "u_view_projection");
   s.floor_view_projection = loc(s.floor, "u_view_projection");
   s.floor_cell = loc(s.floor, "u_cell_m");
@@ -458,6 +461,7 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);  // open sheets and cut meshes are seen from both sides
+  glCullFace(GL_BACK);      // closed meshes cull (RenderMesh::closed)
   glDisable(GL_BLEND);
   glEnable(GL_PROGRAM_POINT_SIZE);
 
@@ -570,6 +574,7 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   const float line_width = std::clamp(style.line_width_px, 1.0f, s.max_line_width);
   glLineWidth(line_width);
   glUniform1f(s.lit_u.opacity, 1.0f);
+  glUniform1i(s.lit_u.two_sided, 1);
   // Opaque meshes first; see-through ones (opacity < 1) last, blended, not writing depth.
   const auto draw_meshes = [&](bool translucent) {
     for (MeshId id = 0; id < scene.mesh_count(); ++id) {
@@ -579,6 +584,14 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
         continue;
       }
       glUniform1f(s.lit_u.opacity, m.opacity);
+      // Faces of a closed surface: its back faces culled (points and lines keep every one).
+      const bool cull = m.closed() && style.display_mode == DisplayMode::kFaces;
+      if (cull) {
+        glEnable(GL_CULL_FACE);
+      } else {
+        glDisable(GL_CULL_FACE);
+      }
+      glUniform1i(s.lit_u.two_sided, cull ? 0 : 1);
       set_matrix(s.lit_u.model_view, (X_camera_world * m.X_world_mesh.matrix()).cast<float>());
       const bool vertex_colours =
           style.colour_mode == ColourMode::kVertexColours && gpu.has_vertex_colours;
@@ -602,6 +615,8 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
       }
     }
     glUniform1f(s.lit_u.opacity, 1.0f);
+    glUniform1i(s.lit_u.two_sided, 1);
+    glDisable(GL_CULL_FACE);
   };
   draw_meshes(false);
 
