@@ -29,12 +29,12 @@ struct LodBuildOptions {
   /// A mesh with fewer triangles gets no coarser levels (its full mesh is cheap enough).
   std::size_t min_triangles = 256;
   /// Each level aims at this fraction of the triangles of the one before.
-  double reduction = 0.35;
+  double reduction = 0.5;
   /// No level reports an error above this fraction of the mesh's largest bounding-box side.
   double max_error_rel = 0.04;
   /// At most this many coarser levels; they stop early when the error limit stops a level
   /// from shedding at least a fifth of the one before's triangles, or at `min_triangles`/4.
-  int max_levels = 5;
+  int max_levels = 8;
 };
 
 /// The coarser levels of `mesh`, finest first (the full mesh itself is level 0 and not listed);

@@ -279,6 +279,7 @@ class Viewer {
       }
     }
     session_ = std::move(next);
+    session_->render_scene().style.level_of_detail = true;  // the window draws far meshes coarser
     built_once_ = true;
     // The scene's warnings, through the log as mesh defects are: once each, however often the
     // session is rebuilt (the JSON summary lists them all).
@@ -513,6 +514,7 @@ class Viewer {
       ImGui::SameLine();
       ImGui::RadioButton("faces", &mode, static_cast<int>(DisplayMode::kFaces));
       scene.style.display_mode = static_cast<DisplayMode>(mode);
+      ImGui::Checkbox("level of detail", &scene.style.level_of_detail);
       ImGui::Checkbox("floor", &scene.floor.visible);
       ImGui::SameLine();
       ImGui::Checkbox("room", &scene.room.visible);
@@ -590,6 +592,7 @@ class Viewer {
       // The haptic loop runs on the device host; this viewer only receives the served views.
       ImGui::Text("served views %.1f Hz", st.rate_hz);
       ImGui::Text("graphics %.1f fps (draw %.1f ms)", stats_.fps_recent, stats_.draw_ms_recent);
+      draw_triangle_line();
       return;
     }
     ImGui::Text("haptic %.1f Hz (%s)", st.rate_hz, st.realtime_priority ? "SCHED_FIFO" : "normal");
@@ -601,6 +604,14 @@ class Viewer {
                          static_cast<unsigned long long>(st.stall_events));
     }
     ImGui::Text("graphics %.1f fps (draw %.1f ms)", stats_.fps_recent, stats_.draw_ms_recent);
+    draw_triangle_line();
+  }
+
+  // How much the levels of detail saved in the last frame.
+  void draw_triangle_line() const {
+    const RenderStats& r = renderer_->last_frame_stats();
+    ImGui::Text("triangles %zu of %zu (%zu meshes coarser)", r.triangles_drawn, r.triangles_full,
+                r.meshes_coarser);
   }
 
   int finish(double wall_s) {
@@ -628,6 +639,9 @@ class Viewer {
                   stats_.frames, wall_s, fps, frame_p50, frame_p99);
       std::printf("cpu/frame    viewer thread %.1f ms, rasteriser threads %.1f ms\n", viewer_cpu_ms,
                   raster_cpu_ms);
+      std::printf("triangles    %zu drawn of %zu in the last frame (levels of detail)\n",
+                  renderer_->last_frame_stats().triangles_drawn,
+                  renderer_->last_frame_stats().triangles_full);
       if (session_->runs_haptic_loop()) {
         std::printf(
             "haptic       %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f "
@@ -659,6 +673,8 @@ class Viewer {
       j["wall_s"] = wall_s;
       j["fps"] = fps;
       j["frame_ms"] = {{"p50", frame_p50}, {"p99", frame_p99}};
+      j["triangles_last_frame"] = {{"drawn", renderer_->last_frame_stats().triangles_drawn},
+                                   {"full", renderer_->last_frame_stats().triangles_full}};
       j["cpu_ms_per_frame"] = {{"viewer_thread", viewer_cpu_ms},
                                {"rasteriser_threads", raster_cpu_ms}};
       j["window"] = {options_.width_px, options_.height_px};
