@@ -3,6 +3,7 @@
 // pixels, per-vertex (Gouraud) interpolation, shadow marks where the floor point projects.
 #include "hapsim/render/renderer.h"
 
+#include "hapsim/geometry/mesh_validation.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/render/image_compare.h"
 #include "render/gl_test_context.h"
@@ -217,6 +218,33 @@ TEST_F(RendererTest, HiddenMeshDrawsNothing) {
   EXPECT_EQ(d.max_abs_diff, 0) << d.describe();
 }
 
+// Levels of detail by screen size: a detailed sphere close up is drawn in full; far away a
+// coarser level is drawn, and its picture is the full mesh's within a few edge pixels (no hole,
+// no shift); with level_of_detail off, always in full.
+TEST_F(RendererTest, FarMeshesDrawACoarserLevelThatLooksTheSame) {
+  RenderScene scene = plain_scene();
+  scene.add_mesh(make_bumpy_sphere(20000, 0.05), Vec3f(0.8f, 0.7f, 0.6f));
+  ASSERT_FALSE(scene.mesh(0).lod_levels().empty());
+  scene.style.level_of_detail = true;
+  OrbitCamera cam = side_camera();
+  cam.distance_m = 0.08;  // close up: the sphere overfills the view
+  render(scene, cam);
+  const RenderStats near = gl_.renderer->last_frame_stats();
+  EXPECT_EQ(near.triangles_drawn, near.triangles_full);
+  cam.distance_m = 2.0;  // a few dozen pixels across
+  // Hysteresis: the level settles over a couple of frames.
+  render(scene, cam);
+  const auto coarse = render(scene, cam);
+  const RenderStats far = gl_.renderer->last_frame_stats();
+  EXPECT_LT(far.triangles_drawn, far.triangles_full / 2);
+  EXPECT_EQ(far.meshes_coarser, 1u);
+  scene.style.level_of_detail = false;
+  const auto full = render(scene, cam);
+  EXPECT_EQ(gl_.renderer->last_frame_stats().triangles_drawn, far.triangles_full);
+  const ImageDiff d = compare_images(full, coarse, kW, kH);
+  EXPECT_LT(d.differing_fraction, 0.01) << d.describe();
+}
+
 TEST_F(RendererTest, UpdatedPositionsChangeOnlyTheDentedRegion) {
   RenderScene scene = plain_scene();
   const TriangleMesh sphere = make_uv_sphere(1.0, 64, 32);
@@ -349,6 +377,22 @@ TEST(RenderScene, UpdatePositionsChecksTheVertexCount) {
   std::vector<Vec3> moved = scene.mesh(id).geometry().vertices;
   scene.update_positions(id, moved);
   EXPECT_NE(scene.mesh(id).vertex_stamp(), stamp);
+}
+
+// Only a closed, outward surface has its back faces culled: an open one (a cut mesh, a sheet)
+// and an inside-out one show their back faces, which culling would hide.
+TEST(RenderScene, OnlyClosedOutwardMeshesAreMarkedClosed) {
+  RenderScene scene;
+  const TriangleMesh box = make_box(Vec3::Ones());
+  EXPECT_TRUE(scene.mesh(scene.add_mesh(box, Vec3f::Ones())).closed());
+  EXPECT_TRUE(scene.mesh(scene.add_mesh(make_uv_sphere(1.0, 16, 8), Vec3f::Ones())).closed());
+  TriangleMesh open = box;
+  open.triangles.pop_back();
+  open.vertex_normals.clear();
+  EXPECT_FALSE(scene.mesh(scene.add_mesh(open, Vec3f::Ones())).closed());
+  TriangleMesh inside_out = box;
+  flip_orientation(inside_out);
+  EXPECT_FALSE(scene.mesh(scene.add_mesh(inside_out, Vec3f::Ones())).closed());
 }
 
 }  // namespace

@@ -1,7 +1,9 @@
 #include "hapsim/render/render_scene.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/geometry/mesh_validation.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -82,6 +84,16 @@ MeshId RenderScene::add_mesh(const TriangleMesh& mesh_M, const Vec3f& colour,
   if (m.geometry_.vertex_normals.size() != m.geometry_.vertices.size()) {
     m.geometry_.compute_vertex_normals();
   }
+  m.lod_levels_ = build_lod_levels(m.geometry_);
+  if (!m.geometry_.vertices.empty()) {
+    const Box3 box = m.geometry_.bounds();
+    m.bounding_centre_M_ = box.center();
+    for (const Vec3& v : m.geometry_.vertices) {
+      m.bounding_radius_m_ = std::max(m.bounding_radius_m_, (v - m.bounding_centre_M_).norm());
+    }
+  }
+  const MeshReport report = validate_mesh(m.geometry_);
+  m.closed_ = report.closed && report.inverted_components == 0 && report.signed_volume > 0.0;
   m.topology_stamp_ = next_stamp();
   m.vertex_stamp_ = next_stamp();
   return static_cast<MeshId>(meshes_.size() - 1);
@@ -124,6 +136,14 @@ void RenderScene::update_positions(MeshId id, std::span<const Vec3> positions_M)
   std::copy(positions_M.begin(), positions_M.end(), m.geometry_.vertices.begin());
   m.geometry_.compute_vertex_normals();  // assign() reuses the normals' storage
   m.vertex_stamp_ = next_stamp();
+}
+
+void RenderScene::drop_lod_levels(MeshId id) {
+  RenderMesh& m = checked(id, "RenderScene::drop_lod_levels");
+  if (!m.lod_levels_.empty()) {
+    m.lod_levels_.clear();
+    m.topology_stamp_ = next_stamp();
+  }
 }
 
 void RenderScene::set_vertex_colours(MeshId id, std::span<const Vec3f> colours) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "hapsim/core/types.h"
+#include "hapsim/geometry/mesh_lod.h"
 #include "hapsim/geometry/triangle_mesh.h"
 
 #include <cstdint>
@@ -44,6 +45,17 @@ class RenderMesh {
 
   /// Positions (mesh frame, metres), triangles and vertex normals (kept current).
   [[nodiscard]] const TriangleMesh& geometry() const { return geometry_; }
+  /// A closed, consistently oriented surface with its normals outward (checked when added): its
+  /// back faces can never be seen from outside, so the renderer culls them (half the triangles a
+  /// software rasteriser must set up) and shades one side. Open sheets and cut meshes are false.
+  [[nodiscard]] bool closed() const { return closed_; }
+  /// Coarser triangle lists over the same vertices for drawing far away (geometry/mesh_lod.h),
+  /// built when the mesh is added; empty for a small mesh. The renderer picks one per frame by
+  /// its error on screen (render/lod_selection.h); new positions move every level alike.
+  [[nodiscard]] const std::vector<LodLevel>& lod_levels() const { return lod_levels_; }
+  /// A sphere around the mesh at rest, mesh frame: where the levels' screen error is measured.
+  [[nodiscard]] const Vec3& bounding_centre_M() const { return bounding_centre_M_; }
+  [[nodiscard]] double bounding_radius_m() const { return bounding_radius_m_; }
   /// Per-vertex RGB colours, empty or one per vertex.
   [[nodiscard]] const std::vector<Vec3f>& vertex_colours() const { return vertex_colours_; }
   /// Unique stamps of the current triangles and of the current positions/normals/colours; the
@@ -57,6 +69,10 @@ class RenderMesh {
   std::vector<Vec3f> vertex_colours_;
   std::uint64_t topology_stamp_ = 0;
   std::uint64_t vertex_stamp_ = 0;
+  bool closed_ = false;
+  std::vector<LodLevel> lod_levels_;
+  Vec3 bounding_centre_M_ = Vec3::Zero();
+  double bounding_radius_m_ = 0.0;
 };
 
 struct RenderSphere {
@@ -150,6 +166,14 @@ struct RenderStyle {
   float point_size_px = 3.0f;
   /// Width of segments and of mesh edges in kLines (clamped to what the driver supports).
   float line_width_px = 1.0f;
+  /// Draw far meshes at a coarser level of detail (the viewer turns it on; snapshots and the
+  /// reference pictures draw full meshes: at their sizes Gouraud shading over coarse triangles
+  /// shows) (RenderMesh::lod_levels), one whose error
+  /// looks no larger than `lod_max_error_px` on screen (its reported error, a bound about twice
+  /// the typical true one: 2 px looks the same as the full mesh on the VHF knee); off: always the
+  /// full meshes.
+  bool level_of_detail = false;
+  double lod_max_error_px = 2.0;
 };
 
 class RenderScene {
@@ -163,6 +187,9 @@ class RenderScene {
   /// New positions for a deforming mesh (same vertex count and order); recomputes its vertex
   /// normals. Allocation-free after the first call. Throws hapsim::Error on a size mismatch.
   void update_positions(MeshId id, std::span<const Vec3> positions_M);
+  /// Drops a mesh's coarser levels (it is always drawn in full): for a mesh whose detail comes
+  /// from its deformation, not its rest shape (a sheet: flat at rest, its levels lose the dent).
+  void drop_lod_levels(MeshId id);
   /// Per-vertex colours (one per vertex), or an empty span to go back to the mesh colour.
   void set_vertex_colours(MeshId id, std::span<const Vec3f> colours);
 

@@ -3,12 +3,14 @@
 #include "hapsim/core/error.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/render/gl_api.h"
+#include "hapsim/render/lod_selection.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
+#include <span>
 #include <vector>
 
 namespace hapsim {
@@ -33,6 +35,7 @@ uniform vec3 u_ambient;
 uniform float u_specular;
 uniform float u_shininess;
 uniform float u_point_size;
+uniform bool u_two_sided;
 out vec3 v_front_colour;
 out vec3 v_back_colour;
 
@@ -57,7 +60,8 @@ void main() {
   vec3 n_camera = dot(n, n) > 0.0 ? normalize(n) : to_eye_camera;
   vec3 base = u_use_vertex_colour ? a_colour : u_colour;
   v_front_colour = shade(n_camera, to_eye_camera, base);
-  v_back_colour = shade(-n_camera, to_eye_camera, base);
+  // A closed mesh's back faces are culled: its back side needs no lighting.
+  v_back_colour = u_two_sided ? shade(-n_camera, to_eye_camera, base) : v_front_colour;
   gl_Position = u_projection * p_camera;
   gl_PointSize = u_point_size;
 }
@@ -200,6 +204,12 @@ struct GpuMesh {
   GLuint ibo = 0;
   GLsizei vertex_count = 0;
   GLsizei index_count = 0;
+  // Levels of detail: level 0 (the full mesh) then the coarser ones, back to back in the one
+  // index buffer (first index and count each), their errors, the level drawn last.
+  std::vector<GLsizei> level_first;
+  std::vector<GLsizei> level_count;
+  std::vector<double> level_error_m;
+  std::size_t level = 0;
   bool has_vertex_colours = false;
   std::uint64_t topology_stamp = 0;
   std::uint64_t vertex_stamp = 0;
@@ -232,7 +242,7 @@ struct GpuMesh {
 struct LitUniforms {
   GLint model_view = -1, projection = -1, colour = -1, use_vertex_colour = -1, light_count = -1,
         light_dir = -1, light_colour = -1, ambient = -1, specular = -1, shininess = -1,
-        point_size = -1, opacity = -1;
+        point_size = -1, opacity = -1, two_sided = -1;
 };
 
 }  // namespace
@@ -254,9 +264,10 @@ struct Renderer::Impl {
   GLuint stream_vbo = 0;
   std::size_t stream_capacity_bytes = 0;
   std::vector<float> staging;  // reused for uploads and the per-frame stream
+  RenderStats stats;
 
   void upload(GpuMesh& gpu, const TriangleMesh& geometry, const std::vector<Vec3f>& colours,
-              bool topology_changed) {
+              bool topology_changed, std::span<const LodLevel> levels = {}) {
     const std::size_t n = geometry.vertices.size();
     staging.resize(n * kLitFloats);
     for (std::size_t i = 0; i < n; ++i) {
@@ -283,12 +294,34 @@ struct Renderer::Impl {
       glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, staging.data());
     }
     if (topology_changed) {
+      gpu.level_first.assign(1, 0);
+      gpu.level_count.assign(1, static_cast<GLsizei>(geometry.triangles.size() * 3));
+      gpu.level_error_m.assign(1, 0.0);
+      gpu.level = 0;
+      std::size_t triangles = geometry.triangles.size();
+      for (const LodLevel& l : levels) {
+        gpu.level_first.push_back(static_cast<GLsizei>(3 * triangles));
+        gpu.level_count.push_back(static_cast<GLsizei>(3 * l.triangles.size()));
+        gpu.level_error_m.push_back(l.error_m);
+        triangles += l.triangles.size();
+      }
       glBindVertexArray(gpu.vao);  // the element buffer binding is VAO state
       glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, gpu.ibo);
       glBufferData(GL_ELEMENT_ARRAY_BUFFER,
-                   static_cast<GLsizeiptr>(geometry.triangles.size() * sizeof(TriangleIndices)),
-                   geometry.triangles.data(), GL_STATIC_DRAW);
-      gpu.index_count = static_cast<GLsizei>(geometry.triangles.size() * 3);
+                   static_cast<GLsizeiptr>(triangles * sizeof(TriangleIndices)), nullptr,
+                   GL_STATIC_DRAW);
+      glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0,
+                      static_cast<GLsizeiptr>(geometry.triangles.size() * sizeof(TriangleIndices)),
+                      geometry.triangles.data());
+      for (std::size_t i = 0; i < levels.size(); ++i) {
+        glBufferSubData(
+            GL_ELEMENT_ARRAY_BUFFER,
+            static_cast<GLintptr>(gpu.level_first[i + 1]) *
+                static_cast<GLintptr>(sizeof(std::uint32_t)),
+            static_cast<GLsizeiptr>(levels[i].triangles.size() * sizeof(TriangleIndices)),
+            levels[i].triangles.data());
+      }
+      gpu.index_count = gpu.level_count[0];
     }
     glBindVertexArray(0);
     gpu.vertex_count = static_cast<GLsizei>(n);
@@ -307,7 +340,7 @@ struct Renderer::Impl {
       }
       const bool topology_changed = gpu.topology_stamp != m.topology_stamp();
       if (topology_changed || gpu.vertex_stamp != m.vertex_stamp()) {
-        upload(gpu, m.geometry(), m.vertex_colours(), topology_changed);
+        upload(gpu, m.geometry(), m.vertex_colours(), topology_changed, m.lod_levels());
         gpu.topology_stamp = m.topology_stamp();
         gpu.vertex_stamp = m.vertex_stamp();
       }
@@ -377,6 +410,7 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
   s.lit_u.specular = loc(s.lit, "u_specular");
   s.lit_u.shininess = loc(s.lit, "u_shininess");
   s.lit_u.point_size = loc(s.lit, "u_point_size");
+  s.lit_u.two_sided = loc(s.lit, "u_two_sided");
   s.unlit_view_projection = loc(s.unlit, "u_view_projection");
   s.floor_view_projection = loc(s.floor, "u_view_projection");
   s.floor_cell = loc(s.floor, "u_cell_m");
@@ -431,6 +465,10 @@ Renderer::~Renderer() {
   glDeleteProgram(s.floor);
 }
 
+const RenderStats& Renderer::last_frame_stats() const {
+  return impl_->stats;
+}
+
 std::string Renderer::gl_version() const {
   const auto* version = glGetString(GL_VERSION);
   return version != nullptr ? reinterpret_cast<const char*>(version) : "";
@@ -458,6 +496,7 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);  // open sheets and cut meshes are seen from both sides
+  glCullFace(GL_BACK);      // closed meshes cull (RenderMesh::closed)
   glDisable(GL_BLEND);
   glEnable(GL_PROGRAM_POINT_SIZE);
 
@@ -467,6 +506,7 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   const Eigen::Matrix4f projection = P.cast<float>();
 
   s.sync_meshes(scene);
+  s.stats = RenderStats{};
 
   // Floor and shadow marks share one streamed buffer with the segments: one upload per frame.
   s.staging.clear();
@@ -570,15 +610,25 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
   const float line_width = std::clamp(style.line_width_px, 1.0f, s.max_line_width);
   glLineWidth(line_width);
   glUniform1f(s.lit_u.opacity, 1.0f);
+  glUniform1i(s.lit_u.two_sided, 1);
   // Opaque meshes first; see-through ones (opacity < 1) last, blended, not writing depth.
+  const Vec3 eye_world = camera.eye_world();
   const auto draw_meshes = [&](bool translucent) {
     for (MeshId id = 0; id < scene.mesh_count(); ++id) {
       const RenderMesh& m = scene.mesh(id);
-      const GpuMesh& gpu = s.meshes[id];
+      GpuMesh& gpu = s.meshes[id];
       if (!m.visible || gpu.vertex_count == 0 || (m.opacity < 1.0f) != translucent) {
         continue;
       }
       glUniform1f(s.lit_u.opacity, m.opacity);
+      // Faces of a closed surface: its back faces culled (points and lines keep every one).
+      const bool cull = m.closed() && style.display_mode == DisplayMode::kFaces;
+      if (cull) {
+        glEnable(GL_CULL_FACE);
+      } else {
+        glDisable(GL_CULL_FACE);
+      }
+      glUniform1i(s.lit_u.two_sided, cull ? 0 : 1);
       set_matrix(s.lit_u.model_view, (X_camera_world * m.X_world_mesh.matrix()).cast<float>());
       const bool vertex_colours =
           style.colour_mode == ColourMode::kVertexColours && gpu.has_vertex_colours;
@@ -586,6 +636,23 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
       set_vec3(s.lit_u.colour, style.colour_mode == ColourMode::kPalette
                                    ? palette_colour(static_cast<int>(id))
                                    : m.colour);
+      // The level of detail: by the error it would show where the mesh comes nearest the eye.
+      std::size_t level = 0;
+      if (style.level_of_detail && gpu.level_error_m.size() > 1) {
+        const Vec3 centre_world = m.X_world_mesh * m.bounding_centre_M();
+        const double distance_m = (centre_world - eye_world).norm() - m.bounding_radius_m();
+        const double px_per_m =
+            pixels_per_metre(distance_m, camera.near_m(), camera.fov_y_rad, height_px);
+        gpu.level =
+            select_lod_level(gpu.level_error_m, px_per_m, gpu.level,
+                             {style.lod_max_error_px, LodSelectionOptions{}.coarsen_fraction});
+        level = gpu.level;
+      }
+      const GLsizei count = gpu.level_count[level];
+      const void* first = byte_offset(static_cast<std::size_t>(gpu.level_first[level]));
+      s.stats.triangles_drawn += static_cast<std::size_t>(count / 3);
+      s.stats.triangles_full += static_cast<std::size_t>(gpu.level_count[0] / 3);
+      s.stats.meshes_coarser += level > 0 ? 1 : 0;
       glBindVertexArray(gpu.vao);
       switch (style.display_mode) {
         case DisplayMode::kPoints:
@@ -593,15 +660,17 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
           break;
         case DisplayMode::kLines:
           glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
-          glDrawElements(GL_TRIANGLES, gpu.index_count, GL_UNSIGNED_INT, nullptr);
+          glDrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, first);
           glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
           break;
         case DisplayMode::kFaces:
-          glDrawElements(GL_TRIANGLES, gpu.index_count, GL_UNSIGNED_INT, nullptr);
+          glDrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, first);
           break;
       }
     }
     glUniform1f(s.lit_u.opacity, 1.0f);
+    glUniform1i(s.lit_u.two_sided, 1);
+    glDisable(GL_CULL_FACE);
   };
   draw_meshes(false);
 

@@ -8,10 +8,21 @@
 #include "hapsim/render/camera.h"
 #include "hapsim/render/render_scene.h"
 
+#include <cstddef>
 #include <memory>
 #include <string>
 
 namespace hapsim {
+
+/// What the last draw drew (a stereo pair: its last eye).
+struct RenderStats {
+  /// Mesh triangles drawn, at the levels of detail chosen.
+  std::size_t triangles_drawn = 0;
+  /// The same meshes' triangles at full detail.
+  std::size_t triangles_full = 0;
+  /// Meshes drawn at a coarser level than the full mesh.
+  std::size_t meshes_coarser = 0;
+};
 
 class Renderer {
  public:
@@ -32,6 +43,8 @@ class Renderer {
   /// coordinates (y up); only that rectangle is cleared (a window draws panels around it).
   void draw_in(const RenderScene& scene, const OrbitCamera& camera, int x_px, int y_px,
                int width_px, int height_px);
+
+  [[nodiscard]] const RenderStats& last_frame_stats() const;
 
   /// "4.5 (Core Profile) Mesa 22.3.6" etc., for logs.
   [[nodiscard]] std::string gl_version() const;

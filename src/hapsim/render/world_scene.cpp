@@ -137,6 +137,9 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
       seg->mesh = scene_.add_mesh(role.box ? with_creased_normals(sd.mesh, 0.0) : sd.mesh,
                                   seg->tissue_colour, world.body_pose(b));
       scene_.mesh(seg->mesh).name = seg->label;
+      if (seg->sheet) {
+        scene_.drop_lod_levels(seg->mesh);  // flat at rest: the dent is all its detail
+      }
       scene_.mesh(seg->mesh).opacity = static_cast<float>(m.opacity);
       // A rig's floor is a slab much wider than the scene: the checked floor stands for it.
       scene_.mesh(seg->mesh).visible = !role.floor;
