@@ -53,9 +53,11 @@ run "$KNEE_HAND" --duration 1.18 --only-segments "$MUSCLE" --colours groups \
 # dent shows in the outline.
 run "$KNEE_HAND" --duration 1.8 --only-segments "$MUSCLE" --colours groups --overlay influence \
   --camera 0.2,-0.06,0.12,0.02,0.03,0.09,36 --snapshot "$OUT/001-fig5-deformed-segment.png"
-# Fig. 6: the hand touching the muscle in the room, as the user sees it (the skin hidden: the
-# paper's model went "from the inner layer of skin to bones").
-run "$KNEE_HAND" --duration 1.8 --view fig6 --room --hide-segments Skin \
+# Fig. 6: the hand touching the muscle in the room (the skin hidden: the paper's model went "from
+# the inner layer of skin to bones"), seen from the medial side so the pressing index finger and
+# the curled others show; the scene's own "fig6" view (from the front) hides the finger behind
+# the hand.
+run "$KNEE_HAND" --duration 1.8 --camera 0.5,0.12,0.21,0.0,0.03,0.12,40 --room --hide-segments Skin \
   --snapshot "$OUT/001-fig6-hand-touching-muscle.png"
 
 echo "make-figures: 6 figures in $OUT"
