@@ -5,6 +5,7 @@
 #include "dds_options.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/render/snapshot_writer.h"
 #include "hapsim/ui/viewer.h"
 
 #include <algorithm>
@@ -30,6 +31,9 @@ struct ViewArgs {
   std::string stereo = "off";
   double eye_separation_m = 0.0;
   double duration_s = 0.0;
+  std::string view;
+  std::string camera;
+  bool room = false;
   std::string screenshot;
   std::string first_screenshot;
   std::string json;
@@ -74,7 +78,28 @@ void view(const ViewArgs& args) {
     throw CommandError("--eye-separation: expected metres >= 0 (0: a thirtieth of the distance)");
   }
   o.eye_separation_m = args.eye_separation_m;
+  if (!std::isfinite(args.duration_s)) {
+    throw CommandError("--duration: expected seconds >= 0 (0: until the window is closed)");
+  }
   o.duration_s = args.duration_s;
+  if (args.connect && (!args.view.empty() || args.room)) {
+    throw CommandError(std::string(!args.view.empty() ? "--view" : "--room") +
+                       ": a scene file's option; --connect takes the scene from the host "
+                       "(--camera works)");
+  }
+  if (!args.view.empty() && !args.camera.empty()) {
+    throw CommandError("--view and --camera: give one of them");
+  }
+  if (!args.camera.empty()) {
+    try {
+      (void)parse_camera_spec(args.camera);  // a bad spec fails before the window opens
+    } catch (const Error& e) {
+      throw CommandError(e.what());
+    }
+  }
+  o.view = args.view;
+  o.camera = args.camera;
+  o.room = args.room;
   o.screenshot = args.screenshot;
   o.first_screenshot = args.first_screenshot;
   o.json = args.json;
@@ -133,6 +158,13 @@ void add_view_command(CLI::App& app) {
       ->check(CLI::Range(0, 16));
   cmd->add_option("--duration", args->duration_s, "Close after S seconds (default: when closed)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--view", args->view,
+                  "Look first from the scene's named view NAME (its \"views\")");
+  cmd->add_option("--camera", args->camera,
+                  "Look first from EYE to TARGET: ex,ey,ez,tx,ty,tz,fov (metres, world frame; "
+                  "field of view in degrees)");
+  cmd->add_flag("--room", args->room,
+                "Show the knee paper's room (walls and floor) from the start");
   cmd->add_option("--screenshot", args->screenshot, "Write the last frame to FILE.png");
   cmd->add_option("--first-screenshot", args->first_screenshot,
                   "Write an early frame (the scene at rest) to FILE.png");

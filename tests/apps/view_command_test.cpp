@@ -13,6 +13,9 @@
 
 #include <cstdlib>
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace hapsim {
 namespace {
@@ -104,6 +107,84 @@ TEST(ViewCommand, PrintsTheScenesWarningsOnceAndListsThemInItsJson) {
   const nlohmann::json j = nlohmann::json::parse(in);
   ASSERT_EQ(j.at("warnings").size(), 1u);
   EXPECT_EQ(j["warnings"][0].get<std::string>().rfind(warning, 0), 0u) << j["warnings"];
+}
+
+// One picture of `view SCENE OPTIONS` with the panels hidden: the mouse probe is never moved, so
+// the scene stands still and pictures taken with different cameras compare.
+RgbaImage view_picture(const std::string& scene, const std::string& options,
+                       const std::string& name) {
+  const auto png = test::temp_path(name + ".png");
+  const auto log = test::temp_path(name + ".log");
+  const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' ") + HAPSIM_BIN_PATH +
+                          " view " + HAPSIM_SCENES_DIR + "/" + scene +
+                          " --duration 1.5 --no-panels --size 640x360 -q " + options +
+                          " --screenshot " + png.string() + " > " + log.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(log);
+  const std::string output((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << cmd << "\n" << output;
+  return read_png(png.string());
+}
+
+double differing(const RgbaImage& a, const RgbaImage& b) {
+  return compare_images(a.rgba, b.rgba, a.width, a.height).differing_fraction;
+}
+
+TEST(ViewCommand, StartsFromTheScenesNamedViewOrAGivenCameraWithTheRoom) {
+  if (!have("xvfb-run")) {
+    GTEST_SKIP() << "xvfb-run missing (scripts/setup.sh installs it)";
+  }
+  // knee_hand_procedural.json's view "front": eye (0, 0.45, 0.1), target (0, 0, 0), 45 degrees.
+  const std::string scene = "knee_hand_procedural.json";
+  const RgbaImage named = view_picture(scene, "--view front", "view_named");
+  const RgbaImage given = view_picture(scene, "--camera 0,0.45,0.1,0,0,0,45", "view_given");
+  const RgbaImage framed = view_picture(scene, "", "view_framed");
+  const RgbaImage room = view_picture(scene, "--room", "view_room");
+  ASSERT_EQ(named.width, 640);
+  EXPECT_LT(differing(named, given), 0.01);  // the view is that camera
+  EXPECT_GT(differing(named, framed), 0.1);  // and not the default framing
+  // The room's walls (RenderRoom's colour, unlit, one wall darker) fill part of the picture
+  // with --room and none without it.
+  const auto walls = [](const RgbaImage& image) {
+    return count_colour(image, {199, 194, 178, 255}, 0, 0, image.width, image.height) +
+           count_colour(image, {169, 165, 152, 255}, 0, 0, image.width, image.height);
+  };
+  EXPECT_GT(walls(room), 640 * 360 / 10);
+  EXPECT_EQ(walls(framed), 0);
+}
+
+TEST(ViewCommand, BadCameraOptionsAreOneLineBeforeAnyWindow) {
+  const std::string knee = std::string(HAPSIM_SCENES_DIR) + "/knee_procedural.json";
+  for (const auto& [options, says] : std::vector<std::pair<std::string, std::string>>{
+           {"--duration nan", "--duration"},
+           {"--camera 1,2", "--camera"},
+           {"--view front --camera 0,0,1,0,0,0,40", "give one of them"},
+       }) {
+    const auto r = test::run_hapsim("view " + knee + " " + options);
+    EXPECT_EQ(r.exit_code, 2) << options << ": " << r.output;
+    EXPECT_NE(r.output.find(says), std::string::npos) << options << ": " << r.output;
+  }
+  const auto r = test::run_hapsim("view --connect --view front");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--connect takes the scene from the host"), std::string::npos)
+      << r.output;
+}
+
+TEST(ViewCommand, AnUnknownViewNamesTheScenesViews) {
+  if (!have("xvfb-run")) {
+    GTEST_SKIP() << "xvfb-run missing (scripts/setup.sh installs it)";
+  }
+  const auto log = test::temp_path("view_unknown.log");
+  const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' ") + HAPSIM_BIN_PATH +
+                          " view " + HAPSIM_SCENES_DIR +
+                          "/knee_hand_procedural.json --view nope --duration 1 > " + log.string() +
+                          " 2>&1";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(log);
+  const std::string output((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 2) << output;
+  EXPECT_NE(output.find("--view nope: the scene has the views fig6, front"), std::string::npos)
+      << output;
 }
 
 TEST(ViewCommand, NoDisplayIsAClearError) {

@@ -28,6 +28,10 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
 
 // glReadPixels and friends without a loader (glvnd's libOpenGL exports the core functions).
 #define GL_GLEXT_PROTOTYPES
@@ -56,14 +60,44 @@ void on_scroll(GLFWwindow* window, double /*x*/, double y) {
   }
 }
 
-std::unique_ptr<ViewerSession> make_session(const ViewerConfig& config) {
+// `views`: the scene file's named views (none for a connected viewer, whose scene is the host's).
+std::unique_ptr<ViewerSession> make_session(const ViewerConfig& config,
+                                            std::vector<SceneView>* views = nullptr) {
   if (config.connect) {
     return make_net_viewer_session(config);
   }
   SceneLoadOptions load;
   load.data_dir = config.data_dir;
   const SceneDescription scene = load_scene(config.scene, load);
+  if (views != nullptr) {
+    *views = scene.views;
+  }
   return make_viewer_session(config, scene);
+}
+
+// The camera ViewerOptions::view or ::camera asked for, none when neither did. Error (one line)
+// for both, a bad spec, or a view the scene does not have (naming the ones it has).
+std::optional<OrbitCamera> first_camera(const ViewerOptions& options,
+                                        const std::vector<SceneView>& views) {
+  if (!options.view.empty() && !options.camera.empty()) {
+    throw Error("--view and --camera", "give one of them");
+  }
+  if (!options.camera.empty()) {
+    return parse_camera_spec(options.camera);
+  }
+  if (options.view.empty()) {
+    return std::nullopt;
+  }
+  std::string names;
+  for (const SceneView& v : views) {
+    if (v.name == options.view) {
+      return OrbitCamera::looking_at(v.eye_m, v.target_m, v.fov_deg * std::numbers::pi / 180.0);
+    }
+    names += (names.empty() ? "" : ", ") + v.name;
+  }
+  throw Error(options.config.scene.string(),
+              "--view " + options.view + ": the scene has " +
+                  (names.empty() ? std::string("no views") : "the views " + names));
 }
 
 std::vector<std::uint8_t> read_window(int width, int height) {
@@ -259,9 +293,10 @@ class Viewer {
 
   void rebuild(const ViewerConfig& config) {
     std::unique_ptr<ViewerSession> next;
+    std::vector<SceneView> views;
     session_.reset();  // one haptic loop (and one exclusive device) at a time
     try {
-      next = make_session(config);
+      next = make_session(config, &views);
       config_ = config;
       status_message_.clear();
     } catch (const std::exception& e) {
@@ -280,6 +315,13 @@ class Viewer {
     }
     session_ = std::move(next);
     session_->render_scene().style.level_of_detail = true;  // the window draws far meshes coarser
+    // The start's --view/--camera and --room apply to the first scene only; one chosen later in
+    // the menu is framed as usual.
+    std::optional<OrbitCamera> asked;
+    if (!built_once_) {
+      asked = first_camera(options_, views);
+      session_->render_scene().room.visible = options_.room;
+    }
     built_once_ = true;
     // The scene's warnings, through the log as mesh defects are: once each, however often the
     // session is rebuilt (the JSON summary lists them all).
@@ -296,7 +338,9 @@ class Viewer {
     int fb_h = 0;
     glfwGetFramebufferSize(window_, &fb_w, &fb_h);
     const Viewport v = view_rect(fb_w, fb_h);
-    camera_ = framed_camera(session_->bounds_world(), static_cast<double>(v.w) / v.h, 1.95, 0.3);
+    camera_ =
+        asked ? *asked
+              : framed_camera(session_->bounds_world(), static_cast<double>(v.w) / v.h, 1.95, 0.3);
     probe_ = MouseProbe(session_->probe_start_world(), probe_options(session_->bounds_world()));
     forces_ = ForceGraph{};
   }

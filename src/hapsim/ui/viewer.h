@@ -35,6 +35,15 @@ struct ViewerOptions {
   /// eyes' separation in metres (0: a thirtieth of the view distance).
   StereoMode stereo = StereoMode::kOff;
   double eye_separation_m = 0.0;
+  /// Where the view first looks from: a view named in the scene file's "views" (`view`), or
+  /// eye,target,fov given outright (`camera`, as render/snapshot_writer.h's parse_camera_spec
+  /// reads it); neither: the scene framed from the front. At most one of them. A scene chosen
+  /// later in the scene menu is framed as usual.
+  std::string view;
+  std::string camera;
+  /// Show the knee paper's room (walls and floor) from the start; the data area's "room" box
+  /// toggles it.
+  bool room = false;
   /// Close after this many seconds (0: when the window is closed).
   double duration_s = 0.0;
   /// Write the last frame (the whole window) to this PNG when closing.
