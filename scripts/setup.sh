@@ -42,8 +42,8 @@ HAPSIM_PACKAGES=(
   # without them rather than skipping their tests): CGAL, FCL, Embree 3, orocos-kdl
   libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev
   # the Python module (python/): Python's headers and find_package(pybind11) build it; NumPy for
-  # its arrays; pytest runs its tests under ctest; matplotlib draws the examples' plots
-  python3-dev python3-numpy pybind11-dev python3-pytest python3-matplotlib
+  # its arrays; pytest runs its tests under ctest; the examples' plots use the matplotlib above
+  python3-dev python3-numpy pybind11-dev python3-pytest
 )
 
 hapsim_install_packages() {
