@@ -177,43 +177,52 @@ std::vector<std::string> fault_problems(const std::vector<WriteLog::Write>& w, c
     }
     previous = i;
   }
-  // The first haptic write after the fault is its cycle's, at least (end - begin) after the
-  // previous one: at most what the ramp leaves after that long (0 beyond zero_by_s). So is any
-  // supervisor write between the fault's end and it.
+  // The first write after the fault, the haptic thread's or the supervisor's (the haptic thread
+  // skips its write while the supervisor is writing: the supervisor's value then stands for that
+  // cycle), comes at least (end - begin) after the previous one: at most what the ramp leaves
+  // after that long (0 beyond zero_by_s). So is every supervisor write before the haptic thread's
+  // first.
   const double fault_s = 1e-9 * static_cast<double>(fault.end_ns - fault.begin_ns);
   const double bound_n = f0_n * ramp_gain(fault_s, true, options.ramp) + 1e-9;
-  std::optional<std::size_t> resumed;
-  for (std::size_t i = 0; i < w.size() && !resumed; ++i) {
+  std::optional<std::size_t> first_after;
+  std::optional<std::size_t> haptic_after;
+  for (std::size_t i = 0; i < w.size() && !haptic_after; ++i) {
     if (w[i].t_ns < fault.end_ns) {
       continue;
     }
-    if (w[i].force_n > bound_n) {
-      say("more than the ramp allows after a " + std::to_string(fault_s * 1e3) + " ms fault (" +
-              std::to_string(bound_n) + " N)",
+    first_after = first_after.value_or(i);
+    if (w[i].haptic) {
+      haptic_after = i;
+    } else if (w[i].force_n > bound_n) {
+      say("the supervisor wrote more than the ramp allows after a " +
+              std::to_string(fault_s * 1e3) + " ms fault (" + std::to_string(bound_n) + " N)",
           i);
     }
-    if (w[i].haptic) {
-      resumed = i;
-    }
   }
-  if (!resumed) {
+  if (!haptic_after) {
     problems.emplace_back("the haptic thread never wrote after the fault");
     return problems;
   }
-  // Back up no faster than the ramp, and all the way.
+  if (*first_after == *haptic_after && w[*haptic_after].force_n > bound_n) {
+    say("more than the ramp allows after a " + std::to_string(fault_s * 1e3) + " ms fault (" +
+            std::to_string(bound_n) + " N)",
+        *haptic_after);
+  }
+  // Back up no faster than the ramp, one step a cycle from the haptic thread's previous write (or
+  // from the supervisor's first write after the fault, which stood for one cycle), and all the way.
+  // Later supervisor writes (another stall during the ramp) are not the base the ramp rises from.
   const double ramp_step_n = f0_n * options.period_s / options.ramp.ramp_duration_s;
-  std::size_t last = *resumed;
+  std::size_t last = *first_after;
   bool back = false;
-  for (std::size_t i = *resumed + 1; i < w.size() && !back; ++i) {
-    if (!w[i].haptic) {
-      continue;
+  for (std::size_t i = *first_after + 1; i < w.size() && !back; ++i) {
+    if (w[i].haptic) {
+      const auto cycles = w[last].haptic ? static_cast<double>(w[i].cycle - w[last].cycle) : 1.0;
+      if (w[i].force_n > w[last].force_n + ramp_step_n * cycles + 1e-9) {
+        say("the force came back faster than the ramp", i);
+      }
+      back = w[i].force_n >= f0_n - 1e-9;
+      last = i;
     }
-    const auto cycles = static_cast<double>(w[i].cycle - w[last].cycle);
-    if (w[i].force_n > w[last].force_n + ramp_step_n * cycles + 1e-9) {
-      say("the force came back faster than the ramp", i);
-    }
-    back = w[i].force_n >= f0_n - 1e-9;
-    last = i;
   }
   if (!back) {
     problems.push_back("the force never came back to " + std::to_string(f0_n) + " N");
@@ -317,8 +326,22 @@ void check_freezes(const FreezeRun& run, std::size_t freezes, const HapticLoopOp
   ASSERT_EQ(run.faults.size(), freezes);
   expect_all_finite_within_rating(run.writes, device_profile("omega3").max_force_n);
   for (std::size_t k = 0; k < run.faults.size(); ++k) {
-    for (const std::string& problem : fault_problems(run.writes, run.faults[k], kForceN, options)) {
+    const auto problems = fault_problems(run.writes, run.faults[k], kForceN, options);
+    for (const std::string& problem : problems) {
       ADD_FAILURE() << "freeze " << k << ": " << problem;
+    }
+    if (!problems.empty()) {  // the writes around the fault, to read what happened
+      for (std::size_t i = 0; i < run.writes.size(); ++i) {
+        const auto& w = run.writes[i];
+        const double from_begin_ms = 1e-6 * static_cast<double>(w.t_ns - run.faults[k].begin_ns);
+        const double from_end_ms = 1e-6 * static_cast<double>(w.t_ns - run.faults[k].end_ns);
+        if (from_begin_ms > -5.0 && from_end_ms < 5.0) {
+          std::printf(
+              "write %zu: %s cycle %llu, %.3f N, %+.3f ms from the freeze, %+.3f ms from its end\n",
+              i, w.haptic ? "haptic" : "supervisor", static_cast<unsigned long long>(w.cycle),
+              w.force_n, from_begin_ms, from_end_ms);
+        }
+      }
     }
   }
   // The haptic thread saw every freeze itself, whatever the supervisor did.
