@@ -74,10 +74,11 @@ TEST(DeviceHostProcess, ServeSendsTheLegacyForcePacketEveryCycle) {
   auto receiver = std::make_unique<LegacyForceUdpReceiver>("127.0.0.1:0");
   const std::uint16_t port = receiver->bound().port;
   LegacyGloveDevice glove(device_profile("rutgers_master"), std::move(receiver));
-  BackgroundHapsim serve("serve " + kScenes +
-                             "knee_hand_procedural.json --duration 2.6 --legacy-force-udp 127.0.0.1:" +
-                             std::to_string(port) + " --session legacy-test --domain 78",
-                         hapsim::test::temp_path("legacy-serve.log"));
+  BackgroundHapsim serve(
+      "serve " + kScenes +
+          "knee_hand_procedural.json --duration 2.6 --legacy-force-udp 127.0.0.1:" +
+          std::to_string(port) + " --session legacy-test --domain 78",
+      hapsim::test::temp_path("legacy-serve.log"));
   std::array<double, 4> peak_n{};
   const auto give_up = std::chrono::steady_clock::now() + 30s;
   while (std::chrono::steady_clock::now() < give_up &&
