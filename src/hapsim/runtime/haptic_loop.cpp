@@ -25,12 +25,19 @@ DeviceCommand scaled_command(const DeviceCommand& command, double gain) noexcept
   return out;
 }
 
+// What the haptic thread last wrote, and the share of its commanded force that carried (its
+// ceiling): a stall during a ramp must go on down from the ramped force, not from the full one.
+struct WrittenCommand {
+  DeviceCommand command;
+  double ceiling = 1.0;
+};
+
 struct HapticLoop::Shared {
   explicit Shared(const DeviceProfile& profile, const ForceRampParams& ramp)
-      : watchdog(profile, ramp), last_written(DeviceCommand{}) {}
+      : watchdog(profile, ramp), last_written(WrittenCommand{}) {}
 
-  ForceWatchdog watchdog;                    // haptic thread only
-  TripleBuffer<DeviceCommand> last_written;  // haptic thread -> supervisor: the ramp's base
+  ForceWatchdog watchdog;                     // haptic thread only
+  TripleBuffer<WrittenCommand> last_written;  // haptic thread -> supervisor: the ramp's base
   std::atomic_flag output_busy = ATOMIC_FLAG_INIT;
   std::atomic<std::int64_t> start_ns{0};
   std::atomic<std::int64_t> end_ns{0};
@@ -233,7 +240,7 @@ void HapticLoop::haptic_thread_main() noexcept {
     }
     s.heartbeat_ns.store(write_ns, std::memory_order_release);
     if (try_write(out)) {
-      s.last_written.write_slot() = out;
+      s.last_written.write_slot() = {out, resume.ceiling()};
       s.last_written.publish();
     }
     const std::int64_t c1 = monotonic_ns();
@@ -260,7 +267,7 @@ void HapticLoop::haptic_thread_main() noexcept {
   // reach wait() for a while). The supervisor's ramp base becomes zero too.
   DeviceCommand zero;
   zero.finger_count = device_.profile().finger_count;
-  s.last_written.write_slot() = zero;
+  s.last_written.write_slot() = {zero, 0.0};
   s.last_written.publish();
   while (!try_write(zero)) {
     // The supervisor is writing right now: it holds the device for one write only.
@@ -280,7 +287,7 @@ void HapticLoop::supervisor_thread_main() noexcept {
   }
   const auto period_ns =
       static_cast<std::int64_t>(std::llround(options_.supervisor_period_s * 1e9));
-  DeviceCommand base;  // the last command the haptic thread wrote
+  WrittenCommand base;  // the last command the haptic thread wrote
   bool stalled = false;
   std::int64_t stall_start_ns = 0;
   bool healthy_seen = true;
@@ -307,8 +314,11 @@ void HapticLoop::supervisor_thread_main() noexcept {
       // cycle resuming in between would write full force right after the device saw ~0). If the
       // write does not happen (the haptic thread is writing: it has resumed), the ceiling only
       // makes its force come back over the ramp time.
-      lower_gain(s.supervisor_gain, gain);
-      (void)try_write(scaled_command(base, gain));
+      // The ceiling is relative to the haptic thread's commanded force: the written one carried
+      // base.ceiling of it (a stall during a ramp), so the ceiling is the product, and the force
+      // it comes back with starts where this write leaves the device.
+      lower_gain(s.supervisor_gain, gain * base.ceiling);
+      (void)try_write(scaled_command(base.command, gain));
       if (!stalled) {
         // Logged after the protective write: a blocked stderr must not keep the force on.
         stalled = true;
