@@ -19,7 +19,9 @@ const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee_proced
 constexpr std::uint64_t kHash = 0x1234;
 
 struct Served {
-  RunSetup setup = make_run_setup(load_scene(kScene), DeviceChoice::scene_script());
+  explicit Served(const std::string& scene = kScene)
+      : setup(make_run_setup(load_scene(scene), DeviceChoice::scene_script())) {}
+  RunSetup setup;
   World& world = *setup.world;
   double t_s = 0.0;
 };
@@ -43,6 +45,7 @@ WorldSnapshot snapshot_of(const World& world) {
   }
   s.contact_count = std::min(state.contact_count, s.contacts.size());
   std::copy_n(state.contacts.begin(), s.contact_count, s.contacts.begin());
+  s.hand = world.hand_reading();
   return s;
 }
 
@@ -130,6 +133,53 @@ TEST(ViewStateCodec, RefusesWhatDoesNotFitTheWorldAndChangesNothing) {
   // Nothing of the refused samples reached the snapshot.
   EXPECT_EQ(max_vertex_error_m(seen, before), 0.0f);
   EXPECT_EQ(seen.contact_count, before.contact_count);
+}
+
+// A glove world's hand travels with the view, so a connected viewer draws the hand the host's
+// glove holds (the fingers' angles, the tracker's pose), not one at rest; a non-finite hand is
+// refused like any other non-finite number.
+TEST(ViewStateCodec, CarriesTheGlovesHandAndRefusesANonFiniteOne) {
+  const std::string scene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/knee_hand_procedural.json";
+  Served host(scene);
+  ViewStateEncoder encoder(host.world);
+  Served viewer_side(scene);
+  WorldSnapshot seen = make_world_snapshot(viewer_side.world);
+  ViewStateDecoder decoder(viewer_side.world);
+  std::string why;
+
+  run_to(host, 2.0);  // the hand has moved in and curled its fingers
+  const WorldSnapshot truth = snapshot_of(host.world);
+  double moved_rad = 0.0;
+  for (const auto& finger : truth.hand.angles_rad) {
+    for (const double a : finger) {
+      moved_rad = std::max(moved_rad, std::abs(a));
+    }
+  }
+  ASSERT_GT(moved_rad, 0.1) << "the script's hand never bent a finger: nothing to carry";
+  hapsim_msg_ViewState m = encoder.encode(truth, kHash, 7, true);
+  ASSERT_TRUE(decoder.decode(m, kHash, seen, why)) << why;
+  for (std::size_t f = 0; f < truth.hand.angles_rad.size(); ++f) {
+    for (std::size_t a = 0; a < truth.hand.angles_rad[f].size(); ++a) {
+      EXPECT_EQ(seen.hand.angles_rad[f][a], truth.hand.angles_rad[f][a]) << f << "," << a;
+    }
+  }
+  EXPECT_LE((seen.hand.X_world_hand.matrix() - truth.hand.X_world_hand.matrix()).norm(), 1e-12);
+  // The fingertips the viewer computes from the carried hand are the host's tools.
+  const auto tips = viewer_side.world.model().hand()->fingertips_world(seen.hand);
+  const auto host_tips = host.world.model().hand()->fingertips_world(truth.hand);
+  for (std::size_t f = 0; f < tips.size(); ++f) {
+    EXPECT_LE((tips[f] - host_tips[f]).norm(), 1e-12) << "finger " << f;
+  }
+
+  const WorldSnapshot before = seen;
+  m.hand_angles_rad[4] = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  EXPECT_NE(why.find("hand"), std::string::npos) << why;
+  m = encoder.encode(truth, kHash, 7, true);
+  m.hand_q_wxyz[0] = 2.0;  // not a rotation
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  EXPECT_NE(why.find("hand"), std::string::npos) << why;
+  EXPECT_EQ(seen.hand.angles_rad, before.hand.angles_rad);
 }
 
 }  // namespace

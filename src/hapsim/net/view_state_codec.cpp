@@ -25,6 +25,11 @@ Vec3 get3(const double (&in)[3]) {
   return {in[0], in[1], in[2]};
 }
 
+constexpr auto kFingers = static_cast<std::size_t>(kHandFingers);
+constexpr auto kAngles = static_cast<std::size_t>(kGloveAnglesPerFinger);
+static_assert(kFingers * kAngles == sizeof(hapsim_msg_ViewState::hand_angles_rad) / sizeof(double),
+              "the ViewState carries every glove angle");
+
 bool finite3(const double (&in)[3]) {
   return std::isfinite(in[0]) && std::isfinite(in[1]) && std::isfinite(in[2]);
 }
@@ -61,6 +66,17 @@ const hapsim_msg_ViewState& ViewStateEncoder::encode(const WorldSnapshot& s,
     put3(v.force_n, s.tools[t].force_world_n);
     v.rendered_force_n = t < s.tool_force_n.size() ? s.tool_force_n[t] : 0.0;
     v.contact_count = s.tools[t].contact_count;
+  }
+  put3(m.hand_p_m, s.hand.X_world_hand.translation());
+  const Quat hand_q(s.hand.X_world_hand.linear());
+  m.hand_q_wxyz[0] = hand_q.w();
+  m.hand_q_wxyz[1] = hand_q.x();
+  m.hand_q_wxyz[2] = hand_q.y();
+  m.hand_q_wxyz[3] = hand_q.z();
+  for (std::size_t f = 0; f < kFingers; ++f) {
+    for (std::size_t a = 0; a < kAngles; ++a) {
+      m.hand_angles_rad[f * kAngles + a] = s.hand.angles_rad[f][a];
+    }
   }
   bodies_.resize(s.body_poses_world.size());
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
@@ -165,6 +181,18 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
       return false;
     }
   }
+  {
+    const Quat q(m.hand_q_wxyz[0], m.hand_q_wxyz[1], m.hand_q_wxyz[2], m.hand_q_wxyz[3]);
+    const bool angles_finite =
+        std::all_of(std::begin(m.hand_angles_rad), std::end(m.hand_angles_rad),
+                    [](double a) { return std::isfinite(a); });
+    if (!finite3(m.hand_p_m) || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3 ||
+        !angles_finite) {
+      why = "the hand's pose or joint angles are not finite (or |q| = " + std::to_string(q.norm()) +
+            " is not 1)";
+      return false;
+    }
+  }
   for (std::size_t t = 0; t < m.tool_count; ++t) {
     const hapsim_msg_ToolView& v = m.tools[t];
     if (!finite3(v.p_m) || !finite3(v.proxy_m) || !finite3(v.force_n) ||
@@ -203,6 +231,17 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
     s.tools[t].force_world_n = get3(v.force_n);
     s.tools[t].contact_count = v.contact_count;
     s.tool_force_n[t] = v.rendered_force_n;
+  }
+  s.hand.X_world_hand = Iso3::Identity();
+  s.hand.X_world_hand.linear() =
+      Quat(m.hand_q_wxyz[0], m.hand_q_wxyz[1], m.hand_q_wxyz[2], m.hand_q_wxyz[3])
+          .normalized()
+          .toRotationMatrix();
+  s.hand.X_world_hand.translation() = get3(m.hand_p_m);
+  for (std::size_t f = 0; f < kFingers; ++f) {
+    for (std::size_t a = 0; a < kAngles; ++a) {
+      s.hand.angles_rad[f][a] = m.hand_angles_rad[f * kAngles + a];
+    }
   }
   for (std::uint32_t b = 0; b < m.bodies._length; ++b) {
     const hapsim_msg_BodyPose& p = m.bodies._buffer[b];

@@ -259,9 +259,10 @@ void WorldScene::add_sheet_grid(const Segment& seg) {
   }
 }
 
-// Whether the hand's reading puts each fingertip where its tool is: a served world's views carry
-// the tools but not the glove's reading, and a hand drawn at rest elsewhere would mislead (the
-// fingertips alone are drawn then).
+// Whether the hand's reading puts each fingertip where its tool is. A served world's views carry
+// the glove's reading with the tools, but a view from an older host, or a reading from another
+// cycle than the tools, would draw the hand elsewhere and mislead (the fingertips alone are drawn
+// then).
 bool WorldScene::hand_agrees_with_tools() const {
   constexpr double kToleranceM = 1e-4;
   const auto tips = world_.model().hand()->fingertips_world(hand_);
