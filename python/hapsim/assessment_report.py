@@ -356,23 +356,22 @@ def _finds_on(assessment: dict, tissue: str | None) -> list[tuple[int, dict]]:
 
 
 def _force_plot(plt, path: str, t, force, *, duration_s: float, limit_n, breaches,
-                finds, ylabel: str):
+                finds, ylabel: str, height_in: float):
     """One force-over-time plot: the force, its limit as a labelled horizontal line, breach
     intervals shaded, each landmark's find marked with its number at the top."""
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
     from matplotlib.transforms import blended_transform_factory
 
-    fig, ax = plt.subplots(figsize=(10.0, 3.0), dpi=_DPI)
+    fig, ax = plt.subplots(figsize=(10.0, height_in), dpi=_DPI)
     t_end = max(duration_s, t[-1] if t else 0.0, 1e-3)
     peak = max(force) if force else 0.0
-    top = max(peak, limit_n or 0.0, 0.5) * 1.22
+    # The curve and the limit below 3/4 of the height: the find markers sit above them.
+    top = max(peak, limit_n or 0.0, 0.5) * 1.34
     handles = [Line2D([], [], color=FORCE_COLOUR, lw=1.4, label="force")]
     for b in breaches:
         ax.axvspan(b["start_s"], b["start_s"] + max(b["duration_s"], t_end * 0.002),
                    color=BREACH_COLOUR, alpha=0.16, lw=0)
-    if breaches:
-        handles.append(Patch(color=BREACH_COLOUR, alpha=0.3, label="over the limit"))
     ax.plot(t, force, color=FORCE_COLOUR, lw=1.3, solid_joinstyle="round")
     if limit_n is not None:
         ax.axhline(limit_n, color=BREACH_COLOUR, lw=1.3, ls=(0, (6, 3)))
@@ -380,15 +379,17 @@ def _force_plot(plt, path: str, t, force, *, duration_s: float, limit_n, breache
                 ha="right", va="bottom", fontweight="bold",
                 bbox=dict(facecolor="white", edgecolor="none", pad=1.0, alpha=0.85))
         handles.append(Line2D([], [], color=BREACH_COLOUR, lw=1.3, ls=(0, (6, 3)), label="limit"))
+    if breaches:
+        handles.append(Patch(color=BREACH_COLOUR, alpha=0.3, label="over the limit"))
     # Landmark finds: a line and the landmark's number, staggered when two are close in time.
     trans = blended_transform_factory(ax.transData, ax.transAxes)
     last_x, level = -math.inf, 0
     for number, lm in sorted(finds, key=lambda f: f[1]["found_at_s"]):
         x = lm["found_at_s"]
-        level = (level + 1) % 3 if x - last_x < 0.045 * t_end else 0
+        level = (level + 1) % 2 if x - last_x < 0.045 * t_end else 0
         last_x = x
         ax.axvline(x, color=FOUND_COLOUR, lw=1.0, ls=":")
-        ax.text(x, 0.93 - 0.13 * level, str(number), transform=trans, ha="center", va="center",
+        ax.text(x, 0.93 - 0.1 * level, str(number), transform=trans, ha="center", va="center",
                 color="white", fontsize=8, fontweight="bold",
                 bbox=dict(boxstyle="circle,pad=0.25", facecolor=FOUND_COLOUR, edgecolor="none"))
     if finds:
@@ -400,7 +401,10 @@ def _force_plot(plt, path: str, t, force, *, duration_s: float, limit_n, breache
     ax.set_ylabel(ylabel)
     ax.legend(handles=handles, loc="lower right", bbox_to_anchor=(1.0, 1.0), ncol=len(handles),
               borderaxespad=0.2, handlelength=1.8)
-    fig.tight_layout(pad=0.6)
+    # Fixed margins (inches), not tight_layout: every plot's time axis lines up on the page.
+    w_in, h_in = fig.get_size_inches()
+    fig.subplots_adjust(left=0.85 / w_in, right=1.0 - 0.2 / w_in, bottom=0.55 / h_in,
+                        top=1.0 - 0.4 / h_in)
     fig.savefig(path, dpi=_DPI)
     plt.close(fig)
 
@@ -418,18 +422,20 @@ def _learning_curve(plt, path: str, sessions: list[dict]):
     score_max = max(s["score_max"] for s in sessions)
     ax_score.plot(x, score, color=FORCE_COLOUR, lw=1.8, marker="o", markersize=6)
     for xi, v in zip(x, score):
-        ax_score.annotate(f"{v:.0f}", (xi, v), textcoords="offset points", xytext=(0, 7),
+        ax_score.annotate(f"{v:.1f}", (xi, v), textcoords="offset points", xytext=(0, 7),
                           ha="center", fontsize=9, color=FORCE_COLOUR)
     ax_score.set_ylim(min(0.0, min(score) * 1.1), score_max * 1.15)
     ax_score.set_ylabel(f"score (of {score_max:g})")
-    ax_score.set_title("Learning curve", loc="left", fontsize=12, fontweight="bold")
 
     missed = [s["missed"] for s in sessions]
     breaches = [s["breaches"] for s in sessions]
     ax_err.bar(x, missed, width=0.55, color=MISSED_COLOUR, label="missed landmarks")
     ax_err.bar(x, breaches, width=0.55, bottom=missed, color=BREACH_COLOUR, label="breaches")
+    for xi, m, b in zip(x, missed, breaches):  # the total, so a session without errors shows 0
+        ax_err.annotate(str(m + b), (xi, m + b), textcoords="offset points", xytext=(0, 4),
+                        ha="center", fontsize=9, color="#333333")
     top = max([m + b for m, b in zip(missed, breaches)] + [1])
-    ax_err.set_ylim(0, top * 1.3)
+    ax_err.set_ylim(0, top * 1.5)
     ax_err.yaxis.set_major_locator(MaxNLocator(integer=True))
     ax_err.set_ylabel("errors")
     ax_err.legend(handles=[Patch(color=MISSED_COLOUR, label="missed landmarks"),
@@ -444,10 +450,13 @@ def _learning_curve(plt, path: str, sessions: list[dict]):
         limit = limits.pop()
         ax_time.axhline(limit, color=BREACH_COLOUR, lw=1.2, ls=(0, (6, 3)))
         ax_time.text(n + 0.45, limit, f"time limit {limit:g} s", color=BREACH_COLOUR, fontsize=9,
-                     ha="right", va="bottom")
+                     ha="right", va="bottom",
+                     bbox=dict(facecolor="white", edgecolor="none", pad=1.0, alpha=0.85))
         t_top = max(t_top, limit)
     ax_time.set_ylim(0.0, t_top * 1.2)
-    ax_time.set_ylabel("time (s)")
+    ax_time.set_ylabel("time per session (s)")
+    for ax in (ax_score, ax_err, ax_time):
+        ax.grid(axis="x", visible=False)
     ax_time.set_xlabel("session")
     ax_time.xaxis.set_major_locator(FixedLocator(x) if n <= 20 else MaxNLocator(integer=True))
     ax_time.set_xlim(0.5, n + 0.5)
@@ -500,7 +509,7 @@ table.data th { text-align:left; font-weight:600; color:var(--muted); font-size:
                 text-transform:uppercase; letter-spacing:.04em; border-bottom:2px solid var(--rule);
                 padding:6px 8px; vertical-align:bottom; }
 table.data td { border-bottom:1px solid var(--rule); padding:7px 8px; vertical-align:top; }
-table.data td.n, table.data th.n { text-align:right; }
+table.data td.n, table.data th.n { text-align:right; white-space:nowrap; }
 table.data tr.breached td { background:#fdf0f0; }
 .sub { color:var(--muted); font-size:12px; }
 .pill { display:inline-block; padding:1px 9px; border-radius:10px; font-size:12px; font-weight:600;
@@ -657,18 +666,18 @@ def write_report(directory: str) -> str:
     total_file = "force_total.png"
     _force_plot(plt, os.path.join(directory, total_file), t, forces["total_force_n"],
                 duration_s=a["duration_s"], limit_n=None, breaches=a["breaches"],
-                finds=_finds_on(a, None), ylabel="total force (N)")
+                finds=_finds_on(a, None), ylabel="total force (N)", height_in=3.0)
     for tissue in tissues:
         name = f"force_{_file_stem(tissue)}.png"
         breaches = [b for b in a["breaches"] if b["tissue"] == tissue]
         _force_plot(plt, os.path.join(directory, name), t, forces[tissue],
                     duration_s=a["duration_s"], limit_n=limit_of.get(tissue), breaches=breaches,
-                    finds=_finds_on(a, tissue), ylabel="force (N)")
+                    finds=_finds_on(a, tissue), ylabel="force (N)", height_in=2.6)
         peak = max(forces[tissue])
         cap = f"Peak {peak:.2f} N"
         cap += (f"; limit {limit_of[tissue]:.1f} N, {len(breaches)} breach"
                 f"{'es' if len(breaches) != 1 else ''}" if tissue in limit_of else "; no limit set")
-        plots.append((name, _pretty(tissue), cap))
+        plots.append((name, _pretty(tissue).capitalize(), cap))
 
     def img(file: str, alt: str) -> str:
         with open(os.path.join(directory, file), "rb") as f:
@@ -784,10 +793,10 @@ def write_summary(out_dir: str, json_paths: list[str]) -> str:
     first, last = sessions[0], sessions[-1]
     scenes = sorted({s["a"].get("scene_name") or s["a"]["scene"] for s in sessions})
     kpis = (_kpi("Sessions", str(len(sessions)))
-            + _kpi("Score, first → last", f'{first["score"]:.0f} → {last["score"]:.0f}')
+            + _kpi("Score, first → last", f'{first["score"]:.1f} → {last["score"]:.1f}')
             + _kpi("Errors, first → last", f'{first["missed"] + first["breaches"]} → '
                    f'{last["missed"] + last["breaches"]}')
-            + _kpi("Time, first → last", f'{first["duration_s"]:.0f} → {last["duration_s"]:.0f}&nbsp;s'))
+            + _kpi("Time, first → last", f'{first["duration_s"]:.1f} → {last["duration_s"]:.1f}&nbsp;s'))
     body = (f'<header><div><div class="eyebrow">Training summary</div>'
             f'<h1>{_esc(" · ".join(scenes))}</h1>'
             f'<p class="meta">{len(sessions)} sessions · Summary made {_now_utc()}</p></div></header>'
