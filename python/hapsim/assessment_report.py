@@ -217,6 +217,12 @@ def load_assessment(path: str) -> dict:
         c.fail("forces.columns", "is not a list of names starting \"t_s\", \"total_force_n\"")
     if len(set(cols)) != len(cols):
         c.fail("forces.columns", "names a column twice")
+    # One column per tissue with a limit or a landmark on it (the contract), so no plot is missing.
+    for where, tissue in ([(f"limits[{i}].tissue", lim["tissue"]) for i, lim in enumerate(a["limits"])]
+                          + [(f"landmarks[{i}].segment", lm["segment"])
+                             for i, lm in enumerate(a["landmarks"]) if lm.get("segment")]):
+        if tissue not in cols[2:]:
+            c.fail("forces.columns", f"has no column for {where} \"{tissue[:40]}\"")
     c.string(a, "picture", "", optional=True)
     return a
 
@@ -509,7 +515,9 @@ table.data th { text-align:left; font-weight:600; color:var(--muted); font-size:
                 text-transform:uppercase; letter-spacing:.04em; border-bottom:2px solid var(--rule);
                 padding:6px 8px; vertical-align:bottom; }
 table.data td { border-bottom:1px solid var(--rule); padding:7px 8px; vertical-align:top; }
-table.data td.n, table.data th.n { text-align:right; white-space:nowrap; }
+table.data td.n, table.data th.n { text-align:right; }
+table.data td.n { white-space:nowrap; }
+table.data td.name { min-width:190px; }
 table.data tr.breached td { background:#fdf0f0; }
 .sub { color:var(--muted); font-size:12px; }
 .pill { display:inline-block; padding:1px 9px; border-radius:10px; font-size:12px; font-weight:600;
@@ -584,7 +592,7 @@ def _landmark_table(a: dict) -> str:
         rows.append(
             f'<tr data-landmark="{_esc(lm["name"])}" data-state="{state}">'
             f'<td><span class="num {state}">{i}</span></td>'
-            f'<td><b>{_esc(lm["name"])}</b><br><span class="sub">{where}</span></td>'
+            f'<td class="name"><b>{_esc(lm["name"])}</b><br><span class="sub">{where}</span></td>'
             f'<td><span class="pill {state}">{state}</span></td>'
             f'<td class="n">{_num(lm.get("found_at_s"), 2, "s")}</td>'
             f'<td class="n">{_num(lm.get("force_at_found_n"), 2, "N")}</td>'
@@ -667,8 +675,13 @@ def write_report(directory: str) -> str:
     _force_plot(plt, os.path.join(directory, total_file), t, forces["total_force_n"],
                 duration_s=a["duration_s"], limit_n=None, breaches=a["breaches"],
                 finds=_finds_on(a, None), ylabel="total force (N)", height_in=3.0)
+    used_names = {total_file}
     for tissue in tissues:
         name = f"force_{_file_stem(tissue)}.png"
+        k = 2
+        while name in used_names:  # "a b" and "a_b" would share a file
+            name, k = f"force_{_file_stem(tissue)}_{k}.png", k + 1
+        used_names.add(name)
         breaches = [b for b in a["breaches"] if b["tissue"] == tissue]
         _force_plot(plt, os.path.join(directory, name), t, forces[tissue],
                     duration_s=a["duration_s"], limit_n=limit_of.get(tissue), breaches=breaches,

@@ -262,7 +262,9 @@ def _break(tmp_path, how):
         bad["duration_s"] = float("nan")
     elif how == "columns":
         bad["forces"]["columns"] = ["total_force_n", "t_s"]
-    if how in ("schema", "landmark name", "nan", "columns"):
+    elif how == "no tissue column":
+        bad["limits"][0]["tissue"] = "gastrocnemius"
+    if how in ("schema", "landmark name", "nan", "columns", "no tissue column"):
         (d / "assessment.json").write_text(json.dumps(bad))
     elif how == "truncated json":
         (d / "assessment.json").write_text(json.dumps(a)[:200])
@@ -295,6 +297,7 @@ def _break(tmp_path, how):
     ("landmark name", "assessment.json", "landmarks[1].name is missing"),
     ("nan", "assessment.json", "duration_s"),
     ("columns", "assessment.json", "forces.columns"),
+    ("no tissue column", "assessment.json", 'no column for limits[0].tissue "gastrocnemius"'),
     ("no csv", "forces.csv", "no such file"),
     ("csv text", "forces.csv", "line 18"),
     ("csv header", "forces.csv", "header"),
