@@ -274,7 +274,9 @@ def _break(tmp_path, how):
         (d / "forces.csv").unlink()
     elif how == "csv text":
         lines = (d / "forces.csv").read_text().splitlines()
-        lines[17] = lines[17].replace(",", ",abc,", 1)
+        fields = lines[17].split(",")
+        fields[2] = "abc"  # the patella's force
+        lines[17] = ",".join(fields)
         (d / "forces.csv").write_text("\n".join(lines) + "\n")
     elif how == "csv header":
         lines = (d / "forces.csv").read_text().splitlines()
@@ -299,7 +301,7 @@ def _break(tmp_path, how):
     ("columns", "assessment.json", "forces.columns"),
     ("no tissue column", "assessment.json", 'no column for limits[0].tissue "gastrocnemius"'),
     ("no csv", "forces.csv", "no such file"),
-    ("csv text", "forces.csv", "line 18"),
+    ("csv text", "forces.csv", 'line 18: patella is "abc"'),
     ("csv header", "forces.csv", "header"),
     ("csv fields", "forces.csv", "2 fields"),
     ("not a png", "picture.png", "not a PNG"),
