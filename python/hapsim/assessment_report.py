@@ -218,9 +218,10 @@ def load_assessment(path: str) -> dict:
     if len(set(cols)) != len(cols):
         c.fail("forces.columns", "names a column twice")
     # One column per tissue with a limit or a landmark on it (the contract), so no plot is missing.
-    for where, tissue in ([(f"limits[{i}].tissue", lim["tissue"]) for i, lim in enumerate(a["limits"])]
-                          + [(f"landmarks[{i}].segment", lm["segment"])
-                             for i, lm in enumerate(a["landmarks"]) if lm.get("segment")]):
+    named = [(f"limits[{i}].tissue", lim["tissue"]) for i, lim in enumerate(a["limits"])]
+    named += [(f"landmarks[{i}].segment", lm["segment"])
+              for i, lm in enumerate(a["landmarks"]) if lm.get("segment")]
+    for where, tissue in named:
         if tissue not in cols[2:]:
             c.fail("forces.columns", f"has no column for {where} \"{tissue[:40]}\"")
     c.string(a, "picture", "", optional=True)
@@ -233,7 +234,8 @@ def load_forces(path: str, columns: list[str]) -> dict[str, list[float]]:
         with open(path, encoding="utf-8", newline="") as f:
             rows = list(csv.reader(f))
     except FileNotFoundError:
-        raise InputError(f"{path}: no such file (assessment.json names it in forces.file)") from None
+        raise InputError(f"{path}: no such file (assessment.json names it in forces.file)") \
+            from None
     except (OSError, UnicodeDecodeError, csv.Error) as e:
         raise InputError(f"{path}: cannot be read ({e})") from None
     if not rows:
@@ -261,7 +263,8 @@ def load_forces(path: str, columns: list[str]) -> dict[str, list[float]]:
             data[name].append(v)
         t = data["t_s"][-1]
         if t < previous_t:
-            raise InputError(f"{path}: line {line}: t_s {t:g} goes back in time (from {previous_t:g})")
+            raise InputError(f"{path}: line {line}: t_s {t:g} goes back in time "
+                             f"(from {previous_t:g})")
         previous_t = t
     if not data["t_s"]:
         raise InputError(f"{path}: has a header but no rows")
@@ -501,16 +504,19 @@ h3 { font-size:15px; margin:22px 0 6px; font-weight:650; }
 .bar span { display:block; height:100%; background:var(--accent); }
 .terms { font-size:13.5px; color:var(--muted); border-collapse:collapse; margin-left:auto; }
 .terms td { padding:1px 0 1px 14px; border:0; }
-.terms td.v { text-align:right; font-variant-numeric:tabular-nums; color:var(--ink); font-weight:600; }
+.terms td.v { text-align:right; font-variant-numeric:tabular-nums; color:var(--ink);
+              font-weight:600; }
 .formula { background:var(--panel); border-left:3px solid var(--accent); padding:10px 14px;
            font-size:13.5px; color:#34404d; margin:16px 0 0; }
-.kpis { display:grid; grid-template-columns:repeat(auto-fit,minmax(150px,1fr)); gap:12px; margin:22px 0 0; }
+.kpis { display:grid; grid-template-columns:repeat(auto-fit,minmax(150px,1fr)); gap:12px;
+        margin:22px 0 0; }
 .kpi { background:var(--panel); border-radius:4px; padding:10px 14px; }
 .kpi .k { font-size:12px; text-transform:uppercase; letter-spacing:.06em; color:var(--muted); }
 .kpi .v { font-size:22px; font-weight:650; font-variant-numeric:tabular-nums; }
 .kpi.alert .v { color:var(--breach); }
 .kpi.good .v { color:var(--found); }
-table.data { width:100%; border-collapse:collapse; font-size:13.5px; font-variant-numeric:tabular-nums; }
+table.data { width:100%; border-collapse:collapse; font-size:13.5px;
+             font-variant-numeric:tabular-nums; }
 table.data th { text-align:left; font-weight:600; color:var(--muted); font-size:12px;
                 text-transform:uppercase; letter-spacing:.04em; border-bottom:2px solid var(--rule);
                 padding:6px 8px; vertical-align:bottom; }
@@ -528,7 +534,8 @@ table.data tr.breached td { background:#fdf0f0; }
        line-height:20px; font-size:11px; font-weight:700; color:#fff; background:var(--missed); }
 .num.found { background:var(--found); }
 figure { margin:0; }
-figure img { width:100%; height:auto; display:block; border:1px solid var(--rule); border-radius:3px; }
+figure img { width:100%; height:auto; display:block; border:1px solid var(--rule);
+             border-radius:3px; }
 figcaption { font-size:12.5px; color:var(--muted); margin-top:6px; }
 .legend { display:flex; gap:22px; flex-wrap:wrap; font-size:13px; margin-top:8px; color:#34404d; }
 .legend i { display:inline-block; width:12px; height:12px; border-radius:50%; margin-right:6px;
@@ -561,7 +568,8 @@ def _now_utc() -> str:
 
 
 def _kpi(label: str, value: str, cls: str = "") -> str:
-    return f'<div class="kpi {cls}"><div class="k">{_esc(label)}</div><div class="v">{value}</div></div>'
+    return (f'<div class="kpi {cls}"><div class="k">{_esc(label)}</div>'
+            f'<div class="v">{value}</div></div>')
 
 
 def _score_block(a: dict) -> str:
@@ -620,7 +628,8 @@ def _limits_tables(a: dict) -> str:
                  if count else '<span class="pill ok">within limit</span>')
         rows.append(
             f'<tr class="{"breached" if count else ""}" data-tissue="{_esc(lim["tissue"])}">'
-            f'<td><b>{_esc(_pretty(lim["tissue"]))}</b></td><td class="n">{_num(lim["max_force_n"], 1, "N")}</td>'
+            f'<td><b>{_esc(_pretty(lim["tissue"]))}</b></td>'
+            f'<td class="n">{_num(lim["max_force_n"], 1, "N")}</td>'
             f'<td>{state}</td><td class="n">{_num(lim.get("breach_duration_s"), 2, "s")}</td>'
             f'<td class="n">{_num(lim.get("worst_excess_n") if count else None, 2, "N")}</td>'
             f'<td class="n">{_num(lim.get("worst_at_s") if count else None, 2, "s")}</td></tr>')
@@ -630,7 +639,8 @@ def _limits_tables(a: dict) -> str:
     if a["breaches"]:
         brows = "".join(
             f'<tr class="breached"><td>{i}</td><td>{_esc(_pretty(b["tissue"]))}</td>'
-            f'<td class="n">{_num(b["start_s"], 2, "s")}</td><td class="n">{_num(b["duration_s"], 2, "s")}</td>'
+            f'<td class="n">{_num(b["start_s"], 2, "s")}</td>'
+            f'<td class="n">{_num(b["duration_s"], 2, "s")}</td>'
             f'<td class="n">{_num(b.get("peak_force_n"), 2, "N")}</td>'
             f'<td class="n">{_num(b.get("excess_n"), 2, "N")}</td></tr>'
             for i, b in enumerate(sorted(a["breaches"], key=lambda b: b["start_s"]), start=1))
@@ -641,9 +651,10 @@ def _limits_tables(a: dict) -> str:
 
 
 def _teleop_block(teleop: dict) -> str:
-    rows = "".join("<tr><td>{}</td><td class=\"n\">{}</td></tr>".format(*_field_label_and_value(k, v))
+    rows = "".join('<tr><td>{}</td><td class="n">{}</td></tr>'.format(*_field_label_and_value(k, v))
                    for k, v in teleop.items())
-    return ('<section id="teleop"><h2>Pick and place</h2><table class="data" style="max-width:520px">'
+    return ('<section id="teleop"><h2>Pick and place</h2>'
+            '<table class="data" style="max-width:520px">'
             f"<tbody>{rows}</tbody></table></section>")
 
 
@@ -720,19 +731,23 @@ def write_report(directory: str) -> str:
     kind = {"palpation": "Palpation", "pick_and_place": "Pick and place"}.get(
         a.get("kind") or "", _pretty(a.get("kind") or "Training"))
     over = '<p class="flag">Over the time limit.</p>' if a.get("over_time") else ""
-    formula = (f'<p class="formula"><b>How the score is computed.</b> {_esc(a["score"]["formula"])}</p>'
+    formula = ('<p class="formula"><b>How the score is computed.</b> '
+               f'{_esc(a["score"]["formula"])}</p>'
                if a["score"].get("formula") else "")
     header = (f'<header><div><div class="eyebrow">{_esc(kind)} training report</div>'
               f"<h1>{_esc(title)}</h1>"
-              f'<p class="meta">Scene <b>{_esc(a["scene"])}</b> · Recording <b>{_esc(a["recording"])}</b></p>'
+              f'<p class="meta">Scene <b>{_esc(a["scene"])}</b> · '
+              f'Recording <b>{_esc(a["recording"])}</b></p>'
               f'<p class="meta">Session length <b>{_num(a["duration_s"], 1, "s")}</b> · '
               f"Report made {_now_utc()}</p>{over}</div>"
               f"{_score_block(a)}</header>{formula}"
               f'<div class="kpis">{"".join(kpis)}</div>')
 
-    legend = (f'<div class="legend"><span><i style="background:{FOUND_COLOUR}"></i>landmark found</span>'
+    legend = ('<div class="legend">'
+              f'<span><i style="background:{FOUND_COLOUR}"></i>landmark found</span>'
               f'<span><i style="background:{MISSED_COLOUR}"></i>landmark missed</span>'
-              f'<span><i style="background:{BREACH_COLOUR}"></i>force limit breached (worst point)</span></div>')
+              f'<span><i style="background:{BREACH_COLOUR}"></i>force limit breached '
+              "(worst point)</span></div>")
     if picture_png is not None:
         picture = (f'<section id="picture"><h2>The scene at the end of the session</h2><figure>'
                    f'<img src="{_data_uri(picture_png)}" alt="the scene with its landmarks">'
@@ -742,17 +757,25 @@ def write_report(directory: str) -> str:
         picture = (f'<section id="picture"><h2>The scene at the end of the session</h2>'
                    f'<p class="note">{_esc(why)}</p></section>')
 
+    # A pick-and-place session has no landmarks: no empty section for them.
+    landmarks = ("" if not a["landmarks"] and a.get("kind") == "pick_and_place" else
+                 f'<section id="landmarks"><h2>Landmarks</h2>{_landmark_table(a)}</section>')
+    how_to_read = []
+    if found:
+        how_to_read.append("Numbered green markers: the moment each landmark was found (numbers "
+                           "as in the landmark table).")
+    if n_breach:
+        how_to_read.append("Shaded red: force over the tissue's limit.")
+    how_to_read.append("Each point is the maximum force over 10 ms.")
     plot_html = "".join(
         f'<figure style="margin-top:14px"><h3>{_esc(h)}</h3>{img(f, "force on " + h)}'
         f"<figcaption>{_esc(c)}</figcaption></figure>" for f, h, c in plots)
     body = (header + picture
-            + f'<section id="landmarks"><h2>Landmarks</h2>{_landmark_table(a)}</section>'
+            + landmarks
             + f'<section id="limits"><h2>Force limits</h2>{_limits_tables(a)}</section>'
             + (_teleop_block(a["teleop"]) if a.get("teleop") is not None else "")
             + '<section id="forces"><h2>Forces over time</h2>'
-            + '<p class="sub">Numbered green markers: the moment each landmark was found '
-              '(numbers as in the landmark table). Shaded red: force over the tissue\'s limit. '
-              'Each point is the maximum over 10 ms.</p>'
+            + f'<p class="sub">{" ".join(how_to_read)}</p>'
             + f'<figure><h3>Total force on the tool</h3>{img(total_file, "total force")}</figure>'
             + plot_html + "</section>"
             + f'<footer>hapsim assess · schema {_esc(a["schema"])} · times in seconds from the '
@@ -809,10 +832,12 @@ def write_summary(out_dir: str, json_paths: list[str]) -> str:
             + _kpi("Score, first → last", f'{first["score"]:.1f} → {last["score"]:.1f}')
             + _kpi("Errors, first → last", f'{first["missed"] + first["breaches"]} → '
                    f'{last["missed"] + last["breaches"]}')
-            + _kpi("Time, first → last", f'{first["duration_s"]:.1f} → {last["duration_s"]:.1f}&nbsp;s'))
+            + _kpi("Time, first → last",
+                   f'{first["duration_s"]:.1f} → {last["duration_s"]:.1f}&nbsp;s'))
     body = (f'<header><div><div class="eyebrow">Training summary</div>'
             f'<h1>{_esc(" · ".join(scenes))}</h1>'
-            f'<p class="meta">{len(sessions)} sessions · Summary made {_now_utc()}</p></div></header>'
+            f'<p class="meta">{len(sessions)} sessions · Summary made {_now_utc()}</p>'
+            "</div></header>"
             f'<div class="kpis">{kpis}</div>'
             f'<section id="curve"><h2>Learning curve</h2><figure>'
             f'<img src="{_data_uri(curve_png)}" alt="learning curve"><figcaption>Score, errors '
@@ -835,7 +860,8 @@ _USAGE = "usage: assessment_report.py report DIR | summary OUT_DIR A.json [B.jso
 
 def main(argv: list[str]) -> int:
     _ensure_matplotlib()  # first: a re-run under /usr/bin/python3 starts from here
-    if len(argv) < 2 or argv[0] not in ("report", "summary") or (argv[0] == "report" and len(argv) != 2):
+    if (len(argv) < 2 or argv[0] not in ("report", "summary")
+            or (argv[0] == "report" and len(argv) != 2)):
         _fail(_USAGE)
     try:
         if argv[0] == "report":

@@ -149,8 +149,9 @@ def test_report_names_every_landmark_with_its_state(report):
     _, a, page = report
     for lm in a["landmarks"]:
         name = html.escape(lm["name"], quote=True)
-        m = re.search(r'<tr data-landmark="([^"]*)" data-state="(\w+)">', page[page.find(name) - 200:])
-        assert m and m.group(1) == name, lm["name"]
+        row_start = page.find(f'<tr data-landmark="{name}"')
+        m = re.match(r'<tr data-landmark="([^"]*)" data-state="(\w+)">', page[row_start:])
+        assert m and m.group(1) == name and f"<b>{name}</b>" in page, lm["name"]
         assert m.group(2) == ("found" if lm["found"] else "missed"), lm["name"]
     # The one name with markup in it is escaped, never raw.
     assert '<"JL">' not in page and "&lt;&quot;JL&quot;&gt; &amp; co" in page
