@@ -545,11 +545,11 @@ figcaption { font-size:12.5px; color:var(--muted); margin-top:6px; }
 footer { margin-top:40px; padding-top:12px; border-top:1px solid var(--rule); font-size:12px;
          color:var(--muted); }
 a { color:var(--accent); }
-section { break-inside:avoid-page; }
 @media print {
-  body { background:#fff; font-size:12px; }
+  body { background:#fff; font-size:12px; -webkit-print-color-adjust:exact; print-color-adjust:exact; }
   .page { box-shadow:none; margin:0; max-width:none; padding:0; }
-  h2 { break-after:avoid-page; }
+  h2, h3 { break-after:avoid-page; }
+  header, .kpis, table.data { break-inside:avoid-page; }
   figure, table.data tr { break-inside:avoid-page; }
   a { color:inherit; text-decoration:none; }
 }
