@@ -239,6 +239,11 @@ def test_summary_over_three_sessions(tmp_path):
     # errors = missed landmarks + breaches: 1+1, 1+0 (9.3-0.9 = 8.4 still breaches: 1+1), 0+0
     errors = [int(e) for e in re.findall(r'data-errors="(\d+)"', page)]
     assert errors == [2, 2, 0]
+    # The errors panel stacks missed landmarks (grey) and breaches (red): two of each here.
+    bar_px = _pixels_near(tmp_path / "learning_curve.png", "#7f7f7f", tol=0.02)
+    assert bar_px > 2000
+    assert abs(_pixels_near(tmp_path / "learning_curve.png", "#d62728", tol=0.02) - bar_px) \
+        < 0.35 * bar_px
 
 
 def test_summary_plots_any_number_of_sessions_to_the_same_size(tmp_path):
