@@ -337,3 +337,15 @@ def test_bad_usage_is_one_line_and_exit_2(args):
     r = run_script(*args)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "usage:" in r.stderr
+
+
+def test_a_named_picture_that_is_missing_is_said_once_and_the_report_is_made(tmp_path):
+    d = tmp_path / "s"
+    make_session(d)
+    (d / "picture.png").unlink()
+    r = run_script("report", d)
+    assert r.returncode == 0, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "picture.png" in lines[0] and "missing" in lines[0], r.stderr
+    page = (d / "index.html").read_text()
+    assert "picture.png is missing" in page and len(embedded_images(page)) == 1 + len(TISSUES)
