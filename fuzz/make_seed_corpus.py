@@ -155,12 +155,63 @@ def command_seeds():
     write(t, "all_ones", b"\xff" * len(full))
 
 
+# --- view_state: control, hapsim_msg_ViewState fields, then the sequences ---------------------
+IDENTITY = (1.0, 0.0, 0.0, 0.0)
+# A flat hand, fingers slightly bent: finger f's abduction, MCP, PIP.
+HAND = (0.0, 0.3, 0.2) * 5
+
+
+def view_state(control=0b11, scene=SCENE, time=1.5, tool_count=4, hand_p=(0.0, 0.1, 0.05),
+               hand_q=IDENTITY, hand=HAND, bodies=(), deflection=(), offsets=(), contacts=(),
+               tool_p=(0.0, 0.09, 0.03)):
+    tool = struct.pack("<3d3d3ddi", *tool_p, *tool_p, 0.0, 0.0, 1.0, 1.0, 1)
+    out = (struct.pack("<BQQQdBB", control, scene, 5, 1500, time, 0, 0) +
+           struct.pack("<3d4d3d", 0.0, 0.1, 0.05, *IDENTITY, 0.0, 0.0, 1.0) +
+           struct.pack("<H", tool_count) + tool * 5 +
+           struct.pack("<3d4d15d", *hand_p, *hand_q, *hand))
+    out += struct.pack("<H", len(bodies)) + b"".join(struct.pack("<3d4d", *p, *q) for p, q in bodies)
+    out += struct.pack("<H", len(deflection)) + b"".join(struct.pack("<f", d) for d in deflection)
+    out += struct.pack("<H", len(offsets)) + b"".join(
+        struct.pack("<II3f", s, v, *o) for s, v, o in offsets)
+    out += struct.pack("<H", len(contacts)) + b"".join(
+        struct.pack("<iii3d3dddB", t, b, s, *p, *n, depth, f, 0)
+        for t, b, s, p, n, depth, f in contacts)
+    return out
+
+
+def view_state_seeds():
+    t = "view_state"
+    contact = (1, 0, 3, (0.0, 0.09, 0.03), (0.0, 1.0, 0.0), 0.002, 1.5)
+    full = view_state(offsets=((0, 10, (0.0, -0.001, 0.0)), (3, 5, (0.0, -0.002, 0.0))),
+                      contacts=(contact,))
+    write(t, "empty", b"")
+    write(t, "short", full[:40])
+    write(t, "valid_dented", full)
+    write(t, "valid_at_rest", view_state())
+    write(t, "other_scene", view_state(control=0b10, scene=1))
+    write(t, "nan_hand_angle", view_state(hand=(NAN,) + HAND[1:]))
+    write(t, "hand_not_a_rotation", view_state(hand_q=(2.0, 0.0, 0.0, 0.0)))
+    write(t, "inf_deflection", view_state(deflection=(INF,)))
+    write(t, "body_not_a_rotation", view_state(bodies=(((0, 0, 0), (0, 0, 0, 0)),)))
+    write(t, "offset_out_of_range", view_state(offsets=((0, 1 << 30, (0.0, 0.0, 0.0)),)))
+    write(t, "offset_nan", view_state(offsets=((0, 1, (NAN, 0.0, 0.0)),)))
+    write(t, "contact_unknown_segment", view_state(contacts=((1, 0, 999) + contact[3:],)))
+    write(t, "contact_negative_tool", view_state(contacts=((-1,) + contact[1:],)))
+    write(t, "too_many_tools", view_state(control=0b10, tool_count=9))
+    write(t, "all_ones", b"\xff" * len(full))
+
+
 if __name__ == "__main__":
-    if CORPUS.exists():
-        shutil.rmtree(CORPUS)
+    # Only the packet targets' folders: the file targets' seeds (scene, mesh, ...) are the
+    # shipped files and the hand-made hostile inputs, kept in the corpus as they are.
+    packet_targets = ("legacy_packet", "local_model", "device_state", "command", "view_state")
+    for target in packet_targets:
+        if (CORPUS / target).exists():
+            shutil.rmtree(CORPUS / target)
     legacy_seeds()
     local_model_seeds()
     device_state_seeds()
     command_seeds()
+    view_state_seeds()
     for folder in sorted(CORPUS.iterdir()):
         print(f"{folder.relative_to(HERE.parent)}: {len(list(folder.iterdir()))} seeds")

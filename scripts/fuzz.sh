@@ -11,8 +11,8 @@ set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 seconds="${1:-60}"
 shift || true
-all=(legacy_packet local_model device_state scene scene_step mesh trajectory number_csv recording
-     urdf)
+all=(legacy_packet local_model device_state command view_state scene scene_step mesh trajectory
+     number_csv recording urdf)
 if [[ $# -eq 0 ]]; then
   targets=("${all[@]}")
 else
@@ -30,7 +30,8 @@ cmake --build build/fuzz -j2 --target "${targets[@]/#/hapsim_fuzz_}" || exit 2
 
 # Per target: the largest input and the time one input may take (a scene generates a knee; a
 # mesh is parsed in a child process with its own 30 s limit, below libFuzzer's).
-declare -A max_len=([scene]=8192 [scene_step]=8192 [mesh]=4096 [recording]=16384 [urdf]=8192)
+declare -A max_len=([view_state]=8192 [scene]=8192 [scene_step]=8192 [mesh]=4096 [recording]=16384
+                  [urdf]=8192)
 declare -A timeout=([scene]=60 [scene_step]=60 [mesh]=60 [urdf]=20)
 # Leaks inside a library we cannot fix, each with its reason (config/sanitizers/lsan.supp).
 export LSAN_OPTIONS="suppressions=$PWD/config/sanitizers/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"

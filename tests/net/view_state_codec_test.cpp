@@ -129,6 +129,11 @@ TEST(ViewStateCodec, RefusesWhatDoesNotFitTheWorldAndChangesNothing) {
   m = encoder.encode(truth, kHash, 7, true);
   m.tool_count = 3;
   EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  m = encoder.encode(truth, kHash, 7, true);
+  ASSERT_GT(m.deflection_m._length, 0u);
+  m.deflection_m._buffer[0] = std::numeric_limits<float>::infinity();  // found by fuzz.view_state
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  EXPECT_NE(why.find("deflection"), std::string::npos) << why;
 
   // Nothing of the refused samples reached the snapshot.
   EXPECT_EQ(max_vertex_error_m(seen, before), 0.0f);

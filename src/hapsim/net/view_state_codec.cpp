@@ -162,6 +162,12 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
     return false;
   }
   // Check everything before changing anything.
+  for (std::uint32_t i = 0; i < m.deflection_m._length; ++i) {
+    if (!std::isfinite(m.deflection_m._buffer[i])) {
+      why = "segment " + std::to_string(i) + "'s deflection is not finite";
+      return false;
+    }
+  }
   for (std::uint32_t i = 0; i < m.offsets._length; ++i) {
     const hapsim_msg_VertexOffset& o = m.offsets._buffer[i];
     if (o.segment >= rest_body_.size() ||
@@ -188,8 +194,8 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
                     [](double a) { return std::isfinite(a); });
     if (!finite3(m.hand_p_m) || !q.coeffs().allFinite() || std::abs(q.norm() - 1.0) > 1e-3 ||
         !angles_finite) {
-      why = "the hand's pose or joint angles are not finite (or |q| = " + std::to_string(q.norm()) +
-            " is not 1)";
+      why = "the hand's pose is not a finite rigid motion (|q| = " + std::to_string(q.norm()) +
+            ") or a finger angle is not finite";
       return false;
     }
   }
