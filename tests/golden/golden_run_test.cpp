@@ -161,6 +161,19 @@ TEST(GoldenRun, Knee) {
 TEST(GoldenRun, KneeHand) {
   check_scene("knee_hand_procedural");
 }
+// Recorded 2026-11-26, after the one-world refactor (these scenes came later): they hold what
+// the scenes do now against later changes. The glove's index on the real knee's vastus medialis.
+TEST(GoldenRun, KneeHandReal) {
+  check_scene("knee_hand");
+}
+// The glove pinching a dynamic ball above the virtual sheet.
+TEST(GoldenRun, HandBallSheet) {
+  check_scene("hand_ball_sheet");
+}
+// A CSG block palpated through the god object.
+TEST(GoldenRun, CsgBlock) {
+  check_scene("csg_block");
+}
 TEST(GoldenRun, Teleop) {
   check_scene("teleop");
 }
