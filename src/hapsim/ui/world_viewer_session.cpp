@@ -263,7 +263,8 @@ class WorldViewerSession final : public ViewerSession {
       for (std::size_t m = 0; m < materials_.size(); ++m) {
         running.materials[m].contact = materials_[m];
       }
-      auto recorder = std::make_unique<SessionRecorder>(*path, content_hash(running), 8192);
+      auto recorder = std::make_unique<SessionRecorder>(
+          *path, content_hash(running), 8192, SessionRecorder::Overflow::kDrop, scene_.file);
       // A recording starts from the scene's start (the world reset, cycle 0), so that replaying
       // it on a fresh world (hapsim run --replay) reproduces it bit for bit.
       reset();
