@@ -22,10 +22,12 @@
 
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -78,8 +80,11 @@ fs::path scene_of(const std::string& recording, const RecordingHeader& header,
                      " is not there (nor " + header.scene_path_absolute + "): give --scene FILE");
 }
 
-// A marker where a landmark without a point is: the centre of its segment's surface.
-Vec3 segment_centre_world(const World& world, const std::string& body, const std::string& segment) {
+// A marker where a landmark without a point is: of the half of its segment's surface nearest its
+// centre, the vertex that faces the camera most (the centre itself would be buried in the tissue
+// around it, the most facing vertex of a long muscle at its far end).
+Vec3 segment_marker_world(const World& world, const std::string& body, const std::string& segment,
+                          const Vec3& towards_eye) {
   const WorldDescription& d = world.description();
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
     if (d.bodies[b].name != body) {
@@ -90,20 +95,40 @@ Vec3 segment_centre_world(const World& world, const std::string& body, const std
         continue;
       }
       const TriangleMesh& mesh = world.surface(b, s);
-      Vec3 sum = Vec3::Zero();
-      for (const Vec3& v : mesh.vertices) {
-        sum += v;
+      if (mesh.vertices.empty()) {
+        return Vec3::Zero();
       }
-      const Vec3 centre_body = mesh.vertices.empty()
-                                   ? Vec3::Zero()
-                                   : Vec3(sum / static_cast<double>(mesh.vertices.size()));
-      return world.body_pose(b) * centre_body;
+      Vec3 centre = Vec3::Zero();
+      for (const Vec3& v : mesh.vertices) {
+        centre += v;
+      }
+      centre /= static_cast<double>(mesh.vertices.size());
+      std::vector<double> distance;
+      for (const Vec3& v : mesh.vertices) {
+        distance.push_back((v - centre).norm());
+      }
+      std::vector<double> sorted = distance;
+      std::nth_element(sorted.begin(),
+                       sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2),
+                       sorted.end());
+      const double median = sorted[sorted.size() / 2];
+      Vec3 best = Vec3::Zero();
+      double best_along = -std::numeric_limits<double>::infinity();
+      for (std::size_t k = 0; k < mesh.vertices.size(); ++k) {
+        const Vec3 p = world.body_pose(b) * mesh.vertices[k];
+        if (distance[k] <= median && p.dot(towards_eye) > best_along) {
+          best_along = p.dot(towards_eye);
+          best = p;
+        }
+      }
+      return best;
     }
   }
   return Vec3::Zero();
 }
 
-// The end of the session from the scene's usual direction, the landmarks and breaches marked.
+// The end of the session, framed on the landmarks and breaches (with a margin), from the scene's
+// usual direction; the landmarks and breaches marked.
 void write_picture(const World& world, const RunSetup& setup, const AssessmentDefinition& def,
                    const AssessmentResult& result, const fs::path& path) {
   WorldSceneOptions o;
@@ -113,28 +138,41 @@ void write_picture(const World& world, const RunSetup& setup, const AssessmentDe
   WorldScene drawn(world, o);
   constexpr int kWidth = 1280;
   constexpr int kHeight = 720;
+  constexpr double kAspect = static_cast<double>(kWidth) / kHeight;
   SnapshotWriter writer(kWidth, kHeight);
-  const OrbitCamera camera =
-      framed_camera(drawn.rest_bounds_world(), static_cast<double>(kWidth) / kHeight,
-                    snapshot_yaw_rad(world), snapshot_pitch_rad(world));
+  const double yaw = snapshot_yaw_rad(world);
+  const double pitch = snapshot_pitch_rad(world);
+  const Vec3 towards_eye =
+      -framed_camera(drawn.rest_bounds_world(), kAspect, yaw, pitch).forward_world();
   drawn.update_from_world(world);
   RenderScene& scene = drawn.scene();
-  const double marker_m = std::max(0.004, 0.015 * drawn.rest_bounds_world().sizes().norm());
+  const double marker_m = std::clamp(0.02 * drawn.rest_bounds_world().sizes().norm(), 0.004, 0.03);
+  Box3 marked;
   for (std::size_t i = 0; i < result.landmarks.size(); ++i) {
     const LandmarkResult& l = result.landmarks[i];
     const Vec3f colour = l.found ? kFoundColour : kMissedColour;
-    Vec3 at = l.point_world ? *l.point_world
-              : l.touched   ? l.peak_point_world
-                            : segment_centre_world(world, def.landmarks[i].body, l.segment);
+    const Vec3 at =
+        l.point_world ? *l.point_world
+        : l.touched   ? l.peak_point_world
+                      : segment_marker_world(world, def.landmarks[i].body, l.segment, towards_eye);
     scene.spheres.push_back({at, marker_m, colour, false});
+    marked.extend(at);
     if (l.point_world) {
       scene.spheres.push_back({*l.point_world, l.radius_m, colour, true});
     }
   }
   for (const BreachResult& b : result.breaches) {
-    scene.spheres.push_back({b.point_world, 0.8 * marker_m, kBreachColour, false});
+    scene.spheres.push_back({b.point_world, 1.2 * marker_m, kBreachColour, false});
+    marked.extend(b.point_world);
   }
-  writer.write_png(scene, camera, path.string());
+  // A rig's task spans the whole scene; landmarks are framed with a margin of a twentieth of the
+  // scene's size.
+  Box3 framed = drawn.rest_bounds_world();
+  if (!marked.isEmpty() && world.rig() == nullptr) {
+    const double margin = 0.05 * drawn.rest_bounds_world().sizes().norm();
+    framed = Box3(marked.min() - Vec3::Constant(margin), marked.max() + Vec3::Constant(margin));
+  }
+  writer.write_png(scene, framed_camera(framed, kAspect, yaw, pitch), path.string());
 }
 
 void write_text_file(const fs::path& path, const std::string& text) {
