@@ -281,9 +281,10 @@ SessionRecorder::SessionRecorder(std::filesystem::path path, std::string scene_h
   if (!scene_file.empty()) {
     std::error_code ec;
     scene_path = scene_file.string();
-    scene_path_absolute = std::filesystem::weakly_canonical(scene_file, ec).string();
+    const std::filesystem::path absolute = std::filesystem::absolute(scene_file, ec);
+    scene_path_absolute = std::filesystem::weakly_canonical(absolute, ec).string();
     if (ec) {
-      scene_path_absolute = std::filesystem::absolute(scene_file, ec).string();
+      scene_path_absolute = absolute.string();
     }
   }
   if (scene_path.size() > kMaxScenePathLength || scene_path_absolute.size() > kMaxScenePathLength) {
