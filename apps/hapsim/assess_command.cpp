@@ -11,6 +11,7 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/device/recording.h"
+#include "hapsim/render/assessment_markers.h"
 #include "hapsim/render/force_scale.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
@@ -51,11 +52,6 @@ struct AssessArgs {
   bool summary = false;
 };
 
-// The contract's colours (docs/assessment.md, "Picture").
-const Vec3f kFoundColour(0x2c / 255.0f, 0xa0 / 255.0f, 0x2c / 255.0f);
-const Vec3f kMissedColour(0x7f / 255.0f, 0x7f / 255.0f, 0x7f / 255.0f);
-const Vec3f kBreachColour(0xd6 / 255.0f, 0x27 / 255.0f, 0x28 / 255.0f);
-
 // The scene a recording was made on: --scene, else the path its header gives (as given, from
 // here; else resolved when it was recorded).
 fs::path scene_of(const std::string& recording, const RecordingHeader& header,
@@ -80,53 +76,6 @@ fs::path scene_of(const std::string& recording, const RecordingHeader& header,
                      " is not there (nor " + header.scene_path_absolute + "): give --scene FILE");
 }
 
-// A marker where a landmark without a point is: of the half of its segment's surface nearest its
-// centre, the vertex that faces the camera most (the centre itself would be buried in the tissue
-// around it, the most facing vertex of a long muscle at its far end).
-Vec3 segment_marker_world(const World& world, const std::string& body, const std::string& segment,
-                          const Vec3& towards_eye) {
-  const WorldDescription& d = world.description();
-  for (std::size_t b = 0; b < d.bodies.size(); ++b) {
-    if (d.bodies[b].name != body) {
-      continue;
-    }
-    for (std::size_t s = 0; s < d.bodies[b].segments.size(); ++s) {
-      if (d.bodies[b].segments[s].name != segment) {
-        continue;
-      }
-      const TriangleMesh& mesh = world.surface(b, s);
-      if (mesh.vertices.empty()) {
-        return Vec3::Zero();
-      }
-      Vec3 centre = Vec3::Zero();
-      for (const Vec3& v : mesh.vertices) {
-        centre += v;
-      }
-      centre /= static_cast<double>(mesh.vertices.size());
-      std::vector<double> distance;
-      for (const Vec3& v : mesh.vertices) {
-        distance.push_back((v - centre).norm());
-      }
-      std::vector<double> sorted = distance;
-      std::nth_element(sorted.begin(),
-                       sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2),
-                       sorted.end());
-      const double median = sorted[sorted.size() / 2];
-      Vec3 best = Vec3::Zero();
-      double best_along = -std::numeric_limits<double>::infinity();
-      for (std::size_t k = 0; k < mesh.vertices.size(); ++k) {
-        const Vec3 p = world.body_pose(b) * mesh.vertices[k];
-        if (distance[k] <= median && p.dot(towards_eye) > best_along) {
-          best_along = p.dot(towards_eye);
-          best = p;
-        }
-      }
-      return best;
-    }
-  }
-  return Vec3::Zero();
-}
-
 // The end of the session, framed on the landmarks and breaches (with a margin), from the scene's
 // usual direction; the landmarks and breaches marked.
 void write_picture(const World& world, const RunSetup& setup, const AssessmentDefinition& def,
@@ -147,24 +96,24 @@ void write_picture(const World& world, const RunSetup& setup, const AssessmentDe
   drawn.update_from_world(world);
   RenderScene& scene = drawn.scene();
   const double marker_m = std::clamp(0.02 * drawn.rest_bounds_world().sizes().norm(), 0.004, 0.03);
+  std::vector<Iso3> X_world_body;
+  for (std::size_t b = 0; b < world.body_count(); ++b) {
+    X_world_body.push_back(world.body_pose(b));
+  }
+  const std::vector<Vec3> markers =
+      landmark_marker_points(world.description(), X_world_body, def, towards_eye);
+  std::vector<bool> found;
   Box3 marked;
   for (std::size_t i = 0; i < result.landmarks.size(); ++i) {
-    const LandmarkResult& l = result.landmarks[i];
-    const Vec3f colour = l.found ? kFoundColour : kMissedColour;
-    const Vec3 at =
-        l.point_world ? *l.point_world
-        : l.touched   ? l.peak_point_world
-                      : segment_marker_world(world, def.landmarks[i].body, l.segment, towards_eye);
-    scene.spheres.push_back({at, marker_m, colour, false});
-    marked.extend(at);
-    if (l.point_world) {
-      scene.spheres.push_back({*l.point_world, l.radius_m, colour, true});
-    }
+    found.push_back(result.landmarks[i].found);
+    marked.extend(markers.at(i));
   }
+  std::vector<Vec3> breach_points;
   for (const BreachResult& b : result.breaches) {
-    scene.spheres.push_back({b.point_world, 1.2 * marker_m, kBreachColour, false});
+    breach_points.push_back(b.point_world);
     marked.extend(b.point_world);
   }
+  add_assessment_markers(scene, def, markers, found, breach_points, marker_m);
   // A rig's task spans the whole scene; landmarks are framed with a margin of a twentieth of the
   // scene's size.
   Box3 framed = drawn.rest_bounds_world();
@@ -323,21 +272,17 @@ void assess(const AssessArgs& args) {
   }
   const fs::path root = make_folder(args.report_dir);
   std::vector<std::string> summary_arguments = {"summary", root.string()};
+  bool reports = true;  // the script ran for every session so far
   for (std::size_t i = 0; i < args.recordings.size(); ++i) {
     char name[32];
     std::snprintf(name, sizeof name, "session-%02zu", i + 1);
     const fs::path dir = make_folder(root / name);
-    const Assessed a = assess_one(args.recordings[i], args, dir);
-    if (json_out) {
-      json_out.write(a.json);
-    }
-    if (!run_report_script({"report", dir.string()})) {
-      exit_status() = 1;
-      return;
-    }
+    (void)assess_one(args.recordings[i], args, dir);
+    // Every session is assessed even when the script is missing or fails (said once).
+    reports = reports && run_report_script({"report", dir.string()});
     summary_arguments.push_back((dir / "assessment.json").string());
   }
-  if (!run_report_script(summary_arguments)) {
+  if (!reports || !run_report_script(summary_arguments)) {
     exit_status() = 1;
     return;
   }

@@ -86,8 +86,8 @@ TEST(AssessCommand, WritesTheJsonOfWhatTheSessionDid) {
   EXPECT_EQ(j.at("kind"), "palpation");
   EXPECT_NEAR(j.at("duration_s").get<double>(), 8.0, 1e-9);
   EXPECT_TRUE(j.at("time_limit_s").is_null());
-  // The path: down 40 mm and back up.
-  EXPECT_NEAR(j.at("path_length_m").get<double>(), 0.08, 1e-6);
+  // The path: down 40 mm and back up, less the 10 µm of travel before the first cycle's sample.
+  EXPECT_NEAR(j.at("path_length_m").get<double>(), 0.08, 2e-5);
   EXPECT_NEAR(j.at("peak_force_n").get<double>(), 9.0, 0.0031);
   ASSERT_EQ(j.at("landmarks").size(), 2u);
   EXPECT_TRUE(j.at("landmarks")[0].at("found").get<bool>());
@@ -128,6 +128,24 @@ TEST(AssessCommand, AReportFolderGetsTheJsonTheForcesAndThePicture) {
   EXPECT_NEAR(peak, 9.0, 0.0031);  // the bins keep the peak
   if (!j.at("picture").is_null()) {
     EXPECT_TRUE(fs::is_regular_file(dir / "picture.png"));
+  }
+}
+
+TEST(AssessCommand, ASeriesGetsOneReportFolderPerSession) {
+  const Recorded one = record_press("assess_series_1");
+  const Recorded two = record_press("assess_series_2");
+  const fs::path dir = temp_path("assess_series_out");
+  fs::remove_all(dir);
+  const RunResult r = run_hapsim("assess " + one.recording.string() + " " + two.recording.string() +
+                                 " --summary --report " + dir.string());
+  ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 1) << r.output;
+  for (const char* session : {"session-01", "session-02"}) {
+    ASSERT_TRUE(fs::is_regular_file(dir / session / "assessment.json")) << session;
+    std::ifstream in(dir / session / "assessment.json");
+    EXPECT_EQ(nlohmann::json::parse(in).at("breaches").size(), 1u) << session;
+  }
+  if (r.exit_code == 0) {
+    EXPECT_TRUE(fs::is_regular_file(dir / "index.html"));
   }
 }
 

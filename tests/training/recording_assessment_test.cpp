@@ -25,8 +25,8 @@ const fs::path kScenes = fs::path(HAPSIM_SOURCE_DIR) / "scenes";
 
 class RecordingAssessmentTest : public test::TempDirTest {
  protected:
-  // Runs `scene_file`'s own script, recorded to `recording`.
-  static void record_scripted_run(const fs::path& scene_file, const fs::path& recording) {
+  // Runs `scene_file`'s own script, recorded to `recording`; the run's summary.
+  static SessionSummary record_scripted_run(const fs::path& scene_file, const fs::path& recording) {
     RunSetup setup = make_run_setup(load_scene(scene_file), DeviceChoice::scene_script());
     SessionRecorder recorder(recording, setup.world->content_hash(), 8192,
                              SessionRecorder::Overflow::kFlushInline, scene_file);
@@ -34,15 +34,17 @@ class RecordingAssessmentTest : public test::TempDirTest {
     options.duration_s = setup.duration_s;
     options.dt_s = setup.scene.run.dt_s;
     options.recorder = &recorder;
-    (void)run_session(*setup.world, *setup.device, options);
+    options.teleop_target_world = setup.teleop_target_world;
+    SessionSummary summary = run_session(*setup.world, *setup.device, options);
     recorder.close();
+    return summary;
   }
 };
 
 TEST_F(RecordingAssessmentTest, TheKneesPalpationFindsTheLandmarksItPressesAndMissesTheOthers) {
   const fs::path scene_file = kScenes / "knee.json";
   const fs::path recording = dir_ / "knee.rec";
-  record_scripted_run(scene_file, recording);
+  (void)record_scripted_run(scene_file, recording);
   const SceneDescription scene = load_scene(scene_file);
   ASSERT_TRUE(scene.has_assessment);
   // Written from the scene's script: it presses, in order, the LCL, the lateral joint line, the
@@ -107,7 +109,7 @@ TEST_F(RecordingAssessmentTest, PressingTooHardRecordsOneBreachOfTheAnalyticDura
     }
   })");
   const fs::path recording = dir_ / "press.rec";
-  record_scripted_run(scene_file, recording);
+  (void)record_scripted_run(scene_file, recording);
   const RecordingAssessment a = assess_recording(recording, load_scene(scene_file));
   EXPECT_EQ(a.replay_difference, "");
   ASSERT_EQ(a.result.breaches.size(), 1u);
@@ -130,6 +132,34 @@ TEST_F(RecordingAssessmentTest, PressingTooHardRecordsOneBreachOfTheAnalyticDura
   // The score: 100 for the landmark, less 5 + 10 · 3.999 · (1 + 5.9985/3.0015).
   const double expected = 100.0 - (5.0 + 10.0 * 3.999 * (1.0 + (9.0 - 3.0015) / 3.0015));
   EXPECT_NEAR(a.result.score.value, std::max(0.0, expected), 0.05);
+}
+
+// The pick-and-place measures agree with what the run's own summary (the session's accountant)
+// says about the same session: grasp time, peak grasp force, the ball's distance from the target,
+// placed, slave collisions.
+TEST_F(RecordingAssessmentTest, TheTeleopPickAndPlaceAgreesWithTheRunSummary) {
+  const fs::path scene_file = kScenes / "teleop.json";
+  const fs::path recording = dir_ / "teleop.rec";
+  const SessionSummary summary = record_scripted_run(scene_file, recording);
+  ASSERT_TRUE(summary.teleop.has_value());
+  const TeleopSummary& s = *summary.teleop;
+
+  const RecordingAssessment a = assess_recording(recording, load_scene(scene_file));
+  EXPECT_EQ(a.replay_difference, "");
+  EXPECT_EQ(a.result.kind, "pick_and_place");
+  ASSERT_TRUE(a.result.teleop.has_value());
+  const TeleopAssessment& t = *a.result.teleop;
+  ASSERT_TRUE(t.time_to_grasp_s.has_value());
+  EXPECT_NEAR(*t.time_to_grasp_s, s.grasp_time_s, 1e-9);
+  EXPECT_NEAR(t.peak_grasp_force_n, s.peak_grasp_force_n, 1e-9);
+  ASSERT_TRUE(t.placement_error_m.has_value() && s.target_error_m.has_value());
+  EXPECT_NEAR(*t.placement_error_m, *s.target_error_m, 1e-9);
+  EXPECT_EQ(t.placed, s.placed());
+  EXPECT_TRUE(t.placed);
+  EXPECT_EQ(t.drops, 0u);
+  EXPECT_EQ(s.slave_collision_steps == 0, t.collisions == 0);
+  // 50 placed + 50·(1 − error / 20 mm), nothing taken off.
+  EXPECT_NEAR(a.result.score.value, 50.0 + 50.0 * (1.0 - *s.target_error_m / 0.020), 1e-9);
 }
 
 TEST_F(RecordingAssessmentTest, ARecordingOfAnotherSceneIsRefusedNamingIt) {

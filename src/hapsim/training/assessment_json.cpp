@@ -162,13 +162,19 @@ std::string format_assessment_summary(const AssessmentResult& r) {
   }
   if (r.teleop) {
     const TeleopAssessment& t = *r.teleop;
+    char grasp[32] = "never";
+    if (t.time_to_grasp_s) {
+      std::snprintf(grasp, sizeof grasp, "%.3f s", *t.time_to_grasp_s);
+    }
+    char error[32] = "-";
+    if (t.placement_error_m) {
+      std::snprintf(error, sizeof error, "%.2f mm", *t.placement_error_m * 1e3);
+    }
     std::snprintf(line, sizeof line,
-                  "pick&place   %s; grasp at %s s, %zu drop(s), placement error %s mm, peak grasp "
-                  "%.2f N, %zu collision(s)\n",
-                  t.placed ? "placed" : "NOT placed",
-                  t.time_to_grasp_s ? std::to_string(*t.time_to_grasp_s).c_str() : "never", t.drops,
-                  t.placement_error_m ? std::to_string(*t.placement_error_m * 1e3).c_str() : "-",
-                  t.peak_grasp_force_n, t.collisions);
+                  "pick&place   %s; grasp at %s, %zu drop(s), placement error %s, peak grasp "
+                  "%.2f N, %zu slave collision(s)\n",
+                  t.placed ? "placed" : "NOT placed", grasp, t.drops, error, t.peak_grasp_force_n,
+                  t.collisions);
     out += line;
   }
   std::string terms;

@@ -22,7 +22,7 @@ constexpr double kPerCollision = 5.0;
 AssessmentScore assessment_score(const AssessmentResult& r) {
   AssessmentScore s;
   s.max = 100.0;
-  double breaches = 0.0;
+  double breaches = 0.0;  // stays +0 without a breach
   for (const BreachResult& b : r.breaches) {
     const auto limit = std::find_if(r.limits.begin(), r.limits.end(),
                                     [&b](const LimitResult& l) { return l.tissue == b.tissue; });
@@ -48,8 +48,9 @@ AssessmentScore assessment_score(const AssessmentResult& r) {
             : 0.0;
     s.terms = {{"placed", t.placed ? kPlaced : 0.0},
                {"accuracy", accuracy},
-               {"drops", -kPerDrop * static_cast<double>(t.drops)},
-               {"collisions", -kPerCollision * static_cast<double>(t.collisions)},
+               // + 0.0: no drop is +0 points, not −0.
+               {"drops", -kPerDrop * static_cast<double>(t.drops) + 0.0},
+               {"collisions", -kPerCollision * static_cast<double>(t.collisions) + 0.0},
                {"breaches", breaches},
                {"time", time}};
     s.formula = std::string(

@@ -268,7 +268,7 @@ void AssessmentScorer::add(const CycleRecord& record) {
     has_teleop_ = true;
     const TeleopStepResult& t = record.teleop;
     if (t.held && !held_ && !grasp_at_s_) {
-      grasp_at_s_ = t0_s;
+      grasp_at_s_ = t1_s;  // held at the end of this cycle (as the run summary times it)
     }
     if (!t.held && held_) {
       released_ = true;
