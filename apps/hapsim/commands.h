@@ -36,6 +36,7 @@ void add_info_command(CLI::App& app);
 void add_query_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_run_command(CLI::App& app);
+void add_assess_command(CLI::App& app);
 void add_view_command(CLI::App& app);
 void add_kinematics_commands(CLI::App& app);
 void add_serve_command(CLI::App& app);

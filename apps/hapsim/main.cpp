@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   add_info_command(app);
   add_query_command(app);
   add_run_command(app);
+  add_assess_command(app);
   add_view_command(app);
   add_kinematics_commands(app);
   add_serve_command(app);

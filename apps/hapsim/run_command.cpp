@@ -392,7 +392,8 @@ void run(const RunArgs& args) {
   }
   std::unique_ptr<SessionRecorder> recorder;
   if (!record_path.empty()) {
-    recorder = std::make_unique<SessionRecorder>(record_path, world->content_hash(), 8192);
+    recorder = std::make_unique<SessionRecorder>(record_path, world->content_hash(), 8192,
+                                                 SessionRecorder::Overflow::kDrop, args.scene);
   }
 
   std::unique_ptr<SnapshotSink> snapshots;

@@ -129,7 +129,8 @@ py::object run(const py::object& scene_arg, std::optional<double> duration_s,
   std::unique_ptr<SessionRecorder> recorder;
   if (!record_path.empty()) {
     recorder = std::make_unique<SessionRecorder>(record_path, setup.world->content_hash(), 8192,
-                                                 SessionRecorder::Overflow::kFlushInline);
+                                                 SessionRecorder::Overflow::kFlushInline,
+                                                 setup.scene.file);
   }
   SessionOptions options;
   options.duration_s = length_s;

@@ -127,8 +127,9 @@ std::string read_error(const std::filesystem::path& path) {
   return "";
 }
 
+// Version 2: magic, six counts, the hash, two scene paths (empty here: a length each), checksum.
 std::size_t header_size(const std::string& hash) {
-  return 8 + 6 * 4 + hash.size() + 8;
+  return 8 + 6 * 4 + hash.size() + 4 + 4 + 8;
 }
 
 TEST(Recording, RoundTripIsBitExact) {
@@ -244,9 +245,57 @@ TEST(Recording, CorruptHeaderIsRejected) {
   EXPECT_NE(with(8, 9).find("version 9"), std::string::npos);                    // version
   EXPECT_NE(with(12, 1).find("corrupt header: frame size"), std::string::npos);  // frame size
   EXPECT_NE(with(29, 0x7f).find("scene hash length"), std::string::npos);        // hash length
-  EXPECT_NE(with(28, 100).find("checksum"), std::string::npos);                  // plausible length
-  EXPECT_NE(with(33, 'Z').find("checksum"), std::string::npos);                  // hash text
+  // A plausible hash length: the scene paths' lengths are then read from the wrong place, and
+  // either they or the checksum fail.
+  EXPECT_NE(with(28, 100).find("corrupt header"), std::string::npos);  // plausible length
+  EXPECT_NE(with(33, 'Z').find("checksum"), std::string::npos);        // hash text
   std::filesystem::remove(path);
+}
+
+// Version 2 names the scene (as given and absolute); a version 1 file (no paths) still reads.
+TEST(Recording, TheHeaderNamesTheSceneAndVersionOneStillReads) {
+  const auto frames = make_frames(3);
+  const auto path = test::temp_path(".hrec");
+  {
+    SessionRecorder recorder(path, "scene-abc123", 7, SessionRecorder::Overflow::kFlushInline,
+                             "scenes/knee.json");
+    for (const RecordedFrame& f : frames) {
+      EXPECT_TRUE(recorder.record(f));
+    }
+    recorder.close();
+  }
+  const Recording rec = read_recording(path);
+  EXPECT_EQ(rec.header.version, 2u);
+  EXPECT_EQ(rec.header.scene_path, "scenes/knee.json");
+  EXPECT_EQ(rec.header.scene_path_absolute,
+            (std::filesystem::current_path() / "scenes/knee.json").string());
+  EXPECT_EQ(rec.frames.size(), 3u);
+
+  // The same session as version 1 wrote it: no path fields, version 1, the checksum over the rest
+  // (FNV-1a 64, docs/recording-format.md).
+  const auto v2 = write_recording(frames);
+  auto bytes = file_bytes(v2);
+  const std::size_t hash_end = 8 + 6 * 4 + std::string("scene-abc123").size();
+  bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(hash_end),
+              bytes.begin() + static_cast<std::ptrdiff_t>(hash_end + 8 + 8));
+  bytes[8] = 1;
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (std::size_t i = 0; i < hash_end; ++i) {
+    h ^= static_cast<unsigned char>(bytes[i]);
+    h *= 0x100000001b3ull;
+  }
+  std::vector<char> sum(8);
+  std::memcpy(sum.data(), &h, 8);
+  bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(hash_end), sum.begin(), sum.end());
+  write_bytes(v2, bytes);
+  const Recording old = read_recording(v2);
+  EXPECT_EQ(old.header.version, 1u);
+  EXPECT_EQ(old.header.scene_hash, "scene-abc123");
+  EXPECT_EQ(old.header.scene_path, "");
+  ASSERT_EQ(old.frames.size(), 3u);
+  EXPECT_TRUE(compare_frames(frames, old.frames).identical);
+  std::filesystem::remove(path);
+  std::filesystem::remove(v2);
 }
 
 TEST(Recording, CompareReportsTheFirstDifferingFrameAndField) {

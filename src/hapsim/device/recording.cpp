@@ -264,7 +264,8 @@ std::size_t recorded_frame_size_bytes() {
 // SessionRecorder
 
 SessionRecorder::SessionRecorder(std::filesystem::path path, std::string scene_hash,
-                                 std::size_t capacity_frames, Overflow overflow)
+                                 std::size_t capacity_frames, Overflow overflow,
+                                 const std::filesystem::path& scene_file)
     : path_(std::move(path)), capacity_frames_(capacity_frames), overflow_(overflow) {
   const std::string where = path_.string();
   if (capacity_frames_ == 0) {
@@ -274,6 +275,21 @@ SessionRecorder::SessionRecorder(std::filesystem::path path, std::string scene_h
     throw Error(where, "scene hash is " + std::to_string(scene_hash.size()) +
                            " characters, at most " + std::to_string(kMaxSceneHashLength) +
                            " allowed");
+  }
+  std::string scene_path;
+  std::string scene_path_absolute;
+  if (!scene_file.empty()) {
+    std::error_code ec;
+    scene_path = scene_file.string();
+    const std::filesystem::path absolute = std::filesystem::absolute(scene_file, ec);
+    scene_path_absolute = std::filesystem::weakly_canonical(absolute, ec).string();
+    if (ec) {
+      scene_path_absolute = absolute.string();
+    }
+  }
+  if (scene_path.size() > kMaxScenePathLength || scene_path_absolute.size() > kMaxScenePathLength) {
+    throw Error(where, "the scene's path is longer than " + std::to_string(kMaxScenePathLength) +
+                           " characters");
   }
   out_.open(path_, std::ios::binary | std::ios::trunc);
   if (!out_) {
@@ -287,6 +303,10 @@ SessionRecorder::SessionRecorder(std::filesystem::path path, std::string scene_h
   put(header, static_cast<std::uint32_t>(kMaxDeviceJoints));
   put(header, static_cast<std::uint32_t>(scene_hash.size()));
   header.insert(header.end(), scene_hash.begin(), scene_hash.end());
+  for (const std::string* text : {&scene_path, &scene_path_absolute}) {
+    put(header, static_cast<std::uint32_t>(text->size()));
+    header.insert(header.end(), text->begin(), text->end());
+  }
   put(header, fnv1a(header.data(), header.size()));
   out_.write(reinterpret_cast<const char*>(header.data()),
              static_cast<std::streamsize>(header.size()));
@@ -413,9 +433,10 @@ RecordingReader::RecordingReader(std::filesystem::path path) : path_(std::move(p
   const auto max_fingers = get<std::uint32_t>(&head[20]);
   const auto max_joints = get<std::uint32_t>(&head[24]);
   const auto hash_length = get<std::uint32_t>(&head[28]);
-  if (header_.version != kRecordingVersion) {
+  if (header_.version != 1 && header_.version != kRecordingVersion) {
     throw Error(where, "recording version " + std::to_string(header_.version) +
-                           ", this build reads version " + std::to_string(kRecordingVersion));
+                           ", this build reads versions 1 and " +
+                           std::to_string(kRecordingVersion));
   }
   if (header_.frame_size_bytes != recorded_frame_size_bytes() ||
       max_contacts != static_cast<std::uint32_t>(kMaxRecordedContacts) ||
@@ -424,7 +445,7 @@ RecordingReader::RecordingReader(std::filesystem::path path) : path_(std::move(p
     throw Error(where, "corrupt header: frame size " + std::to_string(header_.frame_size_bytes) +
                            " bytes, " + std::to_string(max_contacts) + " contacts, " +
                            std::to_string(max_fingers) + " fingers, " + std::to_string(max_joints) +
-                           " joints; version 1 expects " +
+                           " joints; this build expects " +
                            std::to_string(recorded_frame_size_bytes()) + ", " +
                            std::to_string(kMaxRecordedContacts) + ", " +
                            std::to_string(kMaxFingers) + ", " + std::to_string(kMaxDeviceJoints));
@@ -434,17 +455,37 @@ RecordingReader::RecordingReader(std::filesystem::path path) : path_(std::move(p
                            " (at most " + std::to_string(kMaxSceneHashLength) +
                            " and within the file expected)");
   }
-  head.resize(kHeaderFixedBytes + hash_length + 8);
-  in_.read(reinterpret_cast<char*>(head.data() + kHeaderFixedBytes),
-           static_cast<std::streamsize>(hash_length + 8));
-  if (static_cast<std::size_t>(in_.gcount()) != hash_length + 8) {
-    throw Error(where, "truncated header");
+  // Reads `n` more header bytes onto `head`.
+  const auto read_more = [&](std::size_t n) {
+    if (head.size() + n > file_size_) {
+      throw Error(where, "truncated header");
+    }
+    const std::size_t at = head.size();
+    head.resize(at + n);
+    in_.read(reinterpret_cast<char*>(head.data() + at), static_cast<std::streamsize>(n));
+    if (static_cast<std::size_t>(in_.gcount()) != n) {
+      throw Error(where, "truncated header");
+    }
+  };
+  read_more(hash_length);
+  header_.scene_hash.assign(reinterpret_cast<const char*>(&head[kHeaderFixedBytes]), hash_length);
+  if (header_.version >= 2) {
+    for (std::string* text : {&header_.scene_path, &header_.scene_path_absolute}) {
+      read_more(4);
+      const auto length = get<std::uint32_t>(&head[head.size() - 4]);
+      if (length > kMaxScenePathLength) {
+        throw Error(where, "corrupt header: scene path length " + std::to_string(length) +
+                               " (at most " + std::to_string(kMaxScenePathLength) + ")");
+      }
+      read_more(length);
+      text->assign(reinterpret_cast<const char*>(&head[head.size() - length]), length);
+    }
   }
-  const std::size_t checked = kHeaderFixedBytes + hash_length;
+  const std::size_t checked = head.size();
+  read_more(8);
   if (get<std::uint64_t>(&head[checked]) != fnv1a(head.data(), checked)) {
     throw Error(where, "corrupt header: checksum mismatch");
   }
-  header_.scene_hash.assign(reinterpret_cast<const char*>(&head[kHeaderFixedBytes]), hash_length);
   offset_ = head.size();
   frame_count_hint_ = static_cast<std::size_t>((file_size_ - offset_) / header_.frame_size_bytes);
   bytes_.resize(header_.frame_size_bytes);

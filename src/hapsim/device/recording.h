@@ -27,9 +27,12 @@ namespace hapsim {
 
 /// Contacts kept per cycle; more are counted by the world but not recorded.
 inline constexpr int kMaxRecordedContacts = 16;
-inline constexpr std::uint32_t kRecordingVersion = 1;
+/// Version 2 adds the scene file's path to the header (version 1 files are still read).
+inline constexpr std::uint32_t kRecordingVersion = 2;
 /// Longest scene hash string accepted in a header.
 inline constexpr std::size_t kMaxSceneHashLength = 4096;
+/// Longest scene path accepted in a header (version 2).
+inline constexpr std::size_t kMaxScenePathLength = 4096;
 
 /// One contact as the world reports it (plain data; indices are -1 when not applicable).
 struct RecordedContact {
@@ -60,6 +63,11 @@ struct RecordingHeader {
   /// Identifies the scene the session ran on (the world's content hash), so a replay against a
   /// different scene is noticed.
   std::string scene_hash;
+  /// Version 2: the scene file as the command was given it and resolved to an absolute path
+  /// (empty when the session was built in code, and in version 1 files), so `hapsim assess`
+  /// finds the scene a recording was made on.
+  std::string scene_path;
+  std::string scene_path_absolute;
 };
 
 struct Recording {
@@ -76,8 +84,10 @@ class SessionRecorder {
 
   /// Creates `path` and writes the header. Throws hapsim::Error if the file cannot be created or
   /// the hash is longer than kMaxSceneHashLength. Reserves `capacity_frames` (> 0) frames.
+  /// `scene_file`: the scene file the session runs (as given; its absolute path is added), if any.
   SessionRecorder(std::filesystem::path path, std::string scene_hash,
-                  std::size_t capacity_frames = 4096, Overflow overflow = Overflow::kDrop);
+                  std::size_t capacity_frames = 4096, Overflow overflow = Overflow::kDrop,
+                  const std::filesystem::path& scene_file = {});
   /// Flushes and closes; errors are swallowed here, call close() to see them.
   ~SessionRecorder();
   SessionRecorder(const SessionRecorder&) = delete;

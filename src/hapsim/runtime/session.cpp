@@ -322,6 +322,9 @@ SessionSummary run_inline(World& world, Device& device, const SessionOptions& op
     fill_cycle_record(record, i, input, result, out,
                       std::chrono::duration<double, std::micro>(c1 - c0).count());
     accountant.account(record);
+    if (options.on_record) {
+      options.on_record(record);
+    }
     for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
       if (desc.bodies[b].kind != BodyKind::kDeformable) {
         continue;
@@ -394,6 +397,9 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
       loop.request_stop();
     }
     accountant.account(r);
+    if (options.on_record) {
+      options.on_record(r);
+    }
     if (++accounted % progress_every == 0) {
       report_progress(options.progress, "run (real time)",
                       static_cast<double>(accounted) / static_cast<double>(steps));

@@ -66,6 +66,10 @@ struct SessionOptions {
   /// Inline runs only: called after every cycle's bookkeeping with the cycle index (between
   /// cycles, on the stepping thread: may read the world, e.g. to render a snapshot).
   std::function<void(std::size_t cycle)> after_cycle;
+  /// Every cycle's record, after the run's own bookkeeping took it (inline: on the stepping
+  /// thread; real time: on the calling thread, from the ring — never the haptic thread). An
+  /// assessment scores a session from these (training/assessment_scorer.h).
+  std::function<void(const CycleRecord&)> on_record;
 };
 
 /// Step costs, microseconds.

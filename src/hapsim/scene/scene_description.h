@@ -3,6 +3,7 @@
 #pragma once
 
 #include "hapsim/core/types.h"
+#include "hapsim/training/assessment_definition.h"
 #include "hapsim/world/world_description.h"
 
 #include <filesystem>
@@ -151,6 +152,10 @@ struct SceneDescription {
   WorldDescription world;
   DeviceDescription device;
   RunDescription run;
+  /// What a session is judged by ("assessment", docs/assessment.md); has_assessment when the
+  /// scene declares one (`hapsim assess` refuses a scene without).
+  bool has_assessment = false;
+  AssessmentDefinition assessment;
   /// Named camera views ("views"), in name order.
   std::vector<SceneView> views;
   /// What the load and the run's assembly let through but a user should know, one line each,

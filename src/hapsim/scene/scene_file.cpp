@@ -9,6 +9,7 @@
 #include "hapsim/scene/json_text.h"
 #include "hapsim/scene/scene_reader.h"
 #include "hapsim/scene/teleop_reader.h"
+#include "hapsim/scene/assessment_reader.h"
 #include "hapsim/scene/view_reader.h"
 
 #include <nlohmann/json.hpp>
@@ -60,11 +61,12 @@ SceneDescription Parser::parse(const Json& root) {
   const bool teleop = root.is_object() && root.contains("teleop");
   if (teleop) {
     allow_keys(root, "",
-               {"$schema", "format", "description", "data", "teleop", "device", "run", "views"});
+               {"$schema", "format", "description", "data", "teleop", "device", "run", "views",
+                "assessment"});
   } else {
     allow_keys(root, "",
                {"$schema", "format", "description", "data", "world", "materials", "bodies", "tools",
-                "device", "run", "views"});
+                "device", "run", "views", "assessment"});
   }
   const Json& format = required(root, "", "format");
   if (!format.is_string() || format.get<std::string>() != "hapsim-scene/1") {
@@ -87,6 +89,9 @@ SceneDescription Parser::parse(const Json& root) {
     read_teleop(*this, root["teleop"], "/teleop", scene.teleop);
     read_teleop_device(*this, required(root, "", "device"), "/device", scene.device);
     parse_run(root, scene);
+    if (root.contains("assessment")) {
+      read_assessment(*this, root["assessment"], "/assessment", scene);
+    }
     report_progress(options().progress, "scene: loaded", 1.0);
     return scene;
   }
@@ -149,6 +154,9 @@ SceneDescription Parser::parse(const Json& root) {
   parse_run(root, scene);
   // Palpation targets must name what exists.
   check_palpation_targets(*this, scene);
+  if (root.contains("assessment")) {
+    read_assessment(*this, root["assessment"], "/assessment", scene);
+  }
   report_progress(options().progress, "scene: loaded", 1.0);
   return scene;
 }

@@ -7,11 +7,13 @@
 #include "hapsim/device/master_probe_device.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/kinematics/hand_model.h"
+#include "hapsim/render/assessment_markers.h"
 #include "hapsim/render/force_scale.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
+#include "hapsim/training/assessment_scorer.h"
 #if defined(HAPSIM_WITH_SPNAV)
 #include "hapsim/device/spacenav_device.h"
 #endif
@@ -20,7 +22,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <memory>
 #include <numbers>
+#include <optional>
+#include <vector>
 
 namespace hapsim {
 namespace {
@@ -147,6 +152,22 @@ class WorldViewerSession final : public ViewerSession {
     WorldSceneOptions o = view_->options();
     o.force_full_scale_n = readout_.bar_full_scale_n;
     view_->set_options(o);
+    if (scene_.has_assessment) {
+      // Scored from the records this thread drains (never the haptic path); the landmarks marked
+      // where the default view (the knee from the front, a little medial) sees them.
+      teleop_target_world_ = setup.teleop_target_world;
+      script_length_s_ = sim ? setup.duration_s : 0.0;
+      scorer_ = std::make_unique<AssessmentScorer>(scene_.assessment, *world_, scene_.run.dt_s,
+                                                   teleop_target_world_);
+      std::vector<Iso3> X_world_body;
+      for (std::size_t b = 0; b < world_->body_count(); ++b) {
+        X_world_body.push_back(world_->body_pose(b));
+      }
+      landmark_markers_ =
+          landmark_marker_points(world_->description(), X_world_body, scene_.assessment,
+                                 Vec3(-0.35, 0.9, 0.3).normalized());
+      marker_m_ = std::clamp(0.02 * view_->rest_bounds_world().sizes().norm(), 0.004, 0.03);
+    }
     start_loop();
   }
   ~WorldViewerSession() override {
@@ -165,6 +186,9 @@ class WorldViewerSession final : public ViewerSession {
   void drain_records() {
     SpscRing<CycleRecord>& records = *client_->records();
     while (const CycleRecord* r = records.front()) {
+      if (scorer_) {
+        scorer_->add(*r);
+      }
       if (recorder_) {
         if (!recorder_->record(to_recorded_frame(*r, device_->profile()))) {
           ++recorded_dropped_;
@@ -185,9 +209,50 @@ class WorldViewerSession final : public ViewerSession {
     view_->update(s);
     if (s.teleop) {
       update_rig(s, *s.teleop);
+    } else {
+      fill_world_readout(*world_, *view_, s, readout_);
+    }
+    update_assessment();
+  }
+
+  // The landmarks (found green, missed grey, breaches red) and the score: "so far" while the
+  // session runs, final once a scripted device's run has ended (the result recomputed at most
+  // once a second of session time: it copies the force series).
+  void update_assessment() {
+    if (!scorer_) {
       return;
     }
-    fill_world_readout(*world_, *view_, s, readout_);
+    const double dt_s = scene_.run.dt_s;
+    const double t_s = static_cast<double>(scorer_->cycles()) * dt_s;
+    const bool finished = script_length_s_ > 0.0 && t_s >= script_length_s_ - 0.5 * dt_s;
+    if (!assessment_ || t_s - assessed_at_s_ >= 1.0 || (finished && !final_)) {
+      assessment_ = std::make_unique<AssessmentResult>(scorer_->finish());
+      assessed_at_s_ = t_s;
+      final_ = finished;
+    }
+    if (show_landmarks_) {
+      std::vector<bool> found;
+      for (std::size_t i = 0; i < scene_.assessment.landmarks.size(); ++i) {
+        found.push_back(scorer_->landmark_found(i));
+      }
+      std::vector<Vec3> breaches;
+      for (const BreachResult& b : assessment_->breaches) {
+        breaches.push_back(b.point_world);
+      }
+      add_assessment_markers(view_->scene(), scene_.assessment, landmark_markers_, found, breaches,
+                             marker_m_);
+    }
+    char text[160];
+    if (!assessment_->landmarks.empty()) {
+      std::snprintf(text, sizeof text, "%zu of %zu", assessment_->landmarks_found(),
+                    assessment_->landmarks.size());
+      readout_.lines.emplace_back("landmarks found", text);
+    }
+    std::snprintf(text, sizeof text, "%zu", assessment_->breaches.size());
+    readout_.lines.emplace_back("force-limit breaches", text);
+    std::snprintf(text, sizeof text, "%.1f / %.0f%s", assessment_->score.value,
+                  assessment_->score.max, final_ ? " (final)" : " (so far)");
+    readout_.lines.emplace_back("score", text);
   }
 
   RenderScene& render_scene() override {
@@ -244,6 +309,13 @@ class WorldViewerSession final : public ViewerSession {
     loop_.reset();
     client_.reset();
     world_->reset();
+    if (scorer_) {
+      // The world starts again: so does its assessment.
+      scorer_ = std::make_unique<AssessmentScorer>(scene_.assessment, *world_, scene_.run.dt_s,
+                                                   teleop_target_world_);
+      assessment_.reset();
+      final_ = false;
+    }
     start_loop();
   }
 
@@ -263,7 +335,8 @@ class WorldViewerSession final : public ViewerSession {
       for (std::size_t m = 0; m < materials_.size(); ++m) {
         running.materials[m].contact = materials_[m];
       }
-      auto recorder = std::make_unique<SessionRecorder>(*path, content_hash(running), 8192);
+      auto recorder = std::make_unique<SessionRecorder>(
+          *path, content_hash(running), 8192, SessionRecorder::Overflow::kDrop, scene_.file);
       // A recording starts from the scene's start (the world reset, cycle 0), so that replaying
       // it on a fresh world (hapsim run --replay) reproduces it bit for bit.
       reset();
@@ -294,6 +367,9 @@ class WorldViewerSession final : public ViewerSession {
       return;
     }
     draw_world_display_controls(*view_);
+    if (scorer_) {
+      ImGui::Checkbox("landmarks (found green, missed grey)", &show_landmarks_);
+    }
     if (ImGui::CollapsingHeader("Stiffness and limits")) {
       if (recorder_) {
         ImGui::TextWrapped(
@@ -430,6 +506,16 @@ class WorldViewerSession final : public ViewerSession {
   std::string device_name_;
   std::string title_;
   bool paused_ = false;
+  // The scene's assessment, when it has one (docs/assessment.md).
+  std::unique_ptr<AssessmentScorer> scorer_;
+  std::unique_ptr<AssessmentResult> assessment_;
+  std::optional<Vec3> teleop_target_world_;
+  std::vector<Vec3> landmark_markers_;
+  double marker_m_ = 0.0;
+  double script_length_s_ = 0.0;  // a scripted device's run (0: open-ended)
+  double assessed_at_s_ = 0.0;
+  bool final_ = false;
+  bool show_landmarks_ = true;
 };
 
 }  // namespace
