@@ -1,7 +1,7 @@
 #include "hapsim/script/trajectory.h"
 
-#include "support/temp_path.h"
 #include "hapsim/core/error.h"
+#include "support/temp_path.h"
 
 #include <cmath>
 #include <cstring>
