@@ -165,7 +165,17 @@ TEST(GloveCalibrationFile, WrittenCalibrationReadsBackExactly) {
     EXPECT_EQ(d.sensors[i].coupling, c.sensors[i].coupling);
   }
   EXPECT_EQ(d.p_tracker_hand, c.p_tracker_hand);
-  EXPECT_EQ(d.residuals.size(), c.residuals.size());
+  ASSERT_EQ(d.residuals.size(), c.residuals.size());
+  for (std::size_t i = 0; i < c.residuals.size(); ++i) {
+    EXPECT_EQ(d.residuals[i].joint, c.residuals[i].joint);
+    EXPECT_EQ(d.residuals[i].rms_deg, c.residuals[i].rms_deg);
+    // The layout's sensor for the joint: j3 (index abduction) is read by s11, the spread.
+    if (c.residuals[i].joint == 3) {
+      EXPECT_EQ(c.residuals[i].sensor, 11);
+    }
+  }
+  EXPECT_TRUE(c.palm_offset_fitted);
+  EXPECT_EQ(c.pivot_samples, 200u);
 }
 
 TEST(GloveProcedureFile, ErrorsNameThePointer) {

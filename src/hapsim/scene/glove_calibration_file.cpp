@@ -217,6 +217,8 @@ GloveCalibration parse_glove_calibration(std::string_view text, const std::files
     const Json& fit = r.object(root["tracker_to_hand_fit"], "/tracker_to_hand_fit", "an object");
     c.palm_offset_fitted = fit.contains("method") && fit["method"] == "pivot";
     c.pivot_rms_m = r.number_in(fit, "/tracker_to_hand_fit", "rms_m", 0.0, 0.0, 1e3, "m");
+    c.pivot_samples = static_cast<std::size_t>(
+        r.number_in(fit, "/tracker_to_hand_fit", "samples", 0.0, 0.0, 1e12, "rows"));
   }
   if (root.contains("residuals")) {
     const Json& res = r.array(root["residuals"], "/residuals", "the residuals per joint");
@@ -231,6 +233,12 @@ GloveCalibration parse_glove_calibration(std::string_view text, const std::files
         r.fail(JsonReader::at(rp, "joint"), "expected a joint j0..j14");
       }
       g.joint = j;
+      // The sensor that reads it, from the layout (the file's "sensor" is for people).
+      for (int k = 0; k < kGloveSensors; ++k) {
+        if (glove_sensor_layout()[static_cast<std::size_t>(k)].joint == j) {
+          g.sensor = k;
+        }
+      }
       g.rms_deg = r.number_in(jr, rp, "rms_deg", 0.0, 0.0, 1e6, "degrees");
       g.max_deg = r.number_in(jr, rp, "max_deg", 0.0, 0.0, 1e6, "degrees");
       c.residuals.push_back(g);
