@@ -46,5 +46,6 @@ void add_control_command(CLI::App& app);
 void add_simplify_command(CLI::App& app);
 void add_polygonize_command(CLI::App& app);
 void add_sheet_profile_command(CLI::App& app);
+void add_calibrate_command(CLI::App& app);
 
 }  // namespace hapsim::app

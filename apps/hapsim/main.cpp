@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   add_simplify_command(app);
   add_polygonize_command(app);
   add_sheet_profile_command(app);
+  add_calibrate_command(app);
 #ifdef HAPSIM_WITH_BENCH
   add_bench_command(app);
 #endif

@@ -1,7 +1,7 @@
 #include "hapsim/script/trajectory.h"
 
-#include "support/temp_path.h"
 #include "hapsim/core/error.h"
+#include "support/temp_path.h"
 
 #include <cmath>
 #include <cstring>
@@ -90,6 +90,10 @@ TEST(TrajectoryCsv, EveryBadFileNamesLineColumnAndExpectation) {
       {"too many fingers", "t,x,y,z,qw,qx,qy,qz,f0,f1,f2,f3,f4,f5\n", "bad.csv:1:36",
        "no more finger columns"},
       {"duplicate buttons", "t,x,y,z,qw,qx,qy,qz,buttons,buttons\n", "bad.csv:1:29", "twice"},
+      {"sensor gap", "t,x,y,z,qw,qx,qy,qz,s0,s2\n", "bad.csv:1:24", "expected 's1'"},
+      {"joints and sensors", "t,x,y,z,qw,qx,qy,qz,j0,s0\n", "bad.csv:1:1", "not both"},
+      {"NaN count", "t,x,y,z,qw,qx,qy,qz,s0\n0,0,0,0,1,0,0,0,nan\n", "bad.csv:2:17",
+       "column 's0': expected a finite"},
       {"NaN", h + r0 + "1,0,nan,0,1,0,0,0\n", "bad.csv:3:5", "column 'y': expected a finite"},
       {"inf", h + r0 + "1,0,0,-inf,1,0,0,0\n", "bad.csv:3:7", "column 'z': expected a finite"},
       {"not a number", h + r0 + "1,0,0,0,1,0,abc,0\n", "bad.csv:3:13",
@@ -118,6 +122,24 @@ TEST(TrajectoryCsv, EveryBadFileNamesLineColumnAndExpectation) {
       EXPECT_NE(std::string(e.what()).find(c.message_part), std::string::npos) << e.what();
     }
   }
+}
+
+// A glove's raw sensor counts (docs/glove-calibration.md) are kept per row, in column order, and
+// written back as they were read.
+TEST(TrajectoryCsv, RawSensorColumnsAreKeptPerRowAndSavedBack) {
+  const Trajectory t = parse_trajectory_csv(
+      "t,x,y,z,qw,qx,qy,qz,s0,s1,s2,buttons\n0,0,0,0,1,0,0,0,10,20,30,1\n"
+      "0.5,0,0,0,1,0,0,0,11,-21,31.5,0\n",
+      "raw.csv");
+  ASSERT_EQ(t.sensor_count, 3);
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(t.joint_count, 0);
+  EXPECT_EQ(std::vector<double>(t.sensors(1).begin(), t.sensors(1).end()),
+            (std::vector<double>{11.0, -21.0, 31.5}));
+  EXPECT_EQ(t.samples[0].buttons, 1u);
+  const Trajectory again = parse_trajectory_csv(format_trajectory_csv(t), "again.csv");
+  EXPECT_EQ(again.sensor_counts, t.sensor_counts);
+  EXPECT_EQ(again.sensor_count, 3);
 }
 
 TEST(TrajectoryCsv, MissingFileIsNamed) {

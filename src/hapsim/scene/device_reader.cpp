@@ -2,6 +2,7 @@
 
 #include "hapsim/core/device_io.h"
 #include "hapsim/core/device_profile.h"
+#include "hapsim/scene/glove_calibration_file.h"
 
 #include <algorithm>
 #include <set>
@@ -181,8 +182,8 @@ void read_device(const SceneReader& r, const Json& j, const std::string& ptr,
                  SceneDescription& scene) {
   r.object(j, ptr, "the device");
   r.allow_keys(j, ptr,
-               {"type", "profile", "trajectory", "palpation", "hand", "glove_palpation",
-                "glove_pick_and_place"});
+               {"type", "profile", "trajectory", "calibration", "palpation", "hand",
+                "glove_palpation", "glove_pick_and_place"});
   DeviceDescription& d = scene.device;
   if (j.contains("type")) {
     d.type = r.one_of(j["type"], JsonReader::at(ptr, "type"), {"simulated", "glove"});
@@ -191,6 +192,23 @@ void read_device(const SceneReader& r, const Json& j, const std::string& ptr,
   if (!glove &&
       (j.contains("hand") || j.contains("glove_palpation") || j.contains("glove_pick_and_place"))) {
     r.fail(ptr, "'hand', 'glove_palpation' and 'glove_pick_and_place' need \"type\": \"glove\"");
+  }
+  if (j.contains("calibration")) {
+    const std::string cp = JsonReader::at(ptr, "calibration");
+    if (!glove) {
+      r.fail(cp,
+             "a calibration turns a glove's raw sensor counts into angles: it needs "
+             "\"type\": \"glove\"");
+    }
+    if (!j.contains("trajectory")) {
+      r.fail(cp,
+             "a calibration applies to a 'trajectory' of raw sensor counts; the glove's "
+             "scripts give joint angles");
+    }
+    d.glove_calibration_file =
+        r.existing_file(j["calibration"], cp, "a glove calibration (USER.json)");
+    // Read with the scene: a bad calibration is a load error, naming its own file and pointer.
+    d.glove_calibration = load_glove_calibration(d.glove_calibration_file);
   }
   if (glove) {
     scene.world.has_hand = true;

@@ -3,10 +3,12 @@
 #pragma once
 
 #include "hapsim/core/types.h"
+#include "hapsim/device/glove_calibration.h"
 #include "hapsim/training/assessment_definition.h"
 #include "hapsim/world/world_description.h"
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -106,6 +108,10 @@ struct DeviceDescription {
   /// type "glove": a scripted pick-and-place by the hand (a dynamic ball onto a sheet).
   bool has_glove_pick_and_place = false;
   GlovePickAndPlaceDescription glove_pick_and_place;
+  /// type "glove": the user's calibration (docs/glove-calibration.md), read with the scene; it
+  /// turns a trajectory's raw sensor columns into angles when the trajectory is loaded.
+  std::filesystem::path glove_calibration_file;
+  std::optional<GloveCalibration> glove_calibration;
 };
 
 /// A teleoperation scene (000): master arm → slave arm with a parallel gripper → ball → sheet.

@@ -45,6 +45,12 @@ struct PalpationAim {
 [[nodiscard]] Trajectory make_scene_glove_pick_and_place(
     const World& world, const GlovePickAndPlaceDescription& script);
 
+/// A trajectory file for the scene's device: a glove's raw sensor columns turned into angles by
+/// the scene's calibration (scene/glove_calibration_file.h, load_glove_trajectory); raw columns
+/// on any other device, or without a calibration, are an error naming the file.
+[[nodiscard]] Trajectory load_device_trajectory(const SceneDescription& scene,
+                                                const std::filesystem::path& file);
+
 /// The device of the scene: `trajectory_override` (a CSV file) if given, else the scene's
 /// trajectory file, else its palpation script. Throws hapsim::Error if the scene has none.
 [[nodiscard]] std::unique_ptr<SimulatedDevice> make_scene_device(

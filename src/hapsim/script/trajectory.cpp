@@ -31,7 +31,7 @@ std::string_view trim(std::string_view s) {
 }
 
 // What one header column means.
-enum class ColumnKind { kTime, kPos, kQuat, kFinger, kJoint, kButtons };
+enum class ColumnKind { kTime, kPos, kQuat, kFinger, kJoint, kSensor, kButtons };
 struct Column {
   std::string name;
   ColumnKind kind = ColumnKind::kTime;
@@ -84,7 +84,7 @@ int indexed_name(std::string_view name, char prefix) {
 
 std::vector<Column> parse_header(std::string_view line, std::string_view source,
                                  std::size_t line_no, int& finger_count, int& joint_count,
-                                 bool& has_buttons) {
+                                 int& sensor_count, bool& has_buttons) {
   const std::vector<Field> fields = split_fields(line);
   std::vector<Column> columns;
   for (std::size_t i = 0; i < fields.size(); ++i) {
@@ -108,6 +108,7 @@ std::vector<Column> parse_header(std::string_view line, std::string_view source,
     }
     const int finger = indexed_name(f.text, 'f');
     const int joint = indexed_name(f.text, 'j');
+    const int sensor = indexed_name(f.text, 's');
     if (f.text == "buttons") {
       if (has_buttons) {
         throw Error(where, "column 'buttons' appears twice");
@@ -136,10 +137,23 @@ std::vector<Column> parse_header(std::string_view line, std::string_view source,
       }
       ++joint_count;
       columns.push_back({std::string(f.text), ColumnKind::kJoint, joint});
+    } else if (sensor >= 0) {
+      if (sensor != sensor_count || sensor >= kMaxRawSensors) {
+        throw Error(where,
+                    "column '" + std::string(f.text) + "': expected " +
+                        (sensor_count < kMaxRawSensors ? "'s" + std::to_string(sensor_count) + "'"
+                                                       : std::string("no more sensor columns")) +
+                        " (raw sensor columns run s0..s" + std::to_string(kMaxRawSensors - 1) +
+                        " in order)");
+      }
+      ++sensor_count;
+      columns.push_back({std::string(f.text), ColumnKind::kSensor, sensor});
     } else {
       throw Error(where, "unknown column '" + std::string(f.text) + "'; expected f0..f" +
                              std::to_string(kMaxFingers - 1) + " (finger angles), j0..j" +
-                             std::to_string(kMaxDeviceJoints - 1) + " (joint angles) or buttons");
+                             std::to_string(kMaxDeviceJoints - 1) + " (joint angles), s0..s" +
+                             std::to_string(kMaxRawSensors - 1) +
+                             " (raw glove sensor counts) or buttons");
     }
   }
   if (fields.size() < kPoseColumns.size()) {
@@ -328,7 +342,11 @@ Trajectory parse_trajectory_csv(std::string_view text, std::string_view source_n
     }
     if (!have_header) {
       columns = parse_header(line, source_name, line_no, traj.finger_count, traj.joint_count,
-                             traj.has_buttons);
+                             traj.sensor_count, traj.has_buttons);
+      if (traj.sensor_count > 0 && traj.joint_count > 0) {
+        throw Error(location(source_name, line_no, 1),
+                    "a row carries either joint angles j0.. or raw sensor counts s0.., not both");
+      }
       have_header = true;
       continue;
     }
@@ -367,6 +385,9 @@ Trajectory parse_trajectory_csv(std::string_view text, std::string_view source_n
           break;
         case ColumnKind::kJoint:
           s.joint_rad[static_cast<std::size_t>(c.index)] = v;
+          break;
+        case ColumnKind::kSensor:
+          traj.sensor_counts.push_back(v);  // columns come in order s0, s1, ...
           break;
         case ColumnKind::kButtons:
           break;
@@ -413,11 +434,15 @@ std::string format_trajectory_csv(const Trajectory& trajectory) {
   for (int i = 0; i < trajectory.joint_count; ++i) {
     out += ",j" + std::to_string(i);
   }
+  for (int i = 0; i < trajectory.sensor_count; ++i) {
+    out += ",s" + std::to_string(i);
+  }
   if (trajectory.has_buttons) {
     out += ",buttons";
   }
   out += '\n';
-  for (const DeviceInput& s : trajectory.samples) {
+  for (std::size_t row = 0; row < trajectory.samples.size(); ++row) {
+    const DeviceInput& s = trajectory.samples[row];
     out += format_double(s.time_s);
     for (int k = 0; k < 3; ++k) {
       out += ',' + format_double(s.p_world[k]);
@@ -430,6 +455,9 @@ std::string format_trajectory_csv(const Trajectory& trajectory) {
     }
     for (int i = 0; i < trajectory.joint_count; ++i) {
       out += ',' + format_double(s.joint_rad[static_cast<std::size_t>(i)]);
+    }
+    for (const double c : trajectory.sensors(row)) {
+      out += ',' + format_double(c);
     }
     if (trajectory.has_buttons) {
       out += ',' + std::to_string(s.buttons);

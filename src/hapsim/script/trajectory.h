@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -15,6 +16,8 @@ namespace hapsim {
 /// How far from 1 a quaternion's norm may be before it is taken for a mistake (e.g. a column
 /// order mix-up) rather than rounding in a hand-written file.
 inline constexpr double kQuatNormTolerance = 1e-3;
+/// Raw glove sensor columns s0..s31 (docs/glove-calibration.md): counts, not angles.
+inline constexpr int kMaxRawSensors = 32;
 
 struct Trajectory {
   /// Samples with strictly increasing time_s, unit quaternions, finite values; every sample has
@@ -24,6 +27,18 @@ struct Trajectory {
   int joint_count = 0;
   /// Whether the source had a `buttons` column (otherwise buttons are 0).
   bool has_buttons = false;
+  /// Raw glove sensor counts (columns s0..sN): sensor_count per sample, sample-major. A glove
+  /// calibration turns them into joint angles when the trajectory is loaded
+  /// (device/glove_calibration.h); sample_at() does not interpolate them.
+  int sensor_count = 0;
+  std::vector<double> sensor_counts;
+
+  /// Sample i's raw sensor counts (empty when the trajectory has none).
+  [[nodiscard]] std::span<const double> sensors(std::size_t i) const {
+    return std::span<const double>(sensor_counts)
+        .subspan(i * static_cast<std::size_t>(sensor_count),
+                 static_cast<std::size_t>(sensor_count));
+  }
 
   [[nodiscard]] bool empty() const { return samples.empty(); }
   [[nodiscard]] std::size_t size() const { return samples.size(); }
