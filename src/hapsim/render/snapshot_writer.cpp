@@ -49,6 +49,10 @@ void SnapshotWriter::write_png(const RenderScene& scene, const OrbitCamera& came
   hapsim::write_png(path, width_px_, height_px_, render(scene, camera));
 }
 
+int SnapshotWriter::samples() const {
+  return context_->samples();
+}
+
 std::string SnapshotWriter::renderer_name() const {
   return context_->renderer_name();
 }

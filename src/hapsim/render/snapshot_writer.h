@@ -46,6 +46,8 @@ class SnapshotWriter {
   [[nodiscard]] int width() const { return width_px_; }
   [[nodiscard]] int height() const { return height_px_; }
   [[nodiscard]] std::string renderer_name() const;
+  /// Samples per pixel in use (1: no multisampling).
+  [[nodiscard]] int samples() const;
 
  private:
   int width_px_;

@@ -483,8 +483,8 @@ class Viewer {
     const bool mouse_acting = io.MouseDelta.x != 0.0f || io.MouseDelta.y != 0.0f ||
                               io.MouseWheel != 0.0f || ImGui::IsAnyMouseDown();
     redraw.interacting =
-        (io.WantCaptureMouse && mouse_acting) || io.WantCaptureKeyboard ||
-        ImGui::IsAnyItemActive() ||
+        options_.panels_every_frame || (io.WantCaptureMouse && mouse_acting) ||
+        io.WantCaptureKeyboard || ImGui::IsAnyItemActive() ||
         ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId | ImGuiPopupFlags_AnyPopupLevel);
     redraw.picture_due = picture_due;
     const auto now = std::chrono::steady_clock::now();
