@@ -27,7 +27,6 @@ struct ViewArgs {
   std::string size = "1280x720";
   bool no_vsync = false;
   bool no_panels = false;
-  bool panels_every_frame = false;
   int msaa = 0;
   std::string stereo = "off";
   double eye_separation_m = 0.0;
@@ -69,7 +68,6 @@ void view(const ViewArgs& args) {
   }
   o.vsync = !args.no_vsync;
   o.panels = !args.no_panels;
-  o.panels_every_frame = args.panels_every_frame;
   o.msaa_samples = args.msaa;
   try {
     o.stereo = parse_stereo_mode(args.stereo);
@@ -150,9 +148,6 @@ void add_view_command(CLI::App& app) {
   cmd->add_flag("--no-vsync", args->no_vsync, "Draw as fast as possible (to measure fps)");
   cmd->add_flag("--no-panels", args->no_panels,
                 "Start with the control and data areas hidden (Tab shows them)");
-  cmd->add_flag("--panels-every-frame", args->panels_every_frame,
-                "Draw the panels anew every frame instead of at most every 50 ms while unused "
-                "(to measure what that saves)");
   cmd->add_option("--stereo", args->stereo,
                   "Stereo view: off (default), side-by-side (left eye left) or anaglyph "
                   "(red-cyan); V cycles them");

@@ -11,7 +11,6 @@
 #include "hapsim/ui/force_graph.h"
 #include "hapsim/ui/mouse_probe.h"
 #include "hapsim/ui/net_viewer_session.h"
-#include "hapsim/ui/panel_layer.h"
 #include "hapsim/ui/render_cpu_time.h"
 #include "hapsim/ui/space_mouse_camera.h"
 #include "hapsim/ui/viewer_scenes.h"
@@ -149,7 +148,6 @@ class Viewer {
   ~Viewer() {
     session_.reset();  // stops the haptic loop (zero force) before the window goes
     renderer_.reset();
-    panel_layer_.reset();  // its GL objects, while the context lives
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();
@@ -204,20 +202,16 @@ class Viewer {
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
       draw_stereo(*renderer_, session_->render_scene(), camera_, stereo_, options_.eye_separation_m,
                   v.x, v.y, v.w, v.h);
-      const bool first_picture_due =
-          !first_written && !options_.first_screenshot.empty() && stats_.frames >= 3;
-      const bool last_frame_due = options_.duration_s > 0.0 &&
-                                  elapsed_s + 2.0 * std::max(dt_s, 0.001) >= options_.duration_s;
-      const bool last_picture_due =
-          !options_.screenshot.empty() && (last_frame_due || screenshot_requested_);
-      draw_panels(fb_w, fb_h, first_picture_due || last_picture_due);
+      draw_panels();
       const double draw_ms = std::chrono::duration<double, std::milli>(Clock::now() - d0).count();
       draw_ms_sum += draw_ms;
-      if (first_picture_due) {
+      if (!first_written && !options_.first_screenshot.empty() && stats_.frames >= 3) {
         write_png(options_.first_screenshot.string(), fb_w, fb_h, read_window(fb_w, fb_h));
         first_written = true;
       }
-      if (last_picture_due) {
+      const bool last_frame_due = options_.duration_s > 0.0 &&
+                                  elapsed_s + 2.0 * std::max(dt_s, 0.001) >= options_.duration_s;
+      if (!options_.screenshot.empty() && (last_frame_due || screenshot_requested_)) {
         last_frame = read_window(fb_w, fb_h);
         if (screenshot_requested_) {
           write_png(options_.screenshot.string(), fb_w, fb_h, last_frame);
@@ -440,8 +434,7 @@ class Viewer {
     camera_.frame(session_->bounds_world(), static_cast<double>(v.w) / v.h, 1.05);
   }
 
-  // `picture_due`: this frame is saved, so its panels show this frame's figures.
-  void draw_panels(int fb_w, int fb_h, bool picture_due) {
+  void draw_panels() {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
@@ -477,41 +470,7 @@ class Viewer {
     ImGui::End();
 
     ImGui::Render();
-    const ImGuiIO& io = ImGui::GetIO();
-    PanelRedrawInput redraw;
-    // A cursor resting over a panel changes nothing: only one moving, pressing or scrolling there.
-    const bool mouse_acting = io.MouseDelta.x != 0.0f || io.MouseDelta.y != 0.0f ||
-                              io.MouseWheel != 0.0f || ImGui::IsAnyMouseDown();
-    redraw.interacting =
-        options_.panels_every_frame || (io.WantCaptureMouse && mouse_acting) ||
-        io.WantCaptureKeyboard || ImGui::IsAnyItemActive() ||
-        ImGui::IsPopupOpen("", ImGuiPopupFlags_AnyPopupId | ImGuiPopupFlags_AnyPopupLevel);
-    redraw.picture_due = picture_due;
-    const auto now = std::chrono::steady_clock::now();
-    redraw.since_drawn_s = panel_layer_->holds(fb_w, fb_h) && panels_drawn_at_
-                               ? std::chrono::duration<double>(now - *panels_drawn_at_).count()
-                               : -1.0;
-    const PanelDraw how = choose_panel_draw(redraw);
-    if (how == PanelDraw::kDirect) {
-      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-      panels_drawn_at_.reset();  // the texture no longer shows what the window did
-      return;
-    }
-    if (how == PanelDraw::kRefresh) {
-      const ImVec4 bg = ImGui::GetStyle().Colors[ImGuiCol_WindowBg];
-      const float rgb[3] = {bg.x, bg.y, bg.z};
-      panel_layer_->begin_drawing(fb_w, fb_h, rgb);
-      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-      panel_layer_->end_drawing();
-      panels_drawn_at_ = now;
-    }
-    // The two panel columns, in framebuffer pixels (GL's origin bottom left).
-    const double sx = win_w > 0 ? static_cast<double>(fb_w) / win_w : 1.0;
-    const int control_px = static_cast<int>(std::ceil(static_cast<double>(kControlWidth) * sx));
-    const int data_px = static_cast<int>(std::ceil(static_cast<double>(kDataWidth) * sx));
-    panel_layer_->copy_to_window(0, 0, control_px, fb_h);
-    panel_layer_->copy_to_window(fb_w - data_px, 0, data_px, fb_h);
-    glViewport(0, 0, fb_w, fb_h);
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
   }
 
   void draw_control_area() {
@@ -808,9 +767,6 @@ class Viewer {
   /// Every warning printed so far (each once), for the JSON summary.
   std::vector<std::string> warnings_;
   std::string recording_path_;
-  std::unique_ptr<PanelLayer> panel_layer_ = std::make_unique<PanelLayer>();
-  /// When the panels were last drawn into panel_layer_ (none: it is stale).
-  std::optional<std::chrono::steady_clock::time_point> panels_drawn_at_;
 };
 
 }  // namespace

@@ -32,9 +32,6 @@ struct ViewerOptions {
   int msaa_samples = 0;
   /// Show the control and data areas (Tab toggles them): off gives the 3D view the window.
   bool panels = true;
-  /// Draw the panels anew every frame (ui/panel_layer.h: otherwise at most every 50 ms while
-  /// nobody uses them), to measure what that saves.
-  bool panels_every_frame = false;
   /// Stereo 3D view (render/stereo.h; the V key cycles off / side by side / anaglyph) and the
   /// eyes' separation in metres (0: a thirtieth of the view distance).
   StereoMode stereo = StereoMode::kOff;
