@@ -593,6 +593,8 @@ void add_bench_command(CLI::App& app) {
   passivity->add_option("--json", passivity_args->json_path, "Write the rows as JSON to FILE");
   passivity->callback([passivity_args] { run_passivity(*passivity_args); });
 
+  add_snapshot_bench(*bench);
+
   auto soak_args = std::make_shared<SoakArgs>();
   CLI::App* soak = bench->add_subcommand(
       "soak",

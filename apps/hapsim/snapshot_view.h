@@ -12,7 +12,6 @@
 #include "hapsim/scene/scene_description.h"
 #include "hapsim/world/world.h"
 
-#include <numbers>
 #include <optional>
 #include <span>
 #include <string>
@@ -50,34 +49,16 @@ inline double snapshot_pitch_rad(const World& world) {
   return world.rig() != nullptr ? kTeleopPitch : (table_top(world) ? kTableTopPitch : kKneePitch);
 }
 
-/// The camera --view NAME or --camera SPEC chose (at most one of them), none when neither was
-/// given. CommandError (exit 2, one line) for both at once, an unknown view (naming the scene's
-/// views) or a bad spec.
+/// The camera --view NAME or --camera SPEC chose (render/snapshot_writer.h chosen_camera), none
+/// when neither was given; its error as a CommandError (exit 2, one line).
 inline std::optional<OrbitCamera> chosen_snapshot_camera(const SceneDescription& scene,
                                                          const std::string& view,
                                                          const std::string& camera_spec) {
-  if (!view.empty() && !camera_spec.empty()) {
-    throw CommandError("--view and --camera: give one of them");
+  try {
+    return chosen_camera(scene, view, camera_spec);
+  } catch (const Error& e) {
+    throw CommandError(std::string(e.what()));
   }
-  if (!camera_spec.empty()) {
-    try {
-      return parse_camera_spec(camera_spec);
-    } catch (const Error& e) {
-      throw CommandError(std::string(e.what()));
-    }
-  }
-  if (view.empty()) {
-    return std::nullopt;
-  }
-  std::string names;
-  for (const SceneView& v : scene.views) {
-    if (v.name == view) {
-      return OrbitCamera::looking_at(v.eye_m, v.target_m, v.fov_deg * std::numbers::pi / 180.0);
-    }
-    names += (names.empty() ? "" : ", ") + v.name;
-  }
-  throw CommandError("--view " + view + ": " + scene.file.string() + " has " +
-                     (names.empty() ? std::string("no views") : "the views " + names));
 }
 
 /// The final picture's default: from the scene's usual direction, framing a box around

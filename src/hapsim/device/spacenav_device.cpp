@@ -13,12 +13,11 @@ namespace hapsim {
 namespace {
 
 double shaped(int reading, const SpacenavOptions& o) {
-  const double v = std::clamp(static_cast<double>(reading) / o.full_scale, -1.0, 1.0);
-  if (std::abs(v) < o.dead_zone) {
-    return 0.0;
-  }
-  // Rescaled past the dead zone, so motion starts smoothly from zero.
-  return std::copysign((std::abs(v) - o.dead_zone) / (1.0 - o.dead_zone), v);
+  return dead_zoned(static_cast<double>(reading) / o.full_scale, o.dead_zone);
+}
+
+double normalised(int reading, const SpacenavOptions& o) {
+  return std::clamp(static_cast<double>(reading) / o.full_scale, -1.0, 1.0);
 }
 
 }  // namespace
@@ -76,6 +75,16 @@ void SpacenavDevice::reader_main() {
     const auto now = std::chrono::steady_clock::now();
     const double dt = std::min(0.05, std::chrono::duration<double>(now - last).count());
     last = now;
+    {
+      const std::lock_guard<std::mutex> lock(axes_mutex_);
+      axes_.translation = Vec3(normalised(motion[0], options_), normalised(motion[1], options_),
+                               normalised(motion[2], options_));
+      axes_.rotation = Vec3(normalised(motion[3], options_), normalised(motion[4], options_),
+                            normalised(motion[5], options_));
+    }
+    if (drives_camera_.load()) {
+      continue;  // the viewer turns the camera with it; the tool holds still
+    }
     // spacenavd's frame: x right, y up, z towards the user; the world is Z-up, Y away from the
     // user in the default view.
     const Vec3 v(shaped(motion[0], options_), -shaped(motion[2], options_),
@@ -90,6 +99,11 @@ void SpacenavDevice::reader_main() {
     input.buttons = buttons;
     inner_.set_input(input);
   }
+}
+
+SpaceMouseAxes SpacenavDevice::axes() const {
+  const std::lock_guard<std::mutex> lock(axes_mutex_);
+  return axes_;
 }
 
 }  // namespace hapsim

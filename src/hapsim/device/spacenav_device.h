@@ -1,7 +1,7 @@
 // A 3D mouse (3Dconnexion SpaceMouse and the like) through libspnav and the spacenavd daemon
-// (architecture.md#devices): the puck's deflection is a velocity, integrated into the tool pose by a reader
-// thread and handed to the haptic thread through InteractiveDevice's lock-free buffer. A 3D
-// mouse renders no force; the viewer shows the force the tool would feel.
+// (architecture.md#devices): the puck's deflection is a velocity, integrated into the tool pose by
+// a reader thread and handed to the haptic thread through InteractiveDevice's lock-free buffer. A
+// 3D mouse renders no force; the viewer shows the force the tool would feel.
 //
 // Detected at run time: with no daemon answering (nothing plugged in, spacenavd not running)
 // the constructor throws hapsim::Error with a message saying so. Built only where libspnav's
@@ -9,9 +9,11 @@
 #pragma once
 
 #include "hapsim/device/interactive_device.h"
+#include "hapsim/device/space_mouse_axes.h"
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
 
@@ -29,7 +31,7 @@ struct SpacenavOptions {
   Vec3 start_p_world = Vec3::Zero();
 };
 
-class SpacenavDevice final : public Device {
+class SpacenavDevice final : public Device, public SpaceMouseSource {
  public:
   /// Connects to spacenavd. Throws hapsim::Error naming what is missing when it cannot.
   explicit SpacenavDevice(DeviceProfile profile, SpacenavOptions options = {});
@@ -46,12 +48,19 @@ class SpacenavDevice final : public Device {
   /// The newest command written (for the viewer's force display).
   [[nodiscard]] const DeviceCommand& last_command() noexcept { return inner_.last_command(); }
 
+  [[nodiscard]] SpaceMouseAxes axes() const override;
+  void set_drives_camera(bool drives_camera) override { drives_camera_.store(drives_camera); }
+
  private:
   void reader_main();
 
   SpacenavOptions options_;
   InteractiveDevice inner_;
   std::atomic<bool> stop_{false};
+  std::atomic<bool> drives_camera_{false};
+  // The newest reading for the viewer (its thread and the reader's; not the haptic path).
+  mutable std::mutex axes_mutex_;
+  SpaceMouseAxes axes_;
   std::thread reader_;
 };
 

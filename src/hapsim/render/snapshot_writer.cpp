@@ -49,6 +49,10 @@ void SnapshotWriter::write_png(const RenderScene& scene, const OrbitCamera& came
   hapsim::write_png(path, width_px_, height_px_, render(scene, camera));
 }
 
+int SnapshotWriter::samples() const {
+  return context_->samples();
+}
+
 std::string SnapshotWriter::renderer_name() const {
   return context_->renderer_name();
 }
@@ -99,6 +103,29 @@ OrbitCamera parse_camera_spec(const std::string& spec) {
     throw Error("--camera", "the eye is on its target: " + spec);
   }
   return OrbitCamera::looking_at(eye, target, v[6] * std::numbers::pi / 180.0);
+}
+
+std::optional<OrbitCamera> chosen_camera(const SceneDescription& scene, const std::string& view,
+                                         const std::string& camera_spec) {
+  if (!view.empty() && !camera_spec.empty()) {
+    throw Error("--view and --camera", "give one of them");
+  }
+  if (!camera_spec.empty()) {
+    return parse_camera_spec(camera_spec);
+  }
+  if (view.empty()) {
+    return std::nullopt;
+  }
+  std::string names;
+  for (const SceneView& v : scene.views) {
+    if (v.name == view) {
+      return OrbitCamera::looking_at(v.eye_m, v.target_m, v.fov_deg * std::numbers::pi / 180.0);
+    }
+    names += (names.empty() ? "" : ", ") + v.name;
+  }
+  throw Error(scene.file.string(),
+              "--view " + view + ": the scene has " +
+                  (names.empty() ? std::string("no views") : "the views " + names));
 }
 
 std::string numbered_path(const std::string& path, std::uint64_t index) {

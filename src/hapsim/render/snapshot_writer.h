@@ -6,9 +6,11 @@
 #include "hapsim/render/camera.h"
 #include "hapsim/render/render_scene.h"
 #include "hapsim/render/stereo.h"
+#include "hapsim/scene/scene_description.h"
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,6 +46,8 @@ class SnapshotWriter {
   [[nodiscard]] int width() const { return width_px_; }
   [[nodiscard]] int height() const { return height_px_; }
   [[nodiscard]] std::string renderer_name() const;
+  /// Samples per pixel in use (1: no multisampling).
+  [[nodiscard]] int samples() const;
 
  private:
   int width_px_;
@@ -63,6 +67,14 @@ class SnapshotWriter {
 /// "EX,EY,EZ,TX,TY,TZ,FOV": the eye and the target (world, metres) and the vertical field of view
 /// (degrees, in (1, 170]) of `--camera`; throws hapsim::Error saying what is wrong otherwise.
 [[nodiscard]] OrbitCamera parse_camera_spec(const std::string& spec);
+
+/// The camera `--view NAME` (one of `scene.views`) or `--camera SPEC` (parse_camera_spec) chose,
+/// none when both are empty: `hapsim run`/`watch` snapshots and the viewer's first camera. Throws
+/// hapsim::Error (one line) for both at once, a bad spec, or a view the scene does not have
+/// (naming the scene's file and the views it has).
+[[nodiscard]] std::optional<OrbitCamera> chosen_camera(const SceneDescription& scene,
+                                                       const std::string& view,
+                                                       const std::string& camera_spec);
 
 /// "out.png", 42 → "out_000042.png" (a series of snapshots).
 [[nodiscard]] std::string numbered_path(const std::string& path, std::uint64_t index);

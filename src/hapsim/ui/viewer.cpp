@@ -12,6 +12,7 @@
 #include "hapsim/ui/mouse_probe.h"
 #include "hapsim/ui/net_viewer_session.h"
 #include "hapsim/ui/render_cpu_time.h"
+#include "hapsim/ui/space_mouse_camera.h"
 #include "hapsim/ui/viewer_scenes.h"
 
 #define GLFW_INCLUDE_NONE
@@ -28,7 +29,6 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
-#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -60,44 +60,21 @@ void on_scroll(GLFWwindow* window, double /*x*/, double y) {
   }
 }
 
-// `views`: the scene file's named views (none for a connected viewer, whose scene is the host's).
+// `described`: the scene file's description (only its views are kept; left empty for a connected
+// viewer, whose scene is the host's).
 std::unique_ptr<ViewerSession> make_session(const ViewerConfig& config,
-                                            std::vector<SceneView>* views = nullptr) {
+                                            SceneDescription* described = nullptr) {
   if (config.connect) {
     return make_net_viewer_session(config);
   }
   SceneLoadOptions load;
   load.data_dir = config.data_dir;
   const SceneDescription scene = load_scene(config.scene, load);
-  if (views != nullptr) {
-    *views = scene.views;
+  if (described != nullptr) {
+    described->file = scene.file;
+    described->views = scene.views;
   }
   return make_viewer_session(config, scene);
-}
-
-// The camera ViewerOptions::view or ::camera asked for, none when neither did. Error (one line)
-// for both, a bad spec, or a view the scene does not have (naming the ones it has).
-std::optional<OrbitCamera> first_camera(const ViewerOptions& options,
-                                        const std::vector<SceneView>& views) {
-  if (!options.view.empty() && !options.camera.empty()) {
-    throw Error("--view and --camera", "give one of them");
-  }
-  if (!options.camera.empty()) {
-    return parse_camera_spec(options.camera);
-  }
-  if (options.view.empty()) {
-    return std::nullopt;
-  }
-  std::string names;
-  for (const SceneView& v : views) {
-    if (v.name == options.view) {
-      return OrbitCamera::looking_at(v.eye_m, v.target_m, v.fov_deg * std::numbers::pi / 180.0);
-    }
-    names += (names.empty() ? "" : ", ") + v.name;
-  }
-  throw Error(options.config.scene.string(),
-              "--view " + options.view + ": the scene has " +
-                  (names.empty() ? std::string("no views") : "the views " + names));
 }
 
 std::vector<std::uint8_t> read_window(int width, int height) {
@@ -225,7 +202,7 @@ class Viewer {
       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
       draw_stereo(*renderer_, session_->render_scene(), camera_, stereo_, options_.eye_separation_m,
                   v.x, v.y, v.w, v.h);
-      draw_panels(fb_w, fb_h);
+      draw_panels();
       const double draw_ms = std::chrono::duration<double, std::milli>(Clock::now() - d0).count();
       draw_ms_sum += draw_ms;
       if (!first_written && !options_.first_screenshot.empty() && stats_.frames >= 3) {
@@ -293,10 +270,10 @@ class Viewer {
 
   void rebuild(const ViewerConfig& config) {
     std::unique_ptr<ViewerSession> next;
-    std::vector<SceneView> views;
-    session_.reset();  // one haptic loop (and one exclusive device) at a time
+    SceneDescription described;  // the scene file's named views (none for a connected viewer)
+    session_.reset();            // one haptic loop (and one exclusive device) at a time
     try {
-      next = make_session(config, &views);
+      next = make_session(config, &described);
       config_ = config;
       status_message_.clear();
     } catch (const std::exception& e) {
@@ -319,7 +296,7 @@ class Viewer {
     // the menu is framed as usual.
     std::optional<OrbitCamera> asked;
     if (!built_once_) {
-      asked = first_camera(options_, views);
+      asked = chosen_camera(described, options_.view, options_.camera);
       session_->render_scene().room.visible = options_.room;
     }
     built_once_ = true;
@@ -421,6 +398,7 @@ class Viewer {
                   : stereo_ == StereoMode::kSideBySide ? StereoMode::kAnaglyph
                                                        : StereoMode::kOff;
       });
+      key_edge(GLFW_KEY_C, [this] { space_mouse_camera_ = !space_mouse_camera_; });
       key_edge(GLFW_KEY_TAB, [this] {
         panels_ = !panels_;
         frame_view();
@@ -429,6 +407,12 @@ class Viewer {
     }
     if (InteractiveDevice* mouse = session_->mouse_device()) {
       mouse->set_input(probe_.input());
+    }
+    if (SpaceMouseSource* space_mouse = session_->space_mouse()) {
+      space_mouse->set_drives_camera(space_mouse_camera_);
+      if (space_mouse_camera_) {
+        drive_camera(camera_, space_mouse->axes(), dt_s);
+      }
     }
   }
 
@@ -450,7 +434,7 @@ class Viewer {
     camera_.frame(session_->bounds_world(), static_cast<double>(v.w) / v.h, 1.05);
   }
 
-  void draw_panels(int fb_w, int fb_h) {
+  void draw_panels() {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
@@ -462,8 +446,6 @@ class Viewer {
     int win_w = 0;
     int win_h = 0;
     glfwGetWindowSize(window_, &win_w, &win_h);
-    (void)fb_w;
-    (void)fb_h;
     const auto h = static_cast<float>(win_h);
     const auto w = static_cast<float>(win_w);
     const ImGuiWindowFlags fixed = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize |
@@ -569,6 +551,9 @@ class Viewer {
       if (ImGui::Button("Frame scene (F)")) {
         frame_view();
       }
+      if (session_->space_mouse() != nullptr) {
+        ImGui::Checkbox("3D mouse drives the camera (C)", &space_mouse_camera_);
+      }
       session_->draw_controls();
     }
     if (ImGui::CollapsingHeader("Help")) {
@@ -576,7 +561,8 @@ class Viewer {
           "Left-drag: move the probe in the view plane. Wheel: push it in / pull it out. "
           "Right-drag: rotate. Middle-drag or shift+right-drag: pan. Ctrl+wheel: zoom. "
           "1-5: curl fingers. G: grasp. Space: pause. R: reset. M: display mode. F: frame. "
-          "Tab: hide/show panels. Esc: quit.");
+          "C: the 3D mouse drives the camera (twist/tilt orbit, push pans, pull zooms) or the "
+          "probe. Tab: hide/show panels. Esc: quit.");
     }
   }
 
@@ -771,6 +757,8 @@ class Viewer {
   bool paused_ = false;
   bool built_once_ = false;
   bool panels_ = true;
+  /// The 3D mouse (--device spacemouse) turns the camera instead of moving the probe (C key).
+  bool space_mouse_camera_ = false;
   StereoMode stereo_ = StereoMode::kOff;
   bool screenshot_requested_ = false;
   std::array<bool, 512> key_down_{};

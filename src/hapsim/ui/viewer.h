@@ -9,7 +9,8 @@
 // right-drag rotates the view, middle-drag (or shift+right) pans, ctrl+wheel zooms.
 // Keys: 1-5 curl fingers (glove scenes), G closes/opens the grasp, space pauses, R resets,
 // M cycles the display mode, V cycles stereo (off, side by side, anaglyph), F frames the scene,
-// Tab hides the panels, Esc quits.
+// C gives the 3D mouse (--device spacemouse) to the camera or back to the probe
+// (ui/space_mouse_camera.h), Tab hides the panels, Esc quits.
 #pragma once
 
 #include "hapsim/render/stereo.h"

@@ -17,6 +17,7 @@
 namespace hapsim {
 
 class InteractiveDevice;
+class SpaceMouseSource;
 
 /// The choices that need a new session (everything else changes live).
 struct ViewerConfig {
@@ -85,6 +86,9 @@ class ViewerSession {
   [[nodiscard]] virtual bool runs_haptic_loop() const { return true; }
   /// The probe's device when the config asked for the mouse (null otherwise).
   [[nodiscard]] virtual InteractiveDevice* mouse_device() = 0;
+  /// The 3D mouse when the config asked for it (null otherwise): the viewer may take it to
+  /// drive the camera instead of the probe.
+  [[nodiscard]] virtual SpaceMouseSource* space_mouse() { return nullptr; }
   /// Where the probe starts (in front of the scene, as seen from the default camera).
   [[nodiscard]] virtual Vec3 probe_start_world() const = 0;
   [[nodiscard]] virtual const std::string& device_name() const = 0;

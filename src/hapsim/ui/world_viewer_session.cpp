@@ -6,6 +6,7 @@
 #include "hapsim/device/interactive_device.h"
 #include "hapsim/device/master_probe_device.h"
 #include "hapsim/device/recording.h"
+#include "hapsim/device/space_mouse_axes.h"
 #include "hapsim/kinematics/hand_model.h"
 #include "hapsim/render/assessment_markers.h"
 #include "hapsim/render/force_scale.h"
@@ -125,7 +126,9 @@ class WorldViewerSession final : public ViewerSession {
 #if defined(HAPSIM_WITH_SPNAV)
       SpacenavOptions so;
       so.start_p_world = probe_start_world_;
-      probe_ = std::make_unique<SpacenavDevice>(profile, so);
+      auto space_mouse = std::make_unique<SpacenavDevice>(profile, so);
+      space_mouse_ = space_mouse.get();
+      probe_ = std::move(space_mouse);
       device_name_ = "3D mouse (spacenavd)" + target;
 #else
       throw Error("3D mouse", "this build has no 3D mouse support (libspnav was not found)");
@@ -269,6 +272,9 @@ class WorldViewerSession final : public ViewerSession {
   }
   InteractiveDevice* mouse_device() override {
     return mouse_;
+  }
+  SpaceMouseSource* space_mouse() override {
+    return space_mouse_;
   }
   Vec3 probe_start_world() const override {
     return probe_start_world_;
@@ -493,7 +499,8 @@ class WorldViewerSession final : public ViewerSession {
   SceneDescription scene_;
   std::unique_ptr<World> world_;
   std::unique_ptr<WorldScene> view_;
-  std::unique_ptr<Device> probe_;  // a mouse or 3D mouse behind a rig's MasterProbeDevice
+  std::unique_ptr<Device> probe_;            // a mouse or 3D mouse behind a rig's MasterProbeDevice
+  SpaceMouseSource* space_mouse_ = nullptr;  // the 3D mouse, owned by probe_ or device_
   std::unique_ptr<Device> device_;
   InteractiveDevice* mouse_ = nullptr;
   std::unique_ptr<WorldHapticClient> client_;
