@@ -64,7 +64,12 @@ TEST(SceneDetailCaps, ACsgSolidFinerThanTheBudgetIsCoarsenedAndSaidOnce) {
   EXPECT_NE(coarse.warnings[0].find("/bodies/0/geometry: the CSG display mesh is polygonised at"),
             std::string::npos)
       << coarse.warnings[0];
-  EXPECT_NE(coarse.warnings[0].find("not 0.0015 m"), std::string::npos) << coarse.warnings[0];
+  // By hand: a 40 mm cube needs ceil(0.04 / r) + 1 + 4 nodes a side, at most 20 (20³ = 8000),
+  // so r >= 0.04 / 15 = 2.67 mm; coarsened in steps of 1.25 from 1.5 mm: 1.875, 2.34, 2.93 mm.
+  EXPECT_NE(coarse.warnings[0].find("polygonised at 0.00293 m, not 0.0015 m: this load allows at "
+                                    "most 8000 grid nodes per solid"),
+            std::string::npos)
+      << coarse.warnings[0];
   // 8000 nodes is 20 a side with 2 cells of padding each way: about 15 cells over 40 mm instead
   // of 27 (the flat faces' vertices, 16k at 1.5 mm, fall to about 4k).
   EXPECT_LT(vertex_count(coarse), vertex_count(whole) / 3);
