@@ -5,10 +5,12 @@
 // 22 MB of knee (the mesh target covers mesh files).
 #include "file_fuzz_support.h"
 #include "hapsim/scene/scene_file.h"
+#include "scene_fuzz_caps.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   hapsim::SceneLoadOptions options;
   options.data_dir = "/nonexistent/hapsim-fuzz-data";
+  options.detail_caps = hapsim::fuzz::kSceneDetailCaps;
   hapsim::fuzz::expect_value_or_error([&] {
     (void)hapsim::parse_scene(hapsim::fuzz::as_text(data, size),
                               "/nonexistent/hapsim-fuzz/scene.json", options);

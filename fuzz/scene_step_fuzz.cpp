@@ -6,6 +6,7 @@
 #include "hapsim/device/force_safety.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
+#include "scene_fuzz_caps.h"
 
 #include <cmath>
 #include <optional>
@@ -28,6 +29,7 @@ bool finite(const hapsim::DeviceCommand& c) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   hapsim::SceneLoadOptions options;
   options.data_dir = "/nonexistent/hapsim-fuzz-data";
+  options.detail_caps = hapsim::fuzz::kSceneDetailCaps;
   std::optional<hapsim::RunSetup> setup;
   hapsim::fuzz::expect_value_or_error([&] {
     setup.emplace(

@@ -11,7 +11,7 @@ set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 seconds="${1:-60}"
 shift || true
-all=(legacy_packet local_model device_state command view_state scene scene_step mesh trajectory
+all=(legacy_packet local_model device_state command view_state scene scene_step mesh mesh_soup trajectory
      number_csv recording urdf)
 if [[ $# -eq 0 ]]; then
   targets=("${all[@]}")

@@ -298,12 +298,22 @@ bool is_mesh_file_supported(const fs::path& path) {
   return !ext.empty() && Assimp::Importer().IsExtensionSupported(ext.c_str());
 }
 
+namespace {
+
+// Checked before the importer runs (no child for a load that cannot succeed) and again by
+// finish_imported_mesh, which a caller may reach directly.
+void check_scale(const std::string& where, double scale) {
+  if (!std::isfinite(scale) || scale == 0.0) {
+    throw Error(where, "load scale must be finite and non-zero (metres per file unit), got " +
+                           std::to_string(scale));
+  }
+}
+
+}  // namespace
+
 TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& options, MeshReport* report) {
   const std::string where = path.string();
-  if (!std::isfinite(options.scale) || options.scale == 0.0) {
-    throw Error(where, "load scale must be finite and non-zero (metres per file unit), got " +
-                           std::to_string(options.scale));
-  }
+  check_scale(where, options.scale);
   check_readable(path);
   if (!is_mesh_file_supported(path)) {
     throw Error(where, "unsupported mesh format '" + path.extension().string() + "'; " + kExpected);
@@ -327,6 +337,14 @@ TriangleMesh load_mesh(const fs::path& path, const MeshLoadOptions& options, Mes
     });
     decode_triangles(bytes, where, mesh, skipped_primitives);
   }
+  return finish_imported_mesh(std::move(mesh), skipped_primitives, path, options, report);
+}
+
+TriangleMesh finish_imported_mesh(TriangleMesh mesh, std::size_t skipped_primitives,
+                                  const fs::path& path, const MeshLoadOptions& options,
+                                  MeshReport* report) {
+  const std::string where = path.string();
+  check_scale(where, options.scale);
   if (mesh.triangles.empty()) {
     throw Error(where, "file holds no triangles" +
                            (skipped_primitives > 0

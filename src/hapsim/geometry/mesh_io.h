@@ -7,6 +7,7 @@
 #include "hapsim/geometry/triangle_mesh.h"
 #include "hapsim/geometry/vertex_welding.h"
 
+#include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <string_view>
@@ -40,6 +41,16 @@ struct MeshLoadOptions {
 [[nodiscard]] TriangleMesh load_mesh(const std::filesystem::path& path,
                                      const MeshLoadOptions& options = {},
                                      MeshReport* report = nullptr);
+
+/// load_mesh after the importer: `mesh` as the file gave it (unscaled; indices, coordinates and
+/// defects as read: out-of-range, NaN and all) and the point/line primitives skipped, scaled,
+/// welded, validated and repaired per `options`; errors name `path`. Its own function so the
+/// fuzz target mesh_soup (docs/fuzzing.md) reaches our half of a load in process, where the
+/// importer's half needs a child process per file.
+[[nodiscard]] TriangleMesh finish_imported_mesh(TriangleMesh mesh, std::size_t skipped_primitives,
+                                                const std::filesystem::path& path,
+                                                const MeshLoadOptions& options,
+                                                MeshReport* report = nullptr);
 
 struct MeshSaveOptions {
   /// File units per metre on writing, e.g. 1e3 to write millimetres.

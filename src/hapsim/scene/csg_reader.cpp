@@ -154,25 +154,30 @@ CsgSolid read_csg_node(const JsonReader& reader, const Json& node, const std::st
 }
 
 CsgGeometry read_csg_geometry(const JsonReader& reader, const Json& geometry,
-                              const std::string& ptr, const ProgressFn& progress) {
+                              const std::string& ptr, const ProgressFn& progress,
+                              std::size_t grid_node_budget) {
   reader.allow_keys(geometry, ptr, {"csg", "resolution_m"});
   CsgGeometry g;
   const std::string cp = JsonReader::at(ptr, "csg");
   g.solid = read_csg_node(reader, geometry.at("csg"), cp);
   g.resolution_m = reader.number_in(geometry, ptr, "resolution_m", kCsgDefaultResolutionM,
                                     kCsgMinResolutionM, 0.1, "m");
+  g.requested_resolution_m = g.resolution_m;
   const std::string rp =
       geometry.contains("resolution_m") ? JsonReader::at(ptr, "resolution_m") : ptr;
   PolygonizeOptions o;
-  o.cell_size_m = g.resolution_m;
   o.max_grid_nodes = kCsgMaxGridNodes;
   // Counted as the polygoniser does, so the refusal names the scene's own values.
   const Box3 bounds = g.solid.bounds();
   const Vec3 extent = bounds.isEmpty() ? Vec3::Zero() : Vec3(bounds.sizes());
-  double nodes = 1.0;
-  for (int a = 0; a < 3; ++a) {
-    nodes *= std::ceil(extent[a] / g.resolution_m) + 1.0 + 2.0 * o.padding_cells;
-  }
+  auto grid_nodes = [&](double cell_m) {
+    double nodes = 1.0;
+    for (int a = 0; a < 3; ++a) {
+      nodes *= std::ceil(extent[a] / cell_m) + 1.0 + 2.0 * o.padding_cells;
+    }
+    return nodes;
+  };
+  const double nodes = grid_nodes(g.resolution_m);
   if (!(nodes <= static_cast<double>(kCsgMaxGridNodes))) {
     std::ostringstream what;
     what << std::setprecision(3) << "the solid's bounds (" << extent.x() << " x " << extent.y()
@@ -181,6 +186,14 @@ CsgGeometry read_csg_geometry(const JsonReader& reader, const Json& geometry,
          << " are allowed: give a coarser resolution_m";
     reader.fail(rp, what.str());
   }
+  // Bounded: the grid never has fewer nodes than the padding alone gives, so a budget below that
+  // stops at the coarsest cell tried.
+  for (int i = 0; i < 64 && grid_node_budget > 0 &&
+                  grid_nodes(g.resolution_m) > static_cast<double>(grid_node_budget);
+       ++i) {
+    g.resolution_m *= 1.25;
+  }
+  o.cell_size_m = g.resolution_m;
   o.progress = progress;
   try {
     g.mesh = polygonize(g.solid, o);

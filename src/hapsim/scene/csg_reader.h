@@ -36,7 +36,10 @@ struct CsgGeometry {
   CsgSolid solid;
   /// Its polygonised surface, body frame: closed and outward-oriented.
   TriangleMesh mesh;
+  /// The cell the mesh was polygonised at; the scene's own (requested_resolution_m) unless a
+  /// grid node budget coarsened it.
   double resolution_m = kCsgDefaultResolutionM;
+  double requested_resolution_m = kCsgDefaultResolutionM;
 };
 
 /// Reads one NODE at `ptr` into a solid in its parent's frame (the node's pose applied).
@@ -44,10 +47,11 @@ struct CsgGeometry {
                                      const std::string& ptr);
 
 /// Reads a geometry object {"csg": NODE, "resolution_m": r} at `ptr` (the caller has checked
-/// that it holds "csg") and polygonises the solid at r.
+/// that it holds "csg") and polygonises the solid at r; with `grid_node_budget` > 0, at the
+/// finest cell no finer than r whose grid has at most that many nodes (SceneDetailCaps).
 [[nodiscard]] CsgGeometry read_csg_geometry(const JsonReader& reader,
                                             const JsonReader::Json& geometry,
-                                            const std::string& ptr,
-                                            const ProgressFn& progress = {});
+                                            const std::string& ptr, const ProgressFn& progress = {},
+                                            std::size_t grid_node_budget = 0);
 
 }  // namespace hapsim

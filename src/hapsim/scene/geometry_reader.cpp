@@ -8,8 +8,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <map>
 #include <set>
+#include <sstream>
 #include <utility>
 
 namespace hapsim {
@@ -68,6 +70,17 @@ void GeometryReader::check_sizes(const std::string& ptr, const std::vector<Loade
   }
 }
 
+double GeometryReader::capped(double value, double cap, const std::string& ptr) {
+  if (cap <= 0.0 || value <= cap) {
+    return value;
+  }
+  std::ostringstream w;
+  w << std::setprecision(6) << r_.file().string() << ":" << ptr << ": " << value << " lowered to "
+    << cap << ", the most detail this load allows";
+  warnings_.push_back(w.str());
+  return cap;
+}
+
 BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
                                   const std::string& body_name) {
   r_.object(j, ptr, "a geometry");
@@ -97,11 +110,14 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
     body.tissues.push_back(tissue);
   };
   const ProgressFn& progress = r_.options().progress;
+  const SceneDetailCaps& caps = r_.options().detail_caps;
   if (kind == "procedural") {
     r_.allow_keys(j, ptr, {"procedural", "resolution_scale", "include_skin"});
     r_.one_of(j["procedural"], kp, {"knee"});
     ProceduralKneeOptions o;
     o.resolution_scale = r_.number_in(j, ptr, "resolution_scale", 1.0, 0.25, 4.0, "", true);
+    o.resolution_scale = capped(o.resolution_scale, caps.knee_resolution_scale,
+                                JsonReader::at(ptr, "resolution_scale"));
     if (j.contains("include_skin")) {
       if (!j["include_skin"].is_boolean()) {
         r_.fail(JsonReader::at(ptr, "include_skin"),
@@ -117,7 +133,15 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
   }
   if (kind == "csg") {
     report_progress(progress, "scene: polygonising the CSG solid of " + body_name, 0.0);
-    CsgGeometry g = read_csg_geometry(r_, j, ptr, progress);
+    CsgGeometry g = read_csg_geometry(r_, j, ptr, progress, caps.csg_grid_nodes);
+    if (g.resolution_m != g.requested_resolution_m) {
+      std::ostringstream w;
+      w << std::setprecision(3) << r_.file().string() << ":" << ptr
+        << ": the CSG display mesh is polygonised at " << g.resolution_m << " m, not "
+        << g.requested_resolution_m << " m: this load allows at most " << caps.csg_grid_nodes
+        << " grid nodes per solid";
+      warnings_.push_back(w.str());
+    }
     add(body_name, std::move(g.mesh), std::nullopt);
     body.segments.back().csg = std::move(g.solid);
     return body;
@@ -139,7 +163,8 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
       r_.fail(kp, "missing required key 'radius_m'");
     }
     const double r = r_.number_in(s, kp, "radius_m", 0.0, 0.0, 100.0, "m", true);
-    const auto n = static_cast<int>(r_.number_in(s, kp, "segments", 64, 8, 1024, ""));
+    const auto n = static_cast<int>(capped(r_.number_in(s, kp, "segments", 64, 8, 1024, ""),
+                                           caps.sphere_segments, JsonReader::at(kp, "segments")));
     add(body_name, make_uv_sphere(r, n, n / 2), std::nullopt);
     body.segments.back().sphere = ExactSphere{Vec3::Zero(), r};  // contact: the sphere, exactly
   } else if (kind == "sheet") {
@@ -149,7 +174,9 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
       r_.fail(kp, "missing required key 'size_m'");
     }
     const double size = r_.number_in(s, kp, "size_m", 0.0, 0.0, 100.0, "m", true);
-    const auto n = static_cast<int>(r_.number_in(s, kp, "nodes_per_side", 32, 2, 2048, ""));
+    const auto n =
+        static_cast<int>(capped(r_.number_in(s, kp, "nodes_per_side", 32, 2, 2048, ""),
+                                caps.sheet_nodes_per_side, JsonReader::at(kp, "nodes_per_side")));
     add(body_name, make_sheet(n, size), std::nullopt, true);
   } else if (kind == "mesh" || kind == "mesh_folder") {
     const Json& m = r_.object(j[kind], kp, kind + " settings");

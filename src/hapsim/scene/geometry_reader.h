@@ -49,6 +49,9 @@ class GeometryReader {
   void check_sizes(const std::string& ptr, const std::vector<LoadedMesh>& meshes, double scale,
                    const std::filesystem::path& folder);
 
+  /// `value`, or `cap` (SceneDetailCaps; 0: none) when larger, with a warning naming `ptr`.
+  double capped(double value, double cap, const std::string& ptr);
+
   const SceneReader& r_;
   std::set<std::filesystem::path> size_checked_;
   std::vector<std::string> warnings_;

@@ -14,10 +14,28 @@
 #include "hapsim/core/progress.h"
 #include "hapsim/scene/scene_description.h"
 
+#include <cstddef>
 #include <filesystem>
 #include <string_view>
 
 namespace hapsim {
+
+/// Caps on the detail the loader generates, for tools that load many scenes and look at none
+/// (the fuzz targets, fuzz/scene_fuzz.cpp: a million loads under a sanitizer). A scene asking for
+/// finer detail gets the cap instead, said once per value in SceneDescription::warnings; every
+/// reader and generator still runs, on less. Zero: no cap (the default: the scene's own values,
+/// within the limits of docs/scene-format.md).
+struct SceneDetailCaps {
+  /// Polygoniser grid nodes for one CSG solid's display mesh: a finer resolution_m is coarsened
+  /// until the grid fits (a scene beyond kCsgMaxGridNodes is still refused, as without caps).
+  std::size_t csg_grid_nodes = 0;
+  /// The procedural knee's resolution_scale: a larger one is lowered to this.
+  double knee_resolution_scale = 0.0;
+  /// A sphere's segments around (and half as many rings): more are lowered to this.
+  int sphere_segments = 0;
+  /// A sheet's nodes per side: more are lowered to this.
+  int sheet_nodes_per_side = 0;
+};
 
 struct SceneLoadOptions {
   /// The scene's data folder: paths written "data:REL" resolve against it. Empty: the scene's
@@ -26,6 +44,8 @@ struct SceneLoadOptions {
   std::filesystem::path data_dir;
   /// Progress while loading meshes and generating geometry. May be empty.
   ProgressFn progress;
+  /// Detail caps (none by default).
+  SceneDetailCaps detail_caps;
 };
 
 /// Reads and parses `file`. Relative paths in the scene resolve against the file's folder.
