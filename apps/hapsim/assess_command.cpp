@@ -150,6 +150,7 @@ bool run_report_script(const std::vector<std::string>& arguments) {
     }
     command += " '" + quoted + "'";
   }
+  command += " >/dev/null";  // it prints the page's path, which hapsim says itself
   std::fflush(stdout);
   const int status = std::system(command.c_str());
   if (status != 0) {
@@ -260,7 +261,7 @@ void assess(const AssessArgs& args) {
       json_out.write(a.json);
     }
     if (dir) {
-      std::printf("wrote        %s/{assessment.json,forces.csv%s}\n", dir->c_str(),
+      std::printf("wrote        %s{assessment.json,forces.csv%s}\n", (*dir / "").c_str(),
                   a.json["picture"].is_null() ? "" : ",picture.png");
       if (!run_report_script({"report", dir->string()})) {
         exit_status() = 1;
