@@ -12,12 +12,24 @@ hapsim_build
 HAPSIM="${HAPSIM_BUILD_DIR}/apps/hapsim"
 OUT="${HAPSIM_ROOT}/build/main-job"
 mkdir -p "$OUT"
-# A picture of the final state too (offscreen, no display needed), unless the caller asks for one.
+# A picture of the final state too (offscreen, no display needed), unless the caller asks for one;
+# and a recording, which `hapsim assess` scores as a trainee's session would be (landmarks found,
+# force-limit breaches, the score) into an HTML report, unless the caller records elsewhere.
 snapshot=(--snapshot "$OUT/knee-final.png")
+record=(--record "$OUT/knee.rec")
 for arg in "$@"; do
   if [[ "$arg" == --snapshot* ]]; then
     snapshot=()
   fi
+  if [[ "$arg" == --record* ]]; then
+    record=()
+  fi
 done
-"$HAPSIM" run "${HAPSIM_ROOT}/scenes/knee.json" --json "$OUT/knee-run.json" "${snapshot[@]}" "$@"
+"$HAPSIM" run "${HAPSIM_ROOT}/scenes/knee.json" --json "$OUT/knee-run.json" "${snapshot[@]}" \
+    "${record[@]}" "$@"
 echo "hapsim: summary as JSON in $OUT/knee-run.json"
+if [[ ${#record[@]} -gt 0 ]]; then
+  echo
+  "$HAPSIM" assess "$OUT/knee.rec" --report "$OUT/assessment"
+  echo "hapsim: the training report is $OUT/assessment/index.html"
+fi
