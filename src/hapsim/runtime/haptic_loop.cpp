@@ -146,8 +146,25 @@ void HapticLoop::wait() {
 }
 
 bool HapticLoop::try_write(const DeviceCommand& command) noexcept {
+  DeviceCommand copy = command;
+  return try_write(copy, nullptr);
+}
+
+// haptic path (with `resume`)
+bool HapticLoop::try_write(DeviceCommand& command, ResumeCeiling* resume) noexcept {
   if (shared_->output_busy.test_and_set(std::memory_order_acquire)) {
     return false;  // the other thread is writing: its value stands for this cycle
+  }
+  if (resume != nullptr) {
+    // The haptic thread took its ceiling before the write; a supervisor write that landed in
+    // between lowered supervisor_gain first (lower_gain, then its write): honour it now, or the
+    // device would see the supervisor's lowered force and then this one above it.
+    const double late = shared_->supervisor_gain.exchange(1.0);
+    const double share = resume->ceiling();
+    if (late < share) {
+      command = scaled_command(command, share > 0.0 ? late / share : 0.0);
+      resume->lower_to(late);
+    }
   }
   device_.write(command);
   shared_->output_busy.clear(std::memory_order_release);
@@ -239,7 +256,7 @@ void HapticLoop::haptic_thread_main() noexcept {
       bump(s.ramp_cycles);
     }
     s.heartbeat_ns.store(write_ns, std::memory_order_release);
-    if (try_write(out)) {
+    if (try_write(out, &resume)) {
       s.last_written.write_slot() = {out, resume.ceiling()};
       s.last_written.publish();
     }

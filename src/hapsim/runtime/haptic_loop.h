@@ -34,6 +34,8 @@
 
 namespace hapsim {
 
+class ResumeCeiling;
+
 struct HapticLoopOptions {
   double period_s = 0.001;
   /// Stop by itself after this many cycles (0: run until stop()).
@@ -161,6 +163,9 @@ class HapticLoop {
   /// Writes `command` unless the other thread is writing right now (never waits); true if
   /// written.
   bool try_write(const DeviceCommand& command) noexcept;
+  /// The haptic thread's write (with `resume`): also applies a supervisor ceiling lowered since
+  /// `resume` was updated, scaling `command` (left as written) and lowering `resume`.
+  bool try_write(DeviceCommand& command, ResumeCeiling* resume) noexcept;
 
   Device& device_;
   HapticClient& client_;
