@@ -43,8 +43,15 @@ TEST(IsolatedCall, ACrashInTheChildIsAnErrorNamingTheInput) {
     std::raise(SIGSEGV);
     return "unreachable";
   });
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+  // A sanitizer's own SEGV handler reports the crash and exits instead of dying on the signal:
+  // still one error naming the file, with what the child said.
+  EXPECT_NE(message.find("the parser"), std::string::npos) << message;
+  EXPECT_NE(message.find("ABORTING"), std::string::npos) << message;
+#else
   EXPECT_NE(message.find("the parser crashed on this file"), std::string::npos) << message;
   EXPECT_NE(message.find("signal 11"), std::string::npos) << message;
+#endif
   const std::string aborted = failure([]() -> std::string { std::abort(); });
   EXPECT_NE(aborted.find("signal 6"), std::string::npos) << aborted;
 }
