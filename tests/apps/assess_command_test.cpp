@@ -1,8 +1,8 @@
 // `hapsim assess` as a user runs it, on a session recorded by `hapsim run --record`: the JSON of
 // the contract (docs/assessment.md) is written and says what the session did (a press of a sphere
-// whose force k·depth is analytic); the report folder gets its three files and the report page; a missing scene, a
-// scene without an assessment, a recording of another scene and a bad definition are each one
-// line with exit status 2.
+// whose force k·depth is analytic); the report folder gets its three files and the report page; a
+// missing scene, a scene without an assessment, a recording of another scene and a bad definition
+// are each one line with exit status 2.
 #include <nlohmann/json.hpp>
 
 #include "hapsim_process.h"

@@ -496,10 +496,10 @@ TEST(HapticLoopFaults, SecondStallDuringTheRampComesBackFromWhereTheDeviceWas) {
   }
 }
 
-// The other core (every core but one) saturated by busy threads at normal priority while the loop serves
-// a steady force: with real-time priority where permitted and without it (an ordinary user, the
-// haptic thread sharing the cores with the spinners). Whatever the scheduler does, every write is
-// finite and within the rating, the force never rises faster than the ramp (every late cycle is
+// The other core (every core but one) saturated by busy threads at normal priority while the loop
+// serves a steady force: with real-time priority where permitted and without it (an ordinary user,
+// the haptic thread sharing the cores with the spinners). Whatever the scheduler does, every write
+// is finite and within the rating, the force never rises faster than the ramp (every late cycle is
 // ramped, not jumped), and the loop keeps serving and stops cleanly. The late cycles are counted,
 // not asserted: they are the platform's.
 class SaturatedCores : public ::testing::TestWithParam<bool> {};

@@ -4,12 +4,12 @@
 #include "hapsim/core/error.h"
 #include "hapsim/core/text_file.h"
 #include "hapsim/geometry/mass_properties.h"
+#include "hapsim/scene/assessment_reader.h"
 #include "hapsim/scene/device_reader.h"
 #include "hapsim/scene/geometry_reader.h"
 #include "hapsim/scene/json_text.h"
 #include "hapsim/scene/scene_reader.h"
 #include "hapsim/scene/teleop_reader.h"
-#include "hapsim/scene/assessment_reader.h"
 #include "hapsim/scene/view_reader.h"
 
 #include <nlohmann/json.hpp>
