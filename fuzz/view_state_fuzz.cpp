@@ -47,6 +47,18 @@ Viewer& viewer() {
   return v;
 }
 
+// A 16-bit length, then that many elements (at most kMaxElements), each read by `read_element`.
+template <typename T, typename ReadElement>
+std::vector<T> read_sequence(hapsim::fuzz::FieldReader& r, ReadElement read_element) {
+  std::uint16_t length = 0;
+  r.read(length);
+  std::vector<T> out(std::min(length, kMaxElements));
+  for (T& element : out) {
+    read_element(element);
+  }
+  return out;
+}
+
 bool finite(const hapsim::Vec3& v) {
   return v.allFinite();
 }
@@ -100,56 +112,30 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   r.read(m.hand_p_m);
   r.read(m.hand_q_wxyz);
   r.read(m.hand_angles_rad);
-  std::vector<hapsim_msg_BodyPose> bodies;
-  {
-    std::uint16_t length = 0;
-    r.read(length);
-    bodies.resize(std::min(length, kMaxElements));
-    for (auto& b : bodies) {
-      r.read(b.p_m);
-      r.read(b.q_wxyz);
-    }
-  }
-  std::vector<float> deflection_m;
-  {
-    std::uint16_t length = 0;
-    r.read(length);
-    deflection_m.resize(std::min(length, kMaxElements));
-    for (float& d : deflection_m) {
-      r.read(d);
-    }
-  }
+  auto bodies = read_sequence<hapsim_msg_BodyPose>(r, [&](hapsim_msg_BodyPose& b) {
+    r.read(b.p_m);
+    r.read(b.q_wxyz);
+  });
+  auto deflection_m = read_sequence<float>(r, [&](float& d) { r.read(d); });
   if ((control & 2U) != 0) {  // the world's counts: bodies at rest, segments undeflected
     bodies.resize(v.rest.body_poses_world.size(), hapsim_msg_BodyPose{{0, 0, 0}, {1, 0, 0, 0}});
     deflection_m.resize(v.rest.deflection_m.size(), 0.0f);
   }
-  std::vector<hapsim_msg_VertexOffset> offsets;
-  {
-    std::uint16_t length = 0;
-    r.read(length);
-    offsets.resize(std::min(length, kMaxElements));
-    for (auto& o : offsets) {
-      r.read(o.segment);
-      r.read(o.vertex);
-      r.read(o.offset_m);
-    }
-  }
-  std::vector<hapsim_msg_ContactView> contacts;
-  {
-    std::uint16_t length = 0;
-    r.read(length);
-    contacts.resize(std::min(length, kMaxElements));
-    for (auto& c : contacts) {
-      r.read(c.tool);
-      r.read(c.body);
-      r.read(c.segment);
-      r.read(c.point_m);
-      r.read(c.normal);
-      r.read(c.depth_m);
-      r.read(c.force_n);
-      r.read_bool(c.proxy);
-    }
-  }
+  auto offsets = read_sequence<hapsim_msg_VertexOffset>(r, [&](hapsim_msg_VertexOffset& o) {
+    r.read(o.segment);
+    r.read(o.vertex);
+    r.read(o.offset_m);
+  });
+  auto contacts = read_sequence<hapsim_msg_ContactView>(r, [&](hapsim_msg_ContactView& c) {
+    r.read(c.tool);
+    r.read(c.body);
+    r.read(c.segment);
+    r.read(c.point_m);
+    r.read(c.normal);
+    r.read(c.depth_m);
+    r.read(c.force_n);
+    r.read_bool(c.proxy);
+  });
   if ((control & 1U) != 0) {
     m.scene_hash = kSceneHash;
     m.tool_count = static_cast<std::uint16_t>(v.rest.tools.size());
