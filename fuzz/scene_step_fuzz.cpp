@@ -10,8 +10,11 @@
 
 #include <cmath>
 #include <optional>
+#include <utility>
 
 namespace {
+
+constexpr double kScriptSamplePeriodS = 0.01;
 
 bool finite(const hapsim::DeviceCommand& c) {
   bool ok = c.force_world_n.allFinite();
@@ -32,10 +35,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   options.detail_caps = hapsim::fuzz::kSceneDetailCaps;
   std::optional<hapsim::RunSetup> setup;
   hapsim::fuzz::expect_value_or_error([&] {
-    setup.emplace(
-        hapsim::make_run_setup(hapsim::parse_scene(hapsim::fuzz::as_text(data, size),
-                                                   "/nonexistent/hapsim-fuzz/s.json", options),
-                               hapsim::DeviceChoice::scene_script()));
+    hapsim::SceneDescription scene = hapsim::parse_scene(
+        hapsim::fuzz::as_text(data, size), "/nonexistent/hapsim-fuzz/s.json", options);
+    // Only the first 100 cycles are stepped: the scripts sampled every 10 ms, not every 1 ms,
+    // so building a whole palpation is not half of every input's time.
+    scene.device.palpation.sample_period_s = kScriptSamplePeriodS;
+    scene.device.pick_and_place.sample_period_s = kScriptSamplePeriodS;
+    scene.device.glove_palpation.sample_period_s = kScriptSamplePeriodS;
+    scene.device.glove_pick_and_place.sample_period_s = kScriptSamplePeriodS;
+    setup.emplace(hapsim::make_run_setup(std::move(scene), hapsim::DeviceChoice::scene_script()));
   });
   if (!setup || setup->device == nullptr) {
     return 0;

@@ -7,6 +7,9 @@
 # script exit 1 after the other targets ran.
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]
+#
+# HAPSIM_FUZZ_RUNS=N also stops each target after N executions (the long run: SECONDS=3600 and
+# HAPSIM_FUZZ_RUNS=1000000 ends a target at 10^6 executions or an hour, whichever comes first).
 set -uo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 seconds="${1:-60}"
@@ -41,7 +44,7 @@ for t in "${targets[@]}"; do
   artifacts="build/fuzz/artifacts/$t/"
   mkdir -p "$found" "$artifacts"
   log="build/fuzz/$t.log"
-  build/fuzz/fuzz/hapsim_fuzz_"$t" -max_total_time="$seconds" -print_final_stats=1 \
+  build/fuzz/fuzz/hapsim_fuzz_"$t" -max_total_time="$seconds" ${HAPSIM_FUZZ_RUNS:+-runs="$HAPSIM_FUZZ_RUNS"} -print_final_stats=1 \
       -max_len="${max_len[$t]:-4096}" -timeout="${timeout[$t]:-10}" -rss_limit_mb=4096 \
       -artifact_prefix="$artifacts" "$found" "fuzz/corpus/$t" >"$log" 2>&1
   rc=$?
@@ -51,7 +54,8 @@ for t in "${targets[@]}"; do
     status=1
     echo "$t: FOUND something after ${runs:-?} executions (exit $rc): see $log and $artifacts"
   else
-    echo "$t: ${runs:-?} executions in ${seconds} s, coverage ${cov:-?} edges, nothing found"
+    took=$(grep -o 'Done [0-9]* runs in [0-9]* second' "$log" | grep -o 'in [0-9]*' | grep -o '[0-9]*')
+    echo "$t: ${runs:-?} executions in ${took:-$seconds} s, coverage ${cov:-?} edges, nothing found"
   fi
 done
 exit $status

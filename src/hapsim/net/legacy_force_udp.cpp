@@ -15,7 +15,7 @@
 namespace hapsim::net {
 namespace {
 
-std::string quoted(std::string_view text) {
+std::string single_quoted(std::string_view text) {
   // Appended, not "'" + text + "'": GCC 12 warns (-Wrestrict, a false positive) on the latter.
   std::string out;
   out.reserve(text.size() + 2);
@@ -30,11 +30,13 @@ std::uint16_t parse_port(std::string_view digits, std::string_view text, std::st
   const std::string range = allow_zero ? "0 to 65535" : "1 to 65535";
   if (digits.empty() || digits.size() > 5 ||
       !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-    throw Error(std::string(option), quoted(text) + ": the port must be a number from " + range);
+    throw Error(std::string(option),
+                single_quoted(text) + ": the port must be a number from " + range);
   }
   const int port = std::stoi(std::string(digits));
   if (port > 65535 || (port == 0 && !allow_zero)) {
-    throw Error(std::string(option), quoted(text) + ": the port must be a number from " + range);
+    throw Error(std::string(option),
+                single_quoted(text) + ": the port must be a number from " + range);
   }
   return static_cast<std::uint16_t>(port);
 }
@@ -56,8 +58,9 @@ Resolved resolve(const UdpEndpoint& endpoint, bool passive, std::string_view tex
   const std::string port = std::to_string(endpoint.port);
   const int rc = getaddrinfo(endpoint.host.c_str(), port.c_str(), &hints, &found);
   if (rc != 0 || found == nullptr) {
-    throw Error(std::string(option), quoted(text) + ": cannot resolve host " +
-                                         quoted(endpoint.host) + " (" + gai_strerror(rc) + ")");
+    throw Error(std::string(option), single_quoted(text) + ": cannot resolve host " +
+                                         single_quoted(endpoint.host) + " (" + gai_strerror(rc) +
+                                         ")");
   }
   Resolved r;
   r.family = found->ai_family;
@@ -71,7 +74,7 @@ int open_udp_socket(int family, std::string_view text, std::string_view option) 
   const int fd = ::socket(family, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   if (fd < 0) {
     throw Error(std::string(option),
-                quoted(text) + ": cannot open a UDP socket (" + std::strerror(errno) + ")");
+                single_quoted(text) + ": cannot open a UDP socket (" + std::strerror(errno) + ")");
   }
   return fd;
 }
@@ -82,13 +85,13 @@ UdpEndpoint parse_udp_endpoint(std::string_view text, std::string_view option,
                                std::string_view default_host, bool allow_port_zero) {
   const std::string expected = ": expected HOST:PORT or PORT, e.g. 127.0.0.1:5005";
   if (text.empty()) {
-    throw Error(std::string(option), quoted(text) + expected);
+    throw Error(std::string(option), single_quoted(text) + expected);
   }
   UdpEndpoint endpoint;
   if (text.front() == '[') {  // [IPv6]:PORT
     const std::size_t close = text.find("]:");
     if (close == std::string_view::npos || close == 1) {
-      throw Error(std::string(option), quoted(text) + expected);
+      throw Error(std::string(option), single_quoted(text) + expected);
     }
     endpoint.host = std::string(text.substr(1, close - 1));
     endpoint.port = parse_port(text.substr(close + 2), text, option, allow_port_zero);
@@ -97,7 +100,7 @@ UdpEndpoint parse_udp_endpoint(std::string_view text, std::string_view option,
   const std::size_t colon = text.rfind(':');
   if (colon == std::string_view::npos) {
     if (!std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; })) {
-      throw Error(std::string(option), quoted(text) + expected);
+      throw Error(std::string(option), single_quoted(text) + expected);
     }
     endpoint.host = std::string(default_host);
     endpoint.port = parse_port(text, text, option, allow_port_zero);
@@ -105,11 +108,11 @@ UdpEndpoint parse_udp_endpoint(std::string_view text, std::string_view option,
   }
   const std::string_view host = text.substr(0, colon);
   if (host.empty()) {
-    throw Error(std::string(option), quoted(text) + expected);
+    throw Error(std::string(option), single_quoted(text) + expected);
   }
   if (host.find(':') != std::string_view::npos) {
     throw Error(std::string(option),
-                quoted(text) + ": write an IPv6 address in brackets, e.g. [::1]:5005");
+                single_quoted(text) + ": write an IPv6 address in brackets, e.g. [::1]:5005");
   }
   endpoint.host = std::string(host);
   endpoint.port = parse_port(text.substr(colon + 1), text, option, allow_port_zero);
@@ -169,8 +172,8 @@ LegacyForceUdpReceiver::LegacyForceUdpReceiver(std::string_view bind_spec,
   if (::bind(fd_, reinterpret_cast<const sockaddr*>(&r.address), r.length) != 0) {
     const std::string why = std::strerror(errno);
     ::close(fd_);
-    throw Error(std::string(option), quoted(bind_spec) + ": cannot bind UDP " + wanted.host + ":" +
-                                         std::to_string(wanted.port) + " (" + why + ")");
+    throw Error(std::string(option), single_quoted(bind_spec) + ": cannot bind UDP " + wanted.host +
+                                         ":" + std::to_string(wanted.port) + " (" + why + ")");
   }
   sockaddr_storage actual{};
   socklen_t length = sizeof actual;

@@ -141,6 +141,7 @@ PalpationPlan make_scene_palpation(const World& world, const PalpationScriptDesc
   params.approach_s = script.approach_s;
   params.press_s = script.press_s;
   params.release_s = script.release_s;
+  params.sample_period_s = script.sample_period_s;
   if (script.has_around_axis) {
     // The cylinder round the axis through the centre of the targeted bodies that clears every
     // vertex of them, plus the farthest tool sphere from the device point, plus the stand-off.
@@ -360,7 +361,7 @@ Trajectory make_scene_glove_palpation(const World& world, const GlovePalpationDe
   double t = 0.0;
   push(t, p_far);
   const auto ramp = [&](const Vec3& a, const Vec3& b, double duration) {
-    const int n = std::max(1, static_cast<int>(std::ceil(duration / 0.001)));
+    const int n = std::max(1, static_cast<int>(std::ceil(duration / g.sample_period_s)));
     for (int k = 1; k <= n; ++k) {
       push(t + duration * k / n, a + (b - a) * minimum_jerk(static_cast<double>(k) / n));
     }
@@ -478,7 +479,7 @@ Trajectory make_scene_glove_pick_and_place(const World& world,
   // Move the hand to `p` and the fingers to `angles` together, minimum jerk, in `duration` s.
   const auto move = [&](const Vec3& p, const std::array<GloveAngles, kHandFingers>& angles,
                         double duration) {
-    const int n = std::max(1, static_cast<int>(std::ceil(duration / 0.001)));
+    const int n = std::max(1, static_cast<int>(std::ceil(duration / g.sample_period_s)));
     for (int k = 1; k <= n; ++k) {
       const double s = minimum_jerk(static_cast<double>(k) / n);
       std::array<GloveAngles, kHandFingers> a{};

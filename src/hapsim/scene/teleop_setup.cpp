@@ -63,6 +63,7 @@ TeleopSetup make_teleop_setup(const SceneDescription& scene,
     script.place_world = scene.device.pick_and_place.place_m;
     script.clearance_m = scene.device.pick_and_place.clearance_m;
     script.carry_s = scene.device.pick_and_place.carry_s;
+    script.sample_period_s = scene.device.pick_and_place.sample_period_s;
     script.grasp_depth_m =
         grasp_depth_m(d.gripper.pad_depth_m, d.gripper.pad_half_m.z(), d.ball.radius_m);
     script.open_width_m = 0.9 * d.follower.gripper_max_width_m;
