@@ -316,7 +316,7 @@ std::string format_network_table(const std::vector<net::LinkSweepRow>& rows) {
                         : "-";
     std::snprintf(line, sizeof line,
                   "%-11s %-6s %-7s %5.0f %4.0f %6s | %8.3f %+8.2f %8.4f %7.2f %9.2f %-6s %s\n",
-                  net::force_mode_name(c.mode), net::environment_name(c.environment),
+                  net::to_string(c.mode), net::environment_name(c.environment),
                   net::hand_name(c.hand), 1e3 * c.delay_s, 100.0 * c.loss,
                   row.is_outage() ? ms_or_dash(c.outage_s).c_str() : "-", row.run.steady_force_n,
                   100.0 * row.steady_force_error, row.run.hold_ripple_rms_n, row.run.peak_force_n,
@@ -336,7 +336,7 @@ nlohmann::json network_rows_to_json(const std::vector<net::LinkSweepRow>& rows) 
     const net::LinkCase& c = row.link_case;
     const net::LinkRun& r = row.run;
     out.push_back({
-        {"mode", net::force_mode_name(c.mode)},
+        {"mode", net::to_string(c.mode)},
         {"environment", net::environment_name(c.environment)},
         {"hand", net::hand_name(c.hand)},
         {"delay_ms", 1e3 * c.delay_s},

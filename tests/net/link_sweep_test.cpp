@@ -16,7 +16,7 @@ namespace {
 const OneDofPlant kPlant{};
 
 std::string name(const LinkCase& c) {
-  return std::string(force_mode_name(c.mode)) + " " + environment_name(c.environment) + " " +
+  return std::string(to_string(c.mode)) + " " + environment_name(c.environment) + " " +
          hand_name(c.hand) + " " + std::to_string(static_cast<int>(std::lround(1e3 * c.delay_s))) +
          " ms " + std::to_string(static_cast<int>(std::lround(100.0 * c.loss))) + " %";
 }

@@ -50,10 +50,6 @@ LocalModelRenderOptions finger_render_options(const DeviceHostOptions& options) 
   return o;
 }
 
-const char* to_string(ForceMode mode) noexcept {
-  return mode == ForceMode::kRaw ? "raw" : "local-model";
-}
-
 DeviceHostClient::DeviceHostClient(const Participant& participant, const DeviceHostOptions& options)
     : options_(options),
       models_in_(participant),

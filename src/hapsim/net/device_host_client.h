@@ -24,6 +24,7 @@
 #include "hapsim/device/local_model_renderer.h"
 #include "hapsim/device/passivity_observer.h"
 #include "hapsim/net/device_state_codec.h"
+#include "hapsim/net/force_mode.h"
 #include "hapsim/net/link_shim.h"
 #include "hapsim/net/local_model_gate.h"
 #include "hapsim/net/participant.h"
@@ -39,8 +40,6 @@
 #include <optional>
 
 namespace hapsim::net {
-
-enum class ForceMode { kLocalModel, kRaw };
 
 struct DeviceHostOptions {
   std::uint16_t device_id = 0;
@@ -176,7 +175,5 @@ class DeviceHostClient final : public HapticClient {
   std::atomic<std::uint64_t> passivity_cycles_{0};
   std::atomic<double> passivity_dissipated_j_{0.0};
 };
-
-[[nodiscard]] const char* to_string(ForceMode mode) noexcept;
 
 }  // namespace hapsim::net

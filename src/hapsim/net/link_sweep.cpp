@@ -332,10 +332,6 @@ class Session {
 
 }  // namespace
 
-const char* force_mode_name(ForceMode mode) noexcept {
-  return mode == ForceMode::kRaw ? "raw" : "local-model";
-}
-
 const char* environment_name(SweepEnvironment environment) noexcept {
   return environment == SweepEnvironment::kTissue ? "tissue" : "wall";
 }
@@ -450,7 +446,7 @@ std::vector<LinkSweepRow> run_link_sweep(const LinkSweepOptions& options) {
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const LinkCase& c = cases[i];
     report_progress(options.progress,
-                    std::string(force_mode_name(c.mode)) + " " + environment_name(c.environment) +
+                    std::string(to_string(c.mode)) + " " + environment_name(c.environment) +
                         " " + hand_name(c.hand),
                     static_cast<double>(i) / static_cast<double>(cases.size()));
     LinkSweepRow row;

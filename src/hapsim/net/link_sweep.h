@@ -59,6 +59,7 @@
 #include "hapsim/core/progress.h"
 #include "hapsim/device/local_model_renderer.h"
 #include "hapsim/device/passivity_observer.h"
+#include "hapsim/net/force_mode.h"
 
 #include <cstdint>
 #include <string>
@@ -66,7 +67,6 @@
 
 namespace hapsim::net {
 
-enum class ForceMode : std::uint8_t { kRaw, kLocalModel };
 enum class SweepEnvironment : std::uint8_t { kTissue, kWall };
 enum class SweepHand : std::uint8_t { kRelaxed, kStiff };
 /// Which K the simulation sends in local-model mode: the whole contact's (contact spring in
@@ -74,7 +74,6 @@ enum class SweepHand : std::uint8_t { kRelaxed, kStiff };
 /// error comes back through the tissue each round trip).
 enum class ModelStiffness : std::uint8_t { kSeries, kContactOnly };
 
-[[nodiscard]] const char* force_mode_name(ForceMode mode) noexcept;
 [[nodiscard]] const char* environment_name(SweepEnvironment environment) noexcept;
 [[nodiscard]] const char* hand_name(SweepHand hand) noexcept;
 

@@ -1,0 +1,73 @@
+# What keeps a cold build (CI builds everything from a fresh clone on two cores, docs/benchmarks.md#build-time)
+# short, without touching what the library computes:
+#  - precompiled headers: the standard and Eigen headers that nearly every file includes, parsed
+#    once per library instead of once per file; the tests share one, with GoogleTest added;
+#  - unity builds of the two targets with the most files (the headless library, the app): files
+#    compiled in batches of 8, so our own headers and their template instances are compiled
+#    once per batch;
+#  - test code at -O1 (release): tests assert no wall-clock time and the library they call keeps
+#    the release flags; -O3 on gtest's macro-expanded bodies only cost compile time.
+# nlohmann/json stays out of the precompiled headers on purpose: a fifth of the files include
+# it, and the larger header costs the other four fifths more to load than it saves.
+option(HAPSIM_PCH "Precompile the standard, Eigen and GoogleTest headers (a faster cold build)" ON)
+option(HAPSIM_UNITY_BUILD "Compile the headless library and the app in batches of files (a faster cold build)" ON)
+
+set(HAPSIM_PCH_HEADERS
+    <algorithm> <array> <atomic> <chrono> <cmath> <cstdint> <filesystem> <fstream> <limits>
+    <memory> <optional> <span> <string> <vector> <Eigen/Core> <Eigen/Geometry>)
+
+# GCC 12 reports std::string concatenations inside libstdc++ as out of bounds once enough is
+# inlined (GCC bugs 105329, 105651: false positives): at -O1 in the tests, and at -O3 across the
+# app's batched files. The library's own files keep these warnings.
+set(HAPSIM_GCC12_FALSE_POSITIVES -Wno-array-bounds -Wno-stringop-overflow -Wno-stringop-overread
+                                 -Wno-restrict)
+
+# The headers as C++-only generator expressions (some targets also compile C: the drivers' ABI
+# header, Cyclone's generated types); $<ANGLE-R> writes a header's closing bracket inside one.
+function(_hapsim_pch_expressions out)
+  set(_headers ${ARGN})
+  list(TRANSFORM _headers REPLACE "^<(.*)>$" "$<$<COMPILE_LANGUAGE:CXX>:<\\1$<ANGLE-R>>")
+  set(${out} ${_headers} PARENT_SCOPE)
+endfunction()
+
+# A library's own precompiled header.
+function(hapsim_precompile_headers target)
+  if(HAPSIM_PCH)
+    _hapsim_pch_expressions(_headers ${HAPSIM_PCH_HEADERS})
+    target_precompile_headers(${target} PRIVATE ${_headers})
+  endif()
+endfunction()
+
+# A unity build of `target` in batches of 8; SKIP files (their anonymous-namespace types would meet
+# another file's) are compiled alone.
+function(hapsim_unity_build target)
+  cmake_parse_arguments(_unity "" "" "SKIP" ${ARGN})
+  if(HAPSIM_UNITY_BUILD)
+    set_target_properties(${target} PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 8)
+    if(_unity_SKIP)
+      set_source_files_properties(${_unity_SKIP} TARGET_DIRECTORY ${target}
+                                  PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
+    endif()
+  endif()
+endfunction()
+
+# The test executables' code flags; `support` is the library every test links (its include
+# folders and definitions are the precompiled header's). The first call makes the shared header.
+function(hapsim_test_code target support)
+  target_compile_options(${target} PRIVATE "$<$<CONFIG:Release>:-O1;${HAPSIM_GCC12_FALSE_POSITIVES}>")
+  if(NOT HAPSIM_PCH)
+    return()
+  endif()
+  if(NOT TARGET hapsim_test_pch)
+    set(_anchor "${CMAKE_CURRENT_BINARY_DIR}/hapsim_test_pch.cpp")
+    file(WRITE "${_anchor}" "// The tests' shared precompiled header is built with this file.\n")
+    add_library(hapsim_test_pch OBJECT "${_anchor}")
+    target_link_libraries(hapsim_test_pch PRIVATE ${support})
+    hapsim_set_warnings(hapsim_test_pch)
+    target_compile_options(hapsim_test_pch
+                           PRIVATE "$<$<CONFIG:Release>:-O1;${HAPSIM_GCC12_FALSE_POSITIVES}>")
+    _hapsim_pch_expressions(_headers ${HAPSIM_PCH_HEADERS} <gtest/gtest.h>)
+    target_precompile_headers(hapsim_test_pch PRIVATE ${_headers})
+  endif()
+  target_precompile_headers(${target} REUSE_FROM hapsim_test_pch)
+endfunction()
