@@ -14,6 +14,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace hapsim::app {
 namespace {
@@ -34,6 +35,7 @@ struct ViewArgs {
   std::string view;
   std::string camera;
   bool room = false;
+  std::vector<std::string> overlays;
   std::string screenshot;
   std::string first_screenshot;
   std::string json;
@@ -100,6 +102,9 @@ void view(const ViewArgs& args) {
   o.view = args.view;
   o.camera = args.camera;
   o.room = args.room;
+  for (const std::string& overlay : args.overlays) {
+    (overlay == "influence" ? o.influence_overlay : o.contact_vertices_overlay) = true;
+  }
   o.screenshot = args.screenshot;
   o.first_screenshot = args.first_screenshot;
   o.json = args.json;
@@ -165,6 +170,11 @@ void add_view_command(CLI::App& app) {
                   "field of view in degrees)");
   cmd->add_flag("--room", args->room,
                 "Show the knee paper's room (walls and floor) from the start");
+  cmd->add_option("--overlay", args->overlays,
+                  "Show the knee method's overlays from the start (the knee paper's Fig. 3; the "
+                  "Display panel toggles them), comma-separated: influence, contact-vertices")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"influence", "contact-vertices"}));
   cmd->add_option("--screenshot", args->screenshot, "Write the last frame to FILE.png");
   cmd->add_option("--first-screenshot", args->first_screenshot,
                   "Write an early frame (the scene at rest) to FILE.png");

@@ -130,7 +130,7 @@ double differing(const RgbaImage& a, const RgbaImage& b) {
   return compare_images(a.rgba, b.rgba, a.width, a.height).differing_fraction;
 }
 
-TEST(ViewCommand, StartsFromTheScenesNamedViewOrAGivenCameraWithTheRoom) {
+TEST(ViewCommand, StartsFromTheScenesNamedViewOrAGivenCameraWithTheRoomAndTheOverlays) {
   if (!have("xvfb-run")) {
     GTEST_SKIP() << "xvfb-run missing (scripts/setup.sh installs it)";
   }
@@ -151,6 +151,11 @@ TEST(ViewCommand, StartsFromTheScenesNamedViewOrAGivenCameraWithTheRoom) {
   };
   EXPECT_GT(walls(room), 640 * 360 / 10);
   EXPECT_EQ(walls(framed), 0);
+  // The knee method's overlays from the start: every vertex group's sphere of influence, three
+  // great circles each, over the segments (the picture is otherwise the named view's).
+  const RgbaImage influence =
+      view_picture(scene, "--view front --overlay influence", "view_influence");
+  EXPECT_GT(differing(named, influence), 0.01);
 }
 
 TEST(ViewCommand, BadCameraOptionsAreOneLineBeforeAnyWindow) {

@@ -158,6 +158,12 @@ class NetViewerSession final : public ViewerSession {
     c.kind = net::SessionCommandKind::kReset;
     commands_sent_ += commands_->send(c) ? 1 : 0;
   }
+  void set_knee_overlays(bool influence_spheres, bool contact_vertices) override {
+    WorldSceneOptions o = view_->options();
+    o.show_influence_spheres = influence_spheres;
+    o.show_contact_vertices = contact_vertices;
+    view_->set_options(o);
+  }
   void draw_controls() override {
     ImGui::TextWrapped(
         "Connected to session '%s' (scene hash %s). The simulation and the device run "

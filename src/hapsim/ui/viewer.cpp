@@ -292,12 +292,13 @@ class Viewer {
     }
     session_ = std::move(next);
     session_->render_scene().style.level_of_detail = true;  // the window draws far meshes coarser
-    // The start's --view/--camera and --room apply to the first scene only; one chosen later in
-    // the menu is framed as usual.
+    // The start's --view/--camera, --room and --overlay apply to the first scene only; one chosen
+    // later in the menu is framed as usual.
     std::optional<OrbitCamera> asked;
     if (!built_once_) {
       asked = chosen_camera(described, options_.view, options_.camera);
       session_->render_scene().room.visible = options_.room;
+      session_->set_knee_overlays(options_.influence_overlay, options_.contact_vertices_overlay);
     }
     built_once_ = true;
     // The scene's warnings, through the log as mesh defects are: once each, however often the

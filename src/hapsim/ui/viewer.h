@@ -45,6 +45,10 @@ struct ViewerOptions {
   /// Show the knee paper's room (walls and floor) from the start; the data area's "room" box
   /// toggles it.
   bool room = false;
+  /// The knee method's overlays from the start (`--overlay influence,contact-vertices`); the
+  /// Display panel's boxes toggle them.
+  bool influence_overlay = false;
+  bool contact_vertices_overlay = false;
   /// Close after this many seconds (0: when the window is closed).
   double duration_s = 0.0;
   /// Write the last frame (the whole window) to this PNG when closing.

@@ -103,6 +103,10 @@ class ViewerSession {
   virtual void reset() = 0;
   /// ImGui widgets of what this session can change live (segments, materials, overlays).
   virtual void draw_controls() = 0;
+  /// The knee method's overlays (the knee paper's Fig. 3, render/world_scene.h): each vertex
+  /// group's sphere of influence, and the three vertices a touching tool's contact is tested
+  /// against. The Display panel's boxes toggle them too.
+  virtual void set_knee_overlays(bool influence_spheres, bool contact_vertices) = 0;
   /// Starts writing every haptic cycle to `path` (binary recording), or stops; false with a
   /// message in `error` when it cannot.
   virtual bool set_recording(const std::filesystem::path* path, std::string& error) = 0;

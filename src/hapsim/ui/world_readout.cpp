@@ -66,6 +66,15 @@ void draw_world_display_controls(WorldScene& view) {
   changed |= ImGui::Checkbox("proxies", &o.show_proxies);
   ImGui::SameLine();
   changed |= ImGui::Checkbox("force arrows", &o.show_force_arrows);
+  // The knee method's overlays (the knee paper's Fig. 3); drawn on segments that use it.
+  changed |= ImGui::Checkbox("spheres of influence", &o.show_influence_spheres);
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip("Each vertex group's sphere of influence (knee-method segments)");
+  }
+  changed |= ImGui::Checkbox("contact vertices", &o.show_contact_vertices);
+  if (ImGui::IsItemHovered()) {
+    ImGui::SetTooltip("The three vertices a touching tool's contact is tested against");
+  }
   if (changed) {
     view.set_options(o);
   }

@@ -367,6 +367,12 @@ class WorldViewerSession final : public ViewerSession {
     return client_->request_material(static_cast<std::uint32_t>(material), contact);
   }
 
+  void set_knee_overlays(bool influence_spheres, bool contact_vertices) override {
+    WorldSceneOptions o = view_->options();
+    o.show_influence_spheres = influence_spheres;
+    o.show_contact_vertices = contact_vertices;
+    view_->set_options(o);
+  }
   void draw_controls() override {
     if (world_->rig() != nullptr) {
       draw_rig_controls();
