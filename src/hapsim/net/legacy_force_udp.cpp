@@ -212,7 +212,7 @@ std::optional<std::size_t> LegacyForceUdpReceiver::receive(std::span<std::byte> 
 
 std::unique_ptr<LegacyGloveDevice> open_legacy_glove_udp(std::string_view bind_spec,
                                                          DeviceProfile profile,
-                                                         LegacyGloveOptions options,
+                                                         const LegacyGloveOptions& options,
                                                          std::string_view option) {
   return std::make_unique<LegacyGloveDevice>(
       std::move(profile), std::make_unique<LegacyForceUdpReceiver>(bind_spec, option), options);

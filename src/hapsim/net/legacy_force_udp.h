@@ -108,6 +108,6 @@ class LegacyForceUdpReceiver final : public LegacyPacketSource {
 /// a LegacyForceUdpReceiver bound per `bind_spec`. Throws hapsim::Error (one line).
 [[nodiscard]] std::unique_ptr<LegacyGloveDevice> open_legacy_glove_udp(
     std::string_view bind_spec, DeviceProfile profile = device_profile("rutgers_master"),
-    LegacyGloveOptions options = {}, std::string_view option = "--legacy-force-bind");
+    const LegacyGloveOptions& options = {}, std::string_view option = "--legacy-force-bind");
 
 }  // namespace hapsim::net
