@@ -236,6 +236,7 @@ void HapticLoop::haptic_thread_main() noexcept {
     // The ceiling is taken as late as possible before the write, so that a freeze anywhere in the
     // cycle (the sleep, the read, the step) shows as a gap since the previous write.
     const std::int64_t write_ns = monotonic_ns();
+    const double ceiling_of_last_write = resume.ceiling();
     const double ceiling = resume.update(1e-9 * static_cast<double>(write_ns - start_ns),
                                          s.supervisor_gain.exchange(1.0), soft_start);
     if (resume.gap_cut()) {
@@ -244,12 +245,15 @@ void HapticLoop::haptic_thread_main() noexcept {
     }
     if (s.watchdog.ramping()) {
       // Already the last good command scaled by the watchdog's gain: at most the ceiling, and
-      // force comes back from the lower of the two.
+      // force comes back from the lower of the two. A resume ramp under way stops rising here
+      // (the device was lost or the steps fail: from the last write the force only falls; a
+      // loss during the ramp back after a stall once wrote 1.312 N after 1.307 N).
       const double watchdog_gain = s.watchdog.output_gain();
-      if (ceiling < watchdog_gain) {
-        out = scaled_command(out, ceiling / watchdog_gain);
+      const double cap = std::min(ceiling, ceiling_of_last_write);
+      if (cap < watchdog_gain) {
+        out = scaled_command(out, cap / watchdog_gain);
       }
-      resume.lower_to(watchdog_gain);
+      resume.lower_to(std::min(watchdog_gain, cap));
       bump(s.ramp_cycles);
     } else if (ceiling < 1.0) {
       out = scaled_command(out, ceiling);
