@@ -53,6 +53,10 @@ struct WriteLog {
   std::atomic<std::uint64_t> resume_gaps{0};
   std::atomic<std::uint64_t> stall_events{0};
   std::atomic<bool> realtime_priority{false};
+  // The device is gone (set by a client, read by LogDevice): reads unhealthy, status failed.
+  std::atomic<std::int64_t> lost_ns{0};
+  // The first read that found it gone, plus one (0: none yet).
+  std::atomic<std::uint64_t> first_lost_read{0};
   std::array<Write, kCapacity> writes{};
 
   [[nodiscard]] std::vector<Write> copy() const {
@@ -73,6 +77,10 @@ class LogDevice final : public Device {
     last_read_ = log_.reads.fetch_add(1);
     DeviceInput in;
     in.time_s = time_s;
+    in.healthy = log_.lost_ns.load() == 0;
+    if (!in.healthy && log_.first_lost_read.load() == 0) {
+      log_.first_lost_read.store(last_read_ + 1);
+    }
     return in;
   }
   void write(const DeviceCommand& command) noexcept override {
@@ -85,7 +93,13 @@ class LogDevice final : public Device {
     }
   }
   const DeviceProfile& profile() const noexcept override { return profile_; }
-  DeviceStatus status() const noexcept override { return {}; }
+  DeviceStatus status() const noexcept override {
+    DeviceStatus s;
+    if (log_.lost_ns.load() != 0) {
+      s.health = DeviceHealth::kFailed;
+    }
+    return s;
+  }
 
  private:
   WriteLog& log_;
@@ -109,6 +123,9 @@ class SteadyClient final : public HapticClient {
       std::this_thread::sleep_for(stall_);
       end_ns_.store(monotonic_ns());
       resumed_at_ = steps_;
+    } else if (lose_ != nullptr && resumed_at_ != 0 && lose_->load() == 0 &&
+               steps_ >= resumed_at_ + lose_after_) {
+      lose_->store(monotonic_ns());  // the device is gone from the next read on
     } else if (second_stall_ > std::chrono::nanoseconds::zero() && resumed_at_ != 0 &&
                second_begin_ns_.load() == 0 && steps_ >= resumed_at_ + second_after_) {
       // While the force is still coming back from the first stall.
@@ -133,6 +150,11 @@ class SteadyClient final : public HapticClient {
     second_after_ = after;
     second_stall_ = stall;
   }
+  // The device lost `after` cycles after the stall ended (during the ramp back): sets `lost_ns`.
+  void then_lose_device(std::uint64_t after, std::atomic<std::int64_t>* lost_ns) {
+    lose_after_ = after;
+    lose_ = lost_ns;
+  }
   [[nodiscard]] std::int64_t second_begin_ns() const { return second_begin_ns_.load(); }
   [[nodiscard]] std::int64_t second_end_ns() const { return second_end_ns_.load(); }
   // The force the device had when the second stall began (a fraction of the steady force).
@@ -151,6 +173,8 @@ class SteadyClient final : public HapticClient {
   std::uint64_t second_after_ = 0;
   std::chrono::nanoseconds second_stall_{0};
   double second_force_n_ = 0.0;
+  std::uint64_t lose_after_ = 0;
+  std::atomic<std::int64_t>* lose_ = nullptr;
   std::atomic<std::int64_t> second_begin_ns_{0};
   std::atomic<std::int64_t> second_end_ns_{0};
   std::atomic<std::int64_t> begin_ns_{0};
@@ -494,6 +518,42 @@ TEST(HapticLoopFaults, SecondStallDuringTheRampComesBackFromWhereTheDeviceWas) {
   for (const std::string& problem : fault_problems(w, second, kForceN, options)) {
     ADD_FAILURE() << "second stall: " << problem;
   }
+}
+
+// The device lost while the force comes back after a stall (the watchdog's ramp from the last good
+// command meeting the resume ramp): from the loss on the force only falls, to exactly zero.
+// Found under load by WorldFaults.DeviceVanishing… (1.312 N written after 1.307 N).
+TEST(HapticLoopFaults, DeviceLostDuringTheRampBackOnlyFalls) {
+  auto log = std::make_unique<WriteLog>();
+  LogDevice device(*log);
+  SteadyClient client(kForceN);
+  const HapticLoopOptions options;
+  client.stall_at(300, std::chrono::milliseconds(30));
+  client.then_lose_device(3, &log->lost_ns);
+  HapticLoop loop(device, client, options);
+  loop.start();
+  const bool lost = hold_until([&] { return log->lost_ns.load() != 0; });
+  const std::uint64_t served = client.cycles() + 100;
+  hold_until([&] { return client.cycles() >= served; });
+  loop.stop();
+  ASSERT_TRUE(lost) << "the device was never lost";
+  const auto w = log->copy();
+  expect_all_finite_within_rating(w, device.profile().max_force_n);
+  // From the haptic thread's first write after a read that found the device gone.
+  ASSERT_GT(log->first_lost_read.load(), 0u);
+  const std::uint64_t lost_read = log->first_lost_read.load() - 1;
+  std::size_t from = 0;
+  while (from < w.size() && !(w[from].haptic && w[from].cycle == lost_read)) {
+    ++from;
+  }
+  ASSERT_GT(from, 0u);
+  ASSERT_LT(from + 10, w.size()) << "too few writes after the loss";
+  EXPECT_GT(w[from - 1].force_n, 0.0) << "the ramp back had not begun (this tests nothing new)";
+  EXPECT_LT(w[from - 1].force_n, kForceN) << "the ramp back had ended (this tests nothing new)";
+  for (std::size_t i = from; i < w.size(); ++i) {
+    EXPECT_LE(w[i].force_n, w[i - 1].force_n + 1e-12) << "the force rose at write " << i;
+  }
+  EXPECT_EQ(w.back().force_n, 0.0);
 }
 
 // The other core (every core but one) saturated by busy threads at normal priority while the loop
