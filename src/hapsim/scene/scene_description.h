@@ -35,8 +35,8 @@ struct PalpationScriptDescription {
   /// Moves between targets go round this axis (through the body's centre) on a cylinder that
   /// clears the body and the tools, instead of straight through the body. Optional.
   bool has_around_axis = false;
-  Vec3 around_axis_world = Vec3::UnitZ();  /// Longest spacing of the script's samples, seconds. Not
-                                           /// read from the file: 1 ms matches the
+  Vec3 around_axis_world = Vec3::UnitZ();
+  /// Longest spacing of the script's samples, seconds. Not read from the file: 1 ms matches the
   /// haptic rate; a fuzz run that steps only the first 100 cycles coarsens it (fuzz/scene_step).
   double sample_period_s = 0.001;
 };
@@ -59,8 +59,8 @@ struct GlovePalpationDescription {
   double move_s = 0.8;
   double press_s = 0.6;
   double hold_s = 0.6;
-  double release_s = 0.6;  /// Longest spacing of the script's samples, seconds. Not read from the
-                           /// file: 1 ms matches the
+  double release_s = 0.6;
+  /// Longest spacing of the script's samples, seconds. Not read from the file: 1 ms matches the
   /// haptic rate; a fuzz run that steps only the first 100 cycles coarsens it (fuzz/scene_step).
   double sample_period_s = 0.001;
 };
@@ -83,9 +83,8 @@ struct GlovePickAndPlaceDescription {
   double open_clearance_m = 0.02;
   /// Phase durations, seconds (> 0).
   double approach_s = 1.0, close_s = 0.6, lift_s = 0.8, carry_s = 1.5, lower_s = 1.0, press_s = 0.8,
-         open_s = 0.5, retreat_s = 0.8,
-         settle_s = 1.0;  /// Longest spacing of the script's samples, seconds. Not read from the
-                          /// file: 1 ms matches the
+         open_s = 0.5, retreat_s = 0.8, settle_s = 1.0;
+  /// Longest spacing of the script's samples, seconds. Not read from the file: 1 ms matches the
   /// haptic rate; a fuzz run that steps only the first 100 cycles coarsens it (fuzz/scene_step).
   double sample_period_s = 0.001;
 };
@@ -96,8 +95,8 @@ struct PickAndPlaceDescription {
   Vec3 place_m = Vec3(0.5, 0.25, 0.08);
   double clearance_m = 0.12;
   /// Seconds for the carry from above the ball to above the target.
-  double carry_s = 2.0;  /// Longest spacing of the script's samples, seconds. Not read from the
-                         /// file: 1 ms matches the
+  double carry_s = 2.0;
+  /// Longest spacing of the script's samples, seconds. Not read from the file: 1 ms matches the
   /// haptic rate; a fuzz run that steps only the first 100 cycles coarsens it (fuzz/scene_step).
   double sample_period_s = 0.001;
 };
