@@ -446,8 +446,8 @@ std::vector<LinkSweepRow> run_link_sweep(const LinkSweepOptions& options) {
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const LinkCase& c = cases[i];
     report_progress(options.progress,
-                    std::string(to_string(c.mode)) + " " + environment_name(c.environment) +
-                        " " + hand_name(c.hand),
+                    std::string(to_string(c.mode)) + " " + environment_name(c.environment) + " " +
+                        hand_name(c.hand),
                     static_cast<double>(i) / static_cast<double>(cases.size()));
     LinkSweepRow row;
     row.link_case = c;
