@@ -13,6 +13,7 @@
 
 #include <array>
 #include <csignal>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -104,9 +105,18 @@ TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
   EXPECT_EQ(watch.wait(), 0) << watch.output();
   {
     const nlohmann::json w = read_json(watch_json);
-    EXPECT_GT(w["views"].get<int>(), 200);  // ~30 per second
+    // Progress, not rate: the views span the palpation (10.5 s of 1 kHz cycles) and came at
+    // least ten a second, a third of serve's 30 (a loaded machine's watch lags, not loses them).
+    const auto cycles = w["cycles"].get<std::array<std::uint64_t, 2>>();
+    EXPECT_GT(cycles[1] - cycles[0], 9'000u);
+    EXPECT_GT(w["views"].get<int>(), 100);
     EXPECT_EQ(w["refused"].get<int>(), 0);
-    EXPECT_NEAR(w["peak_force_n"].get<double>(), a_peak_n(one_json), 0.05 * a_peak_n(one_json));
+    // A view samples serve's force every ~33 ms (longer under load): its largest is not above
+    // serve's peak (5 % for the world's force before the device's safety stage) and, the patella
+    // held pressed over several views, within 15 % below it.
+    const double served_peak_n = a_peak_n(served_json);
+    EXPECT_LE(w["peak_force_n"].get<double>(), 1.05 * served_peak_n);
+    EXPECT_GE(w["peak_force_n"].get<double>(), 0.85 * served_peak_n);
     EXPECT_GT(w["max_deflection_m"].get<double>(), 0.005);
     EXPECT_TRUE(std::filesystem::exists(watch_png));
   }
