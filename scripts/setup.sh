@@ -17,9 +17,10 @@ HAPSIM_PACKAGES=(
   libeigen3-dev libassimp-dev liburdfdom-dev nlohmann-json3-dev libcli11-dev libspdlog-dev
   # find_package(meshoptimizer): mesh simplification (hapsim simplify, display levels of detail)
   libmeshoptimizer-dev
-  # find_package(OpenGL COMPONENTS OpenGL EGL): GL/gl.h and KHR/ (libgl-dev), libOpenGL.so
+  # find_package(OpenGL COMPONENTS OpenGL EGL GLX): GL/gl.h and KHR/ (libgl-dev), libOpenGL.so
   # (libopengl-dev, GLVND's OpenGL library: the renderer links it, not libGL), EGL/egl.h and
-  # libEGL.so (libegl-dev)
+  # libEGL.so (libegl-dev); GL/glx.h and libGLX.so (libglx-dev, a dependency of libgl-dev: the
+  # viewer presents part of its window with GLX_MESA_copy_sub_buffer)
   libgl-dev libopengl-dev libegl-dev
   # at run time GLVND dispatches to Mesa: EGL surfaceless for headless pictures (libegl-mesa0),
   # GLX under Xvfb for the viewer (libglx-mesa0), llvmpipe, the software rasteriser (libgl1-mesa-dri)

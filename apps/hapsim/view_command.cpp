@@ -28,6 +28,7 @@ struct ViewArgs {
   std::string size = "1280x720";
   bool no_vsync = false;
   bool no_panels = false;
+  double panels_hz = 20.0;
   int msaa = 0;
   std::string stereo = "off";
   double eye_separation_m = 0.0;
@@ -70,6 +71,7 @@ void view(const ViewArgs& args) {
   }
   o.vsync = !args.no_vsync;
   o.panels = !args.no_panels;
+  o.panel_refresh_hz = args.panels_hz;
   o.msaa_samples = args.msaa;
   try {
     o.stereo = parse_stereo_mode(args.stereo);
@@ -153,6 +155,11 @@ void add_view_command(CLI::App& app) {
   cmd->add_flag("--no-vsync", args->no_vsync, "Draw as fast as possible (to measure fps)");
   cmd->add_flag("--no-panels", args->no_panels,
                 "Start with the control and data areas hidden (Tab shows them)");
+  cmd->add_option("--panels-hz", args->panels_hz,
+                  "On a software rasteriser, redraw the panels at least N times a second while "
+                  "nothing happens on them and draw the 3D view alone in between (default 20; "
+                  "0: the panels every frame)")
+      ->check(CLI::Range(0.0, 1000.0));
   cmd->add_option("--stereo", args->stereo,
                   "Stereo view: off (default), side-by-side (left eye left) or anaglyph "
                   "(red-cyan); V cycles them");

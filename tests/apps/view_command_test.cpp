@@ -81,6 +81,63 @@ TEST(ViewCommand, MouseProbeUnderXvfbDentsTheKneeAndShowsTheForce) {
   EXPECT_GT(d.differing_fraction, 0.002) << d.describe();
 }
 
+// Between panel frames the viewer draws and presents the 3D view alone (ui/panel_refresh.h), on a
+// software rasteriser. What the X server shows (not the viewer's own read-back) must keep the
+// panels and follow the scene: two grabs of the screen a second apart, the panels redrawn at most
+// every 5 s, the palpation moving the fingertip. The 3D view moved; the control panel is drawn and
+// unchanged.
+TEST(ViewCommand, FramesWithoutThePanelsKeepThemOnTheWindowAndShowTheSceneMoving) {
+#ifndef HAPSIM_X11_GRAB_PATH
+  GTEST_SKIP() << "built without X11's headers (libx11-dev): no screen grab";
+#else
+  if (!have("xvfb-run") || !have("xdotool")) {
+    GTEST_SKIP() << "xvfb-run or xdotool missing (scripts/setup.sh installs both)";
+  }
+  const auto out = test::temp_path("viewer_partial");
+  const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' bash ") +
+                          HAPSIM_SOURCE_DIR + "/tests/apps/viewer_partial_frames.sh " +
+                          HAPSIM_BIN_PATH + " " + HAPSIM_X11_GRAB_PATH + " " + HAPSIM_SCENES_DIR +
+                          "/knee_procedural.json " + out.string();
+  const int status = std::system(cmd.c_str());
+  std::ifstream log(out / "view.log");
+  const std::string log_text((std::istreambuf_iterator<char>(log)), {});
+  ASSERT_EQ(status, 0) << log_text;
+  std::ifstream in(out / "view.json");
+  ASSERT_TRUE(in) << log_text;
+  const nlohmann::json j = nlohmann::json::parse(in);
+  if (!j["partial_redraw"].get<bool>()) {
+    GTEST_SKIP() << "not a software rasteriser with GLX_MESA_copy_sub_buffer here: the viewer "
+                    "draws its panels every frame ("
+                 << j["renderer"].get<std::string>() << ")";
+  }
+  EXPECT_LT(4 * j["panel_frames"].get<int>(), j["frames"].get<int>()) << log_text;
+
+  const RgbaImage a = read_png((out / "grab1.png").string());
+  const RgbaImage b = read_png((out / "grab2.png").string());
+  ASSERT_EQ(a.width, 1280);
+  ASSERT_EQ(b.height, 720);
+  const auto crop = [](const RgbaImage& im, int x0, int width) {
+    std::vector<std::uint8_t> c;
+    for (int y = 0; y < im.height; ++y) {
+      const auto* row = &im.rgba[(static_cast<std::size_t>(y) * im.width + x0) * 4];
+      c.insert(c.end(), row, row + 4 * width);
+    }
+    return c;
+  };
+  // The control panel (x 0-300): on the screen in both grabs, widgets and text (not the clear
+  // colour alone), and the same.
+  // ImGui's dark style's window colour (0.06 grey), which the viewer clears the panels' area with.
+  const int blank = count_colour(a, {15, 15, 15, 255}, 0, 0, 300, 720);
+  EXPECT_LT(blank, 300 * 720 * 95 / 100);
+  const std::vector<std::uint8_t> control_a = crop(a, 0, 300);
+  const ImageDiff panel = compare_images(control_a, crop(b, 0, 300), 300, 720);
+  EXPECT_LT(panel.differing_fraction, 0.002) << panel.describe();
+  // The 3D view (x 320-920) followed the fingertip between the grabs.
+  const ImageDiff view = compare_images(crop(a, 320, 600), crop(b, 320, 600), 600, 720);
+  EXPECT_GT(view.differing_fraction, 0.002) << view.describe();
+#endif
+}
+
 // The viewer prints the scene's warnings once (through the log, as `hapsim run` does) and lists
 // them in its JSON: here a trajectory 100 m above the knee.
 TEST(ViewCommand, PrintsTheScenesWarningsOnceAndListsThemInItsJson) {

@@ -11,8 +11,10 @@
 #include "hapsim/ui/force_graph.h"
 #include "hapsim/ui/mouse_probe.h"
 #include "hapsim/ui/net_viewer_session.h"
+#include "hapsim/ui/panel_refresh.h"
 #include "hapsim/ui/render_cpu_time.h"
 #include "hapsim/ui/space_mouse_camera.h"
+#include "hapsim/ui/sub_buffer_present.h"
 #include "hapsim/ui/viewer_scenes.h"
 
 #define GLFW_INCLUDE_NONE
@@ -31,6 +33,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 // glReadPixels and friends without a loader (glvnd's libOpenGL exports the core functions).
@@ -51,13 +54,72 @@ void on_glfw_error(int code, const char* text) {
 
 struct InputState {
   double wheel_steps = 0.0;
+  /// What the events say about the panels (null while they are drawn every frame), and their
+  /// widths in window coordinates (0 when hidden).
+  PanelRefresh* panel_refresh = nullptr;
+  double panel_left_px = 0.0;
+  double panel_right_px = 0.0;
 };
 
+InputState* input_of(GLFWwindow* window) {
+  return static_cast<InputState*>(glfwGetWindowUserPointer(window));
+}
+
+// An event at the pointer: over a panel (or just off one) the panels are due.
+void note_pointer(GLFWwindow* window) {
+  InputState* state = input_of(window);
+  if (state == nullptr || state->panel_refresh == nullptr) {
+    return;
+  }
+  double x = 0.0;
+  double y = 0.0;
+  glfwGetCursorPos(window, &x, &y);
+  int win_w = 0;
+  int win_h = 0;
+  glfwGetWindowSize(window, &win_w, &win_h);
+  state->panel_refresh->pointer_event(x < state->panel_left_px ||
+                                      x >= static_cast<double>(win_w) - state->panel_right_px);
+}
+
+void note_other_input(GLFWwindow* window) {
+  InputState* state = input_of(window);
+  if (state != nullptr && state->panel_refresh != nullptr) {
+    state->panel_refresh->other_event();
+  }
+}
+
 void on_scroll(GLFWwindow* window, double /*x*/, double y) {
-  auto* state = static_cast<InputState*>(glfwGetWindowUserPointer(window));
+  note_pointer(window);
+  InputState* state = input_of(window);
   if (state != nullptr && !ImGui::GetIO().WantCaptureMouse) {
     state->wheel_steps += y;
   }
+}
+
+// ImGui's GLFW backend (1.86) polls the pointer's position and chains to these others.
+void on_cursor(GLFWwindow* window, double /*x*/, double /*y*/) {
+  note_pointer(window);
+}
+void on_mouse_button(GLFWwindow* window, int /*button*/, int /*action*/, int /*mods*/) {
+  note_pointer(window);
+}
+void on_key(GLFWwindow* window, int /*key*/, int /*scancode*/, int /*action*/, int /*mods*/) {
+  note_other_input(window);
+}
+void on_char(GLFWwindow* window, unsigned int /*codepoint*/) {
+  note_other_input(window);
+}
+void on_refresh(GLFWwindow* window) {
+  note_other_input(window);  // exposed again: the window's pixels need the panels too
+}
+
+// Mesa's software rasterisers, where drawing the panels costs a quarter of a frame; on a GPU they
+// cost next to nothing and presenting a part of the window would bypass vsync.
+bool software_rasteriser() {
+  const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  const std::string_view r = renderer != nullptr ? renderer : "";
+  return r.find("llvmpipe") != std::string_view::npos ||
+         r.find("softpipe") != std::string_view::npos;
 }
 
 // `described`: the scene file's description (only its views are kept; left empty for a connected
@@ -99,13 +161,18 @@ struct FrameStats {
   std::vector<double> frame_ms;
   double fps_recent = 0.0;
   double draw_ms_recent = 0.0;
+  /// Frames that drew the panels too (the others drew only the 3D view: ui/panel_refresh.h).
+  std::size_t whole_frames = 0;
   /// CPU time from the first frame on (render_cpu_time.h).
   RenderCpuTime cpu_start;
 };
 
 class Viewer {
  public:
-  explicit Viewer(const ViewerOptions& options) : options_(options), config_(options.config) {
+  explicit Viewer(const ViewerOptions& options)
+      : options_(options),
+        config_(options.config),
+        panel_refresh_(options.panel_refresh_hz > 0.0 ? 1.0 / options.panel_refresh_hz : 0.0) {
     glfwSetErrorCallback(on_glfw_error);
     if (glfwInit() == GLFW_FALSE) {
       throw Error("viewer", "cannot open a window (" + glfw_error_text +
@@ -126,7 +193,12 @@ class Viewer {
     glfwMakeContextCurrent(window_);
     glfwSwapInterval(options.vsync ? 1 : 0);
     glfwSetWindowUserPointer(window_, &input_);
-    glfwSetScrollCallback(window_, on_scroll);  // before ImGui, which chains to it
+    glfwSetScrollCallback(window_, on_scroll);  // before ImGui, which chains to them
+    glfwSetCursorPosCallback(window_, on_cursor);
+    glfwSetMouseButtonCallback(window_, on_mouse_button);
+    glfwSetKeyCallback(window_, on_key);
+    glfwSetCharCallback(window_, on_char);
+    glfwSetWindowRefreshCallback(window_, on_refresh);
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     ImGui::GetIO().IniFilename = nullptr;
@@ -137,6 +209,12 @@ class Viewer {
     stereo_ = options.stereo;
     renderer_ = std::make_unique<Renderer>();
     gl_version_ = renderer_->gl_version();
+    if (options.panel_refresh_hz > 0.0 && software_rasteriser()) {
+      presenter_ = SubBufferPresenter::for_current_context();
+    }
+    if (presenter_) {
+      input_.panel_refresh = &panel_refresh_;
+    }
     scene_choices_ = options.scene_choices;
     if (!config_.connect && std::find(scene_choices_.begin(), scene_choices_.end(),
                                       config_.scene) == scene_choices_.end()) {
@@ -190,35 +268,68 @@ class Viewer {
       forces_.push(r.bars);
       peak_deflection_m_ = std::max(peak_deflection_m_, r.max_deflection_m);
 
-      glfwGetFramebufferSize(window_, &fb_w, &fb_h);
+      int next_fb_w = 0;
+      int next_fb_h = 0;
+      glfwGetFramebufferSize(window_, &next_fb_w, &next_fb_h);
+      if (next_fb_w != fb_w || next_fb_h != fb_h) {
+        panel_refresh_.other_event();  // resized: the panels move
+        fb_w = next_fb_w;
+        fb_h = next_fb_h;
+      }
       const auto d0 = Clock::now();
       const Viewport v = view_rect(fb_w, fb_h);
-      // The whole back buffer, in the panels' colour: they are drawn without a background of their
-      // own (ImGuiWindowFlags_NoBackground), since on a software rasteriser blending a textured
-      // quad over 650×720 pixels cost ~5 ms of its CPU a frame; a clear costs next to nothing.
-      glViewport(0, 0, fb_w, fb_h);
-      const ImVec4 panel = ImGui::GetStyle().Colors[ImGuiCol_WindowBg];
-      glClearColor(panel.x, panel.y, panel.z, 1.0f);
-      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      const bool first_due =
+          !first_written && !options_.first_screenshot.empty() && stats_.frames >= 3;
+      const bool last_frame_due = options_.duration_s > 0.0 &&
+                                  elapsed_s + 2.0 * std::max(dt_s, 0.001) >= options_.duration_s;
+      const bool screenshot_due =
+          !options_.screenshot.empty() && (last_frame_due || screenshot_requested_);
+      // The panels too, or the 3D view alone over the panels' pixels of an earlier frame.
+      input_.panel_left_px = control_width();
+      input_.panel_right_px = data_width();
+      const ImGuiIO& io = ImGui::GetIO();
+      // ImGui settles its windows' layout over its first frames: those draw the panels too.
+      const bool whole =
+          !presenter_ || !panels_ || stats_.whole_frames < 3 || first_due || screenshot_due ||
+          panel_refresh_.due(elapsed_s, io.WantCaptureMouse || io.WantCaptureKeyboard);
+      if (whole) {
+        // The whole back buffer, in the panels' colour: they are drawn without a background of
+        // their own (ImGuiWindowFlags_NoBackground), since on a software rasteriser blending a
+        // textured quad over 650×720 pixels cost ~5 ms of its CPU a frame; a clear costs next to
+        // nothing.
+        glViewport(0, 0, fb_w, fb_h);
+        const ImVec4 panel = ImGui::GetStyle().Colors[ImGuiCol_WindowBg];
+        glClearColor(panel.x, panel.y, panel.z, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      }
+      // The renderer clears its own viewport.
       draw_stereo(*renderer_, session_->render_scene(), camera_, stereo_, options_.eye_separation_m,
                   v.x, v.y, v.w, v.h);
-      draw_panels();
+      if (whole) {
+        draw_panels();
+        panel_refresh_.drawn(elapsed_s);
+        ++stats_.whole_frames;
+      }
       const double draw_ms = std::chrono::duration<double, std::milli>(Clock::now() - d0).count();
       draw_ms_sum += draw_ms;
-      if (!first_written && !options_.first_screenshot.empty() && stats_.frames >= 3) {
+      if (first_due) {
         write_png(options_.first_screenshot.string(), fb_w, fb_h, read_window(fb_w, fb_h));
         first_written = true;
       }
-      const bool last_frame_due = options_.duration_s > 0.0 &&
-                                  elapsed_s + 2.0 * std::max(dt_s, 0.001) >= options_.duration_s;
-      if (!options_.screenshot.empty() && (last_frame_due || screenshot_requested_)) {
+      if (screenshot_due) {
         last_frame = read_window(fb_w, fb_h);
         if (screenshot_requested_) {
           write_png(options_.screenshot.string(), fb_w, fb_h, last_frame);
           screenshot_requested_ = false;
         }
       }
-      glfwSwapBuffers(window_);
+      if (!presenter_) {
+        glfwSwapBuffers(window_);
+      } else if (whole) {
+        presenter_->present(0, 0, fb_w, fb_h);
+      } else {
+        presenter_->present(v.x, v.y, v.w, v.h);  // never a swap: the back buffer stays ours
+      }
 
       ++stats_.frames;
       if (stats_.frames > 1) {
@@ -673,6 +784,12 @@ class Viewer {
       std::printf("triangles    %zu drawn of %zu in the last frame (levels of detail)\n",
                   renderer_->last_frame_stats().triangles_drawn,
                   renderer_->last_frame_stats().triangles_full);
+      if (presenter_) {
+        std::printf(
+            "panels       drawn in %zu of %zu frames (at least %.3g a second; the others drew "
+            "and presented the 3D view alone)\n",
+            stats_.whole_frames, stats_.frames, options_.panel_refresh_hz);
+      }
       if (session_->runs_haptic_loop()) {
         std::printf(
             "haptic       %.2f Hz (%s), period jitter p50 %.1f us, p99 %.1f us, max %.1f "
@@ -711,6 +828,9 @@ class Viewer {
       j["window"] = {options_.width_px, options_.height_px};
       j["msaa_samples"] = options_.msaa_samples;
       j["panels"] = panels_;
+      // Frames that drew the panels; the others drew the 3D view alone (ui/panel_refresh.h).
+      j["partial_redraw"] = presenter_.has_value();
+      j["panel_frames"] = presenter_ ? stats_.whole_frames : stats_.frames;
       j["haptic"] = {{"rate_hz", st.rate_hz},
                      {"cycles", st.cycles},
                      {"scheduling", st.realtime_priority ? "SCHED_FIFO" : "normal"},
@@ -750,6 +870,9 @@ class Viewer {
   MouseProbe probe_{Vec3::Zero()};
   ForceGraph forces_;
   InputState input_;
+  /// Present without swapping, to redraw the 3D view alone (software rasteriser only).
+  std::optional<SubBufferPresenter> presenter_;
+  PanelRefresh panel_refresh_;
   FrameStats stats_;
   double cursor_x_ = 0.0;
   double cursor_y_ = 0.0;

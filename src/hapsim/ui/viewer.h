@@ -32,6 +32,10 @@ struct ViewerOptions {
   int msaa_samples = 0;
   /// Show the control and data areas (Tab toggles them): off gives the 3D view the window.
   bool panels = true;
+  /// On a software rasteriser, redraw the panels at least this often while nothing happens on
+  /// them, and in the frames between draw and present the 3D view alone (ui/panel_refresh.h);
+  /// 0 draws them every frame. On a GPU they are drawn every frame.
+  double panel_refresh_hz = 20.0;
   /// Stereo 3D view (render/stereo.h; the V key cycles off / side by side / anaglyph) and the
   /// eyes' separation in metres (0: a thirtieth of the view distance).
   StereoMode stereo = StereoMode::kOff;

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# The viewer's partial frames under a virtual X display: the knee palpation on the scripted device
+# with the panels redrawn at most every 5 s, so between them the viewer draws and presents the 3D
+# view alone. Two grabs of what the X server shows, a second apart, and the viewer's JSON.
+# Usage: viewer_partial_frames.sh HAPSIM_BIN GRAB_BIN SCENE OUT_DIR   (run inside xvfb-run)
+set -euo pipefail
+bin="$1" grab="$2" scene="$3" out="$4"
+mkdir -p "$out"
+"$bin" view "$scene" --device sim --duration 6 --size 1280x720 --no-vsync --panels-hz 0.2 \
+  --json "$out/view.json" > "$out/view.log" 2>&1 &
+viewer=$!
+window=$(xdotool search --sync --onlyvisible --name hapsim | head -n 1)
+# The pointer over the 3D view, where it does not ask the panels to be redrawn.
+xdotool mousemove --window "$window" 640 360
+sleep 2.5
+"$grab" "$out/grab1.png"
+sleep 1
+"$grab" "$out/grab2.png"
+wait "$viewer"
