@@ -7,12 +7,18 @@ set -euo pipefail
 bin="$1" grab="$2" scene="$3" out="$4"
 mkdir -p "$out"
 "$bin" view "$scene" --device sim --duration 6 --size 1280x720 --no-vsync --panels-hz 0.2 \
-  --json "$out/view.json" > "$out/view.log" 2>&1 &
+  --first-screenshot "$out/first.png" --json "$out/view.json" > "$out/view.log" 2>&1 &
 viewer=$!
 window=$(xdotool search --sync --onlyvisible --name hapsim | head -n 1)
 # The pointer over the 3D view, where it does not ask the panels to be redrawn.
 xdotool mousemove --window "$window" 640 360
-sleep 2.5
+# The window opens before the scene is loaded: wait for the viewer's third frame (its first
+# screenshot), however long a loaded machine takes to get there.
+for _ in $(seq 1 300); do
+  [[ -s "$out/first.png" ]] && break
+  sleep 0.1
+done
+sleep 1
 "$grab" "$out/grab1.png"
 sleep 1
 "$grab" "$out/grab2.png"

@@ -75,4 +75,15 @@ std::vector<LodLevel> build_lod_levels(const TriangleMesh& mesh, const LodBuildO
   return levels;
 }
 
+std::vector<TriangleIndices> vertex_cache_order(std::span<const TriangleIndices> triangles,
+                                                std::size_t vertex_count) {
+  static_assert(sizeof(TriangleIndices) == 3 * sizeof(unsigned), "triangles are 3 indices");
+  std::vector<TriangleIndices> out(triangles.size());
+  // meshoptimizer reads and writes flat index lists; a triangle's three stay in their order.
+  meshopt_optimizeVertexCache(reinterpret_cast<unsigned*>(out.data()),
+                              reinterpret_cast<const unsigned*>(triangles.data()),
+                              3 * triangles.size(), vertex_count);
+  return out;
+}
+
 }  // namespace hapsim

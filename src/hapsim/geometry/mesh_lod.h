@@ -9,6 +9,7 @@
 #include "hapsim/geometry/triangle_mesh.h"
 
 #include <cstddef>
+#include <span>
 #include <vector>
 
 namespace hapsim {
@@ -41,5 +42,12 @@ struct LodBuildOptions {
 /// empty for a small mesh. Open meshes keep their border vertices (no gaps open at a cut).
 [[nodiscard]] std::vector<LodLevel> build_lod_levels(const TriangleMesh& mesh,
                                                      const LodBuildOptions& options = {});
+
+/// The same triangles, each with its own winding, in an order that reuses recently shaded
+/// vertices (meshoptimizer's vertex cache optimiser), for drawing the full mesh: a software
+/// rasteriser shades a vertex once per batch it appears in. The levels above are already so
+/// ordered. Precondition: every index is below `vertex_count`.
+[[nodiscard]] std::vector<TriangleIndices> vertex_cache_order(
+    std::span<const TriangleIndices> triangles, std::size_t vertex_count);
 
 }  // namespace hapsim

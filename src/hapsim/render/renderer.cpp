@@ -1,6 +1,7 @@
 #include "hapsim/render/renderer.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/geometry/mesh_lod.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/render/gl_api.h"
 #include "hapsim/render/lod_selection.h"
@@ -310,9 +311,11 @@ struct Renderer::Impl {
       glBufferData(GL_ELEMENT_ARRAY_BUFFER,
                    static_cast<GLsizeiptr>(triangles * sizeof(TriangleIndices)), nullptr,
                    GL_STATIC_DRAW);
+      // The full mesh reordered for vertex reuse (its coarser levels already are): llvmpipe shades
+      // a vertex again in every batch it appears in. Once per topology, not per frame.
+      const std::vector<TriangleIndices> full = vertex_cache_order(geometry.triangles, n);
       glBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0,
-                      static_cast<GLsizeiptr>(geometry.triangles.size() * sizeof(TriangleIndices)),
-                      geometry.triangles.data());
+                      static_cast<GLsizeiptr>(full.size() * sizeof(TriangleIndices)), full.data());
       for (std::size_t i = 0; i < levels.size(); ++i) {
         glBufferSubData(
             GL_ELEMENT_ARRAY_BUFFER,
