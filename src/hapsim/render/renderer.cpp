@@ -19,9 +19,11 @@ namespace {
 
 constexpr const char* kWhere = "Renderer";
 
-// Lit geometry: Gouraud shading, i.e. the lighting equation runs here, per vertex, for both faces
-// (gl_FrontFacing picks one in the fragment shader). Camera frame (C): x right, y up, z back.
-constexpr const char* kLitVertex = R"(#version 330 core
+// Lit geometry: Gouraud shading, i.e. the lighting equation runs here, per vertex; for both faces
+// where TWO_SIDED is 1 (gl_FrontFacing picks one in the fragment shader). Camera frame (C): x
+// right, y up, z back. Compiled twice (kLitTwoSided, kLitOneSided): a uniform choice would not save
+// the second shading on llvmpipe, which evaluates both sides of a select.
+constexpr const char* kLitVertexBody = R"(
 layout(location = 0) in vec3 a_position_M;
 layout(location = 1) in vec3 a_normal_M;
 layout(location = 2) in vec3 a_colour;
@@ -36,7 +38,6 @@ uniform vec3 u_ambient;
 uniform float u_specular;
 uniform float u_shininess;
 uniform float u_point_size;
-uniform bool u_two_sided;
 out vec3 v_front_colour;
 out vec3 v_back_colour;
 
@@ -61,8 +62,11 @@ void main() {
   vec3 n_camera = dot(n, n) > 0.0 ? normalize(n) : to_eye_camera;
   vec3 base = u_use_vertex_colour ? a_colour : u_colour;
   v_front_colour = shade(n_camera, to_eye_camera, base);
-  // A closed mesh's back faces are culled: its back side needs no lighting.
-  v_back_colour = u_two_sided ? shade(-n_camera, to_eye_camera, base) : v_front_colour;
+#if TWO_SIDED
+  v_back_colour = shade(-n_camera, to_eye_camera, base);
+#else
+  v_back_colour = v_front_colour;  // a closed mesh's back faces are culled: no back to light
+#endif
   gl_Position = u_projection * p_camera;
   gl_PointSize = u_point_size;
 }
@@ -243,16 +247,24 @@ struct GpuMesh {
 struct LitUniforms {
   GLint model_view = -1, projection = -1, colour = -1, use_vertex_colour = -1, light_count = -1,
         light_dir = -1, light_colour = -1, ambient = -1, specular = -1, shininess = -1,
-        point_size = -1, opacity = -1, two_sided = -1;
+        point_size = -1, opacity = -1;
+};
+
+// One of the lit program's two variants with its uniforms' locations.
+struct LitProgram {
+  GLuint id = 0;
+  LitUniforms u;
 };
 
 }  // namespace
 
 struct Renderer::Impl {
-  GLuint lit = 0;
+  // Both faces lit (open sheets and cut meshes, points, lines, spheres), and front faces only
+  // (closed meshes drawn as faces, back faces culled: half the vertex shading).
+  LitProgram lit_two_sided;
+  LitProgram lit_one_sided;
   GLuint unlit = 0;
   GLuint floor = 0;
-  LitUniforms lit_u;
   GLint unlit_view_projection = -1;
   GLint floor_view_projection = -1, floor_cell = -1, floor_origin = -1, floor_colour_a = -1,
         floor_colour_b = -1;
@@ -356,7 +368,8 @@ struct Renderer::Impl {
                                    static_cast<float>(p_world.z()), c.x(), c.y(), c.z()});
   }
 
-  void set_lit_lighting(const Lighting& lighting, const Eigen::Matrix3d& R_CW) {
+  static void set_lit_lighting(const LitUniforms& lit_u, const Lighting& lighting,
+                               const Eigen::Matrix3d& R_CW) {
     constexpr auto kSlots = 3 * static_cast<std::size_t>(Lighting::kMaxLights);
     std::array<float, kSlots> dirs{};
     std::array<float, kSlots> colours{};
@@ -395,25 +408,32 @@ Renderer::Renderer() : impl_(std::make_unique<Impl>()) {
                             reinterpret_cast<const char*>(version));
   }
   Impl& s = *impl_;
-  s.lit = link_program(kLitVertex, kLitFragment, "lit");
-  s.unlit = link_program(kUnlitVertex, kUnlitFragment, "unlit");
-  s.floor = link_program(kFloorVertex, kFloorFragment, "floor");
   const auto loc = [](GLuint program, const char* name) {
     return glGetUniformLocation(program, name);
   };
-  s.lit_u.model_view = loc(s.lit, "u_model_view");
-  s.lit_u.projection = loc(s.lit, "u_projection");
-  s.lit_u.colour = loc(s.lit, "u_colour");
-  s.lit_u.opacity = loc(s.lit, "u_opacity");
-  s.lit_u.use_vertex_colour = loc(s.lit, "u_use_vertex_colour");
-  s.lit_u.light_count = loc(s.lit, "u_light_count");
-  s.lit_u.light_dir = loc(s.lit, "u_light_dir_camera");
-  s.lit_u.light_colour = loc(s.lit, "u_light_colour");
-  s.lit_u.ambient = loc(s.lit, "u_ambient");
-  s.lit_u.specular = loc(s.lit, "u_specular");
-  s.lit_u.shininess = loc(s.lit, "u_shininess");
-  s.lit_u.point_size = loc(s.lit, "u_point_size");
-  s.lit_u.two_sided = loc(s.lit, "u_two_sided");
+  const auto make_lit = [&](bool two_sided) {
+    const std::string vertex = std::string("#version 330 core\n#define TWO_SIDED ") +
+                               (two_sided ? "1" : "0") + kLitVertexBody;
+    LitProgram p;
+    p.id = link_program(vertex.c_str(), kLitFragment, two_sided ? "lit" : "lit (one-sided)");
+    p.u.model_view = loc(p.id, "u_model_view");
+    p.u.projection = loc(p.id, "u_projection");
+    p.u.colour = loc(p.id, "u_colour");
+    p.u.opacity = loc(p.id, "u_opacity");
+    p.u.use_vertex_colour = loc(p.id, "u_use_vertex_colour");
+    p.u.light_count = loc(p.id, "u_light_count");
+    p.u.light_dir = loc(p.id, "u_light_dir_camera");
+    p.u.light_colour = loc(p.id, "u_light_colour");
+    p.u.ambient = loc(p.id, "u_ambient");
+    p.u.specular = loc(p.id, "u_specular");
+    p.u.shininess = loc(p.id, "u_shininess");
+    p.u.point_size = loc(p.id, "u_point_size");
+    return p;
+  };
+  s.lit_two_sided = make_lit(true);
+  s.lit_one_sided = make_lit(false);
+  s.unlit = link_program(kUnlitVertex, kUnlitFragment, "unlit");
+  s.floor = link_program(kFloorVertex, kFloorFragment, "floor");
   s.unlit_view_projection = loc(s.unlit, "u_view_projection");
   s.floor_view_projection = loc(s.floor, "u_view_projection");
   s.floor_cell = loc(s.floor, "u_cell_m");
@@ -463,7 +483,8 @@ Renderer::~Renderer() {
   s.tube.destroy();
   glDeleteBuffers(1, &s.stream_vbo);
   glDeleteVertexArrays(1, &s.stream_vao);
-  glDeleteProgram(s.lit);
+  glDeleteProgram(s.lit_two_sided.id);
+  glDeleteProgram(s.lit_one_sided.id);
   glDeleteProgram(s.unlit);
   glDeleteProgram(s.floor);
 }
@@ -605,40 +626,49 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
     glDrawArrays(GL_TRIANGLES, marks_first, segments_first - marks_first);
   }
 
-  // Meshes and spheres: lit.
-  glUseProgram(s.lit);
-  set_matrix(s.lit_u.projection, projection);
-  s.set_lit_lighting(scene.lighting, X_camera_world.topLeftCorner<3, 3>());
-  glUniform1f(s.lit_u.point_size, style.point_size_px);
+  // Meshes and spheres: lit. The frame's uniforms on both variants.
+  for (const LitProgram* p : {&s.lit_one_sided, &s.lit_two_sided}) {
+    glUseProgram(p->id);
+    set_matrix(p->u.projection, projection);
+    Impl::set_lit_lighting(p->u, scene.lighting, X_camera_world.topLeftCorner<3, 3>());
+    glUniform1f(p->u.point_size, style.point_size_px);
+    glUniform1f(p->u.opacity, 1.0f);
+  }
+  const LitUniforms& lit_u = s.lit_two_sided.u;  // in use from here on, but for closed meshes
   const float line_width = std::clamp(style.line_width_px, 1.0f, s.max_line_width);
   glLineWidth(line_width);
-  glUniform1f(s.lit_u.opacity, 1.0f);
-  glUniform1i(s.lit_u.two_sided, 1);
   // Opaque meshes first; see-through ones (opacity < 1) last, blended, not writing depth.
   const Vec3 eye_world = camera.eye_world();
   const auto draw_meshes = [&](bool translucent) {
+    GLuint in_use = 0;
     for (MeshId id = 0; id < scene.mesh_count(); ++id) {
       const RenderMesh& m = scene.mesh(id);
       GpuMesh& gpu = s.meshes[id];
       if (!m.visible || gpu.vertex_count == 0 || (m.opacity < 1.0f) != translucent) {
         continue;
       }
-      glUniform1f(s.lit_u.opacity, m.opacity);
-      // Faces of a closed surface: its back faces culled (points and lines keep every one).
+      // Faces of a closed surface: its back faces culled and left unlit (points and lines keep
+      // every one).
       const bool cull = m.closed() && style.display_mode == DisplayMode::kFaces;
       if (cull) {
         glEnable(GL_CULL_FACE);
       } else {
         glDisable(GL_CULL_FACE);
       }
-      glUniform1i(s.lit_u.two_sided, cull ? 0 : 1);
-      set_matrix(s.lit_u.model_view, (X_camera_world * m.X_world_mesh.matrix()).cast<float>());
+      const LitProgram& program = cull ? s.lit_one_sided : s.lit_two_sided;
+      if (program.id != in_use) {
+        glUseProgram(program.id);
+        in_use = program.id;
+      }
+      const LitUniforms& u = program.u;
+      glUniform1f(u.opacity, m.opacity);
+      set_matrix(u.model_view, (X_camera_world * m.X_world_mesh.matrix()).cast<float>());
       const bool vertex_colours =
           style.colour_mode == ColourMode::kVertexColours && gpu.has_vertex_colours;
-      glUniform1i(s.lit_u.use_vertex_colour, vertex_colours ? 1 : 0);
-      set_vec3(s.lit_u.colour, style.colour_mode == ColourMode::kPalette
-                                   ? palette_colour(static_cast<int>(id))
-                                   : m.colour);
+      glUniform1i(u.use_vertex_colour, vertex_colours ? 1 : 0);
+      set_vec3(u.colour, style.colour_mode == ColourMode::kPalette
+                             ? palette_colour(static_cast<int>(id))
+                             : m.colour);
       // The level of detail: by the error it would show where the mesh comes nearest the eye.
       std::size_t level = 0;
       if (style.level_of_detail && gpu.level_error_m.size() > 1) {
@@ -671,19 +701,19 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
           break;
       }
     }
-    glUniform1f(s.lit_u.opacity, 1.0f);
-    glUniform1i(s.lit_u.two_sided, 1);
+    glUseProgram(s.lit_two_sided.id);
+    glUniform1f(lit_u.opacity, 1.0f);
     glDisable(GL_CULL_FACE);
   };
   draw_meshes(false);
 
-  glUniform1i(s.lit_u.use_vertex_colour, 0);
+  glUniform1i(lit_u.use_vertex_colour, 0);
   const auto draw_sphere = [&](const Vec3& centre_world, double radius_m, const Vec3f& colour) {
     Eigen::Matrix4d X_world_sphere = Eigen::Matrix4d::Identity();
     X_world_sphere.topLeftCorner<3, 3>() *= radius_m;
     X_world_sphere.topRightCorner<3, 1>() = centre_world;
-    set_matrix(s.lit_u.model_view, (X_camera_world * X_world_sphere).cast<float>());
-    set_vec3(s.lit_u.colour, colour);
+    set_matrix(lit_u.model_view, (X_camera_world * X_world_sphere).cast<float>());
+    set_vec3(lit_u.colour, colour);
     glDrawElements(GL_TRIANGLES, s.sphere.index_count, GL_UNSIGNED_INT, nullptr);
   };
   if (!scene.spheres.empty() || !scene.capsules.empty()) {
@@ -719,8 +749,8 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
       X_world_tube.block<3, 1>(0, 1) = c.radius_m * y;
       X_world_tube.block<3, 1>(0, 2) = axis;
       X_world_tube.topRightCorner<3, 1>() = c.a_world;
-      set_matrix(s.lit_u.model_view, (X_camera_world * X_world_tube).cast<float>());
-      set_vec3(s.lit_u.colour, c.colour);
+      set_matrix(lit_u.model_view, (X_camera_world * X_world_tube).cast<float>());
+      set_vec3(lit_u.colour, c.colour);
       glDrawElements(GL_TRIANGLES, s.tube.index_count, GL_UNSIGNED_INT, nullptr);
     }
   }
@@ -730,7 +760,6 @@ void Renderer::draw_in(const RenderScene& scene, const OrbitCamera& camera, int 
     glBindVertexArray(s.stream_vao);
     glDrawArrays(GL_LINES, segments_first, stream_end - segments_first);
   }
-  glUseProgram(s.lit);
   glEnable(GL_BLEND);
   glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
   glDepthMask(GL_FALSE);
