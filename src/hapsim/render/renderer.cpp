@@ -174,8 +174,8 @@ constexpr int kUnlitFloats = 6;
 
 const void* byte_offset(std::size_t floats) {
   // GL's buffer-offset idiom: the "pointer" is a byte offset into the bound buffer.
-  return reinterpret_cast<const void*>(floats *
-                                       sizeof(float));  // NOLINT(performance-no-int-to-ptr)
+  // NOLINTNEXTLINE(performance-no-int-to-ptr)
+  return reinterpret_cast<const void*>(floats * sizeof(float));
 }
 
 static_assert(sizeof(TriangleIndices) == 3 * sizeof(std::uint32_t), "indices upload as is");
