@@ -13,7 +13,9 @@
 
 #include <cstddef>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -52,21 +54,41 @@ std::vector<std::uint8_t> columns(const RgbaImage& image, int x0, int width) {
   return c;
 }
 
+// A viewer script of tests/apps run under a virtual display: `SCRIPT HAPSIM_BIN ARGS OUT`, which
+// leaves the viewer's log and JSON in OUT.
+struct ScriptedView {
+  int status = -1;
+  std::string log;
+  std::optional<nlohmann::json> json;
+};
+
+ScriptedView run_view_script(const std::string& script, const std::string& args,
+                             const std::filesystem::path& out) {
+  const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' bash ") +
+                          HAPSIM_SOURCE_DIR + "/tests/apps/" + script + " " + HAPSIM_BIN_PATH +
+                          " " + args + " " + out.string();
+  ScriptedView v;
+  v.status = std::system(cmd.c_str());
+  std::ifstream log(out / "view.log");
+  v.log.assign(std::istreambuf_iterator<char>(log), {});
+  std::ifstream in(out / "view.json");
+  if (in) {
+    v.json = nlohmann::json::parse(in);
+  }
+  return v;
+}
+
 TEST(ViewCommand, MouseProbeUnderXvfbDentsTheKneeAndShowsTheForce) {
   if (!have("xvfb-run") || !have("xdotool")) {
     GTEST_SKIP() << "xvfb-run or xdotool missing (scripts/setup.sh installs both)";
   }
   const auto out = test::temp_path("viewer");
-  const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' bash ") +
-                          HAPSIM_SOURCE_DIR + "/tests/apps/viewer_smoke.sh " + HAPSIM_BIN_PATH +
-                          " " + HAPSIM_SCENES_DIR + "/knee_procedural.json " + out.string();
-  const int status = std::system(cmd.c_str());
-  std::ifstream log(out / "view.log");
-  const std::string log_text((std::istreambuf_iterator<char>(log)), {});
-  ASSERT_EQ(status, 0) << log_text;
-  std::ifstream in(out / "view.json");
-  ASSERT_TRUE(in) << log_text;
-  const nlohmann::json j = nlohmann::json::parse(in);
+  const ScriptedView v = run_view_script(
+      "viewer_smoke.sh", std::string(HAPSIM_SCENES_DIR) + "/knee_procedural.json", out);
+  ASSERT_EQ(v.status, 0) << v.log;
+  ASSERT_TRUE(v.json) << v.log;
+  const nlohmann::json& j = *v.json;
+  const std::string& log_text = v.log;
   EXPECT_TRUE(j["ok"].get<bool>());
   EXPECT_GT(j["frames"].get<int>(), 20);
   EXPECT_GT(j["peak_force_n"][0].get<double>(), 0.1) << "the probe never pressed: " << log_text;
@@ -98,17 +120,13 @@ TEST(ViewCommand, FramesWithoutThePanelsKeepThemOnTheWindowAndShowTheSceneMoving
     GTEST_SKIP() << "xvfb-run or xdotool missing (scripts/setup.sh installs both)";
   }
   const auto out = test::temp_path("viewer_partial");
-  const std::string cmd = std::string("xvfb-run -a -s '-screen 0 1280x720x24' bash ") +
-                          HAPSIM_SOURCE_DIR + "/tests/apps/viewer_partial_frames.sh " +
-                          HAPSIM_BIN_PATH + " " + HAPSIM_X11_GRAB_PATH + " " + HAPSIM_SCENES_DIR +
-                          "/knee_procedural.json " + out.string();
-  const int status = std::system(cmd.c_str());
-  std::ifstream log(out / "view.log");
-  const std::string log_text((std::istreambuf_iterator<char>(log)), {});
-  ASSERT_EQ(status, 0) << log_text;
-  std::ifstream in(out / "view.json");
-  ASSERT_TRUE(in) << log_text;
-  const nlohmann::json j = nlohmann::json::parse(in);
+  const ScriptedView v = run_view_script(
+      "viewer_partial_frames.sh",
+      std::string(HAPSIM_X11_GRAB_PATH) + " " + HAPSIM_SCENES_DIR + "/knee_procedural.json", out);
+  ASSERT_EQ(v.status, 0) << v.log;
+  ASSERT_TRUE(v.json) << v.log;
+  const nlohmann::json& j = *v.json;
+  const std::string& log_text = v.log;
   if (!j["partial_redraw"].get<bool>()) {
     GTEST_SKIP() << "not a software rasteriser with GLX_MESA_copy_sub_buffer here: the viewer "
                     "draws its panels every frame ("
