@@ -21,8 +21,8 @@ constexpr const char* kWhere = "Renderer";
 
 // Lit geometry: Gouraud shading, i.e. the lighting equation runs here, per vertex; for both faces
 // where TWO_SIDED is 1 (gl_FrontFacing picks one in the fragment shader). Camera frame (C): x
-// right, y up, z back. Compiled twice (kLitTwoSided, kLitOneSided): a uniform choice would not save
-// the second shading on llvmpipe, which evaluates both sides of a select.
+// right, y up, z back. Compiled twice (Impl::lit_two_sided, Impl::lit_one_sided): a uniform choice
+// would not save the second shading on llvmpipe, which evaluates both sides of a select.
 constexpr const char* kLitVertexBody = R"(
 layout(location = 0) in vec3 a_position_M;
 layout(location = 1) in vec3 a_normal_M;
