@@ -1,6 +1,7 @@
 #include "hapsim/render/offscreen_context.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/leak_check.h"
 #include "hapsim/render/gl_api.h"
 
 // No X11 types in the EGL headers: this context never talks to a display server.
@@ -167,6 +168,7 @@ OffscreenContext::OffscreenContext(int width_px, int height_px, int samples)
       throw Error(kWhere,
                   "EGL: cannot make the surfaceless context current (" + egl_error_text() + ")");
     }
+    keep_libraries_mapped_for_leak_check();  // Mesa's driver is loaded by now
 
     GLint max_samples = 1;
     glGetIntegerv(GL_MAX_SAMPLES, &max_samples);

@@ -1,6 +1,7 @@
 #include "hapsim/ui/viewer.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/leak_check.h"
 #include "hapsim/core/statistics.h"
 #include "hapsim/device/interactive_device.h"
 #include "hapsim/render/camera.h"
@@ -209,6 +210,7 @@ class Viewer {
     stereo_ = options.stereo;
     renderer_ = std::make_unique<Renderer>();
     gl_version_ = renderer_->gl_version();
+    keep_libraries_mapped_for_leak_check();  // Mesa's driver is loaded by now
     if (options.panel_refresh_hz > 0.0 && software_rasteriser()) {
       presenter_ = SubBufferPresenter::for_current_context();
     }

@@ -1,0 +1,43 @@
+#include "hapsim/core/leak_check.h"
+
+#include <dlfcn.h>
+#include <link.h>
+
+#include <cstddef>
+
+#if defined(__SANITIZE_ADDRESS__)
+#define HAPSIM_LEAK_CHECKED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(leak_sanitizer)
+#define HAPSIM_LEAK_CHECKED 1
+#endif
+#endif
+
+namespace hapsim {
+
+void keep_libraries_mapped_for_leak_check() {
+#if defined(HAPSIM_LEAK_CHECKED)
+  dl_iterate_phdr(
+      [](dl_phdr_info* info, std::size_t /*size*/, void* /*data*/) -> int {
+        if (info->dlpi_name != nullptr && info->dlpi_name[0] != '\0') {
+          // RTLD_NOLOAD: only what is mapped already; RTLD_NODELETE: later dlclose()s keep it.
+          void* handle = dlopen(info->dlpi_name, RTLD_LAZY | RTLD_NOLOAD | RTLD_NODELETE);
+          if (handle != nullptr) {
+            dlclose(handle);  // our reference only; the library stays mapped
+          }
+        }
+        return 0;
+      },
+      nullptr);
+#endif
+}
+
+bool built_with_leak_checks() {
+#if defined(HAPSIM_LEAK_CHECKED)
+  return true;
+#else
+  return false;
+#endif
+}
+
+}  // namespace hapsim
