@@ -12,23 +12,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
 namespace hapsim::bench {
 namespace {
-
-std::size_t status_kb(const char* key) {
-  std::ifstream in("/proc/self/status");
-  std::string line;
-  const std::string prefix = std::string(key) + ":";
-  while (std::getline(in, line)) {
-    if (line.rfind(prefix, 0) == 0) {
-      return static_cast<std::size_t>(std::strtoull(line.c_str() + prefix.size(), nullptr, 10));
-    }
-  }
-  return 0;
-}
 
 // Every channel a command carries: the tip force, the finger forces, the joint torques.
 constexpr std::size_t kChannels = 3 + kMaxFingers + kMaxDeviceJoints;
@@ -50,12 +39,21 @@ Channels channels(const DeviceCommand& c) {
 
 }  // namespace
 
-std::size_t peak_rss_bytes() {
-  return status_kb("VmHWM") * 1024;
-}
-
-std::size_t current_rss_bytes() {
-  return status_kb("VmRSS") * 1024;
+ProcessMemory process_memory() {
+  std::ifstream in("/proc/self/status");
+  ProcessMemory m;
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto kb = [&line](const char* key) {
+      return static_cast<std::size_t>(std::strtoull(line.c_str() + std::strlen(key), nullptr, 10));
+    };
+    if (line.rfind("VmHWM:", 0) == 0) {
+      m.peak_rss_bytes = kb("VmHWM:") * 1024;
+    } else if (line.rfind("VmRSS:", 0) == 0) {
+      m.rss_bytes = kb("VmRSS:") * 1024;
+    }
+  }
+  return m;
 }
 
 SoakResult run_soak(const SoakOptions& options) {
@@ -121,7 +119,8 @@ SoakResult run_soak(const SoakOptions& options) {
     }
     if (step_us.size() == minute_steps || k + 1 == total_steps) {
       const SampleSummary s = summarize_samples(step_us);
-      result.minutes.push_back({s.p50, s.p99, s.max, peak_rss_bytes(), current_rss_bytes()});
+      const ProcessMemory memory = process_memory();
+      result.minutes.push_back({s.p50, s.p99, s.max, memory.peak_rss_bytes, memory.rss_bytes});
       step_us.clear();
       report_progress(options.progress, result.scene,
                       static_cast<double>(k + 1) / static_cast<double>(total_steps));

@@ -62,7 +62,12 @@ struct SoakResult {
 
 /// This process's peak and current resident set (VmHWM, VmRSS in /proc/self/status), bytes; 0
 /// where unknown.
-[[nodiscard]] std::size_t peak_rss_bytes();
-[[nodiscard]] std::size_t current_rss_bytes();
+struct ProcessMemory {
+  std::size_t peak_rss_bytes = 0;
+  std::size_t rss_bytes = 0;
+};
+/// Both from one read of /proc/self/status: the kernel computes them from the same count, so the
+/// peak is never below the current. (Two reads apart saw the set grow in between under ASan.)
+[[nodiscard]] ProcessMemory process_memory();
 
 }  // namespace hapsim::bench

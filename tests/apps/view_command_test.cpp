@@ -110,7 +110,7 @@ TEST(ViewCommand, MouseProbeUnderXvfbDentsTheKneeAndShowsTheForce) {
 // Between panel frames the viewer draws and presents the 3D view alone (ui/panel_refresh.h), on a
 // software rasteriser. What the X server shows (not the viewer's own read-back) must keep the
 // panels and follow the scene: two grabs of the screen a second apart, the panels redrawn at most
-// every 5 s, the palpation moving the fingertip. The 3D view moved; the control panel is drawn and
+// every 20 s, the palpation moving the fingertip. The 3D view moved; the control panel is drawn and
 // unchanged.
 TEST(ViewCommand, FramesWithoutThePanelsKeepThemOnTheWindowAndShowTheSceneMoving) {
 #ifndef HAPSIM_X11_GRAB_PATH
@@ -132,7 +132,12 @@ TEST(ViewCommand, FramesWithoutThePanelsKeepThemOnTheWindowAndShowTheSceneMoving
                     "draws its panels every frame ("
                  << j["renderer"].get<std::string>() << ")";
   }
-  EXPECT_LT(4 * j["panel_frames"].get<int>(), j["frames"].get<int>()) << log_text;
+  // Whatever the machine's speed (a Debug ASan build draws 2-3 frames a second): the panels were
+  // drawn only in the frames that must draw them (ImGui's three settling frames, the first
+  // screenshot, the Escape key's, at most one 20 s refresh), and other frames drew the 3D view
+  // alone.
+  EXPECT_LE(j["panel_frames"].get<int>(), 6) << log_text;
+  EXPECT_GE(j["frames"].get<int>() - j["panel_frames"].get<int>(), 2) << log_text;
 
   const RgbaImage a = read_png((out / "grab1.png").string());
   const RgbaImage b = read_png((out / "grab2.png").string());

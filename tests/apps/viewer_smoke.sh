@@ -15,6 +15,12 @@ window=$(xdotool search --sync --onlyvisible --name hapsim | head -n 1)
 xdotool windowactivate --sync "$window" 2>/dev/null || true
 sleep 1.5
 xdotool mousemove --window "$window" 640 330
+# The window opens before the scene is loaded: wait for the viewer's third frame (its first
+# screenshot, taken before the probe moves), however long a loaded machine takes to get there.
+for _ in $(seq 1 1200); do
+  [[ -s "$out/first.png" ]] && break
+  sleep 0.1
+done
 # Wheel up = push the probe away from the viewer, into the knee (2 mm a step).
 xdotool click --repeat 34 --delay 40 4
 sleep 1

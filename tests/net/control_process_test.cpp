@@ -29,6 +29,9 @@ using Clock = std::chrono::steady_clock;
 
 constexpr dds_domainid_t kDomain = 80;
 const std::string kNet = " --session control-test --domain 80";
+// How long a control command waits for serve's answer: a bound on a hang, not a time asserted (the
+// default 5 s was too short for a material change under a Debug ASan build).
+const std::string kControl = kNet + " --timeout 60";
 const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/csg_block.json";
 
 // What a viewer would see over `window`: the served world's times, and the models served.
@@ -86,7 +89,7 @@ TEST(ControlProcess, PausesResumesResetsAndRetunesAServedWorld) {
   EXPECT_GT(running.last_time_s, running.first_time_s);
   EXPECT_EQ(running.views_paused, 0u);
 
-  const hapsim::test::RunResult pause = hapsim::test::run_hapsim("control pause" + kNet);
+  const hapsim::test::RunResult pause = hapsim::test::run_hapsim("control pause" + kControl);
   ASSERT_EQ(pause.exit_code, 0) << pause.output << serve.output();
   EXPECT_NE(pause.output.find("is paused"), std::string::npos) << pause.output;
   EXPECT_TRUE(serve.wait_for("command      pause from", std::chrono::seconds(2)));
@@ -98,21 +101,21 @@ TEST(ControlProcess, PausesResumesResetsAndRetunesAServedWorld) {
   EXPECT_GT(paused.models, 100u);                      // still served at the loop's rate...
   EXPECT_EQ(paused.valid_models, 0u);                  // ... as free space: no force
 
-  const hapsim::test::RunResult resume = hapsim::test::run_hapsim("control resume" + kNet);
+  const hapsim::test::RunResult resume = hapsim::test::run_hapsim("control resume" + kControl);
   ASSERT_EQ(resume.exit_code, 0) << resume.output;
   EXPECT_NE(resume.output.find("is running"), std::string::npos) << resume.output;
   const Observed resumed = observe(views, models, std::chrono::milliseconds(300));
   EXPECT_GT(resumed.last_time_s, resumed.first_time_s);
   EXPECT_GE(resumed.first_time_s, paused.last_time_s);  // it goes on from where it stood
 
-  const hapsim::test::RunResult reset = hapsim::test::run_hapsim("control reset" + kNet);
+  const hapsim::test::RunResult reset = hapsim::test::run_hapsim("control reset" + kControl);
   ASSERT_EQ(reset.exit_code, 0) << reset.output;
   const Observed after_reset = observe(views, models, std::chrono::milliseconds(200));
   EXPECT_LT(after_reset.first_time_s, resumed.last_time_s);  // back at the scene's start
   EXPECT_LT(after_reset.first_time_s, 0.5);
 
-  const hapsim::test::RunResult material =
-      hapsim::test::run_hapsim("control material plastic --stiffness 800 --max-force 6.5" + kNet);
+  const hapsim::test::RunResult material = hapsim::test::run_hapsim(
+      "control material plastic --stiffness 800 --max-force 6.5" + kControl);
   ASSERT_EQ(material.exit_code, 0) << material.output;
   EXPECT_TRUE(serve.wait_for("plastic to k 800 N/m, max force 6.50 N", std::chrono::seconds(2)))
       << serve.output();
@@ -135,16 +138,16 @@ TEST(ControlProcess, PausesResumesResetsAndRetunesAServedWorld) {
   EXPECT_EQ(still_running.views_paused, 0u);
 
   // Bad requests: one line, exit 2, before (or without) touching the host.
-  const hapsim::test::RunResult typo = hapsim::test::run_hapsim("control pauze" + kNet);
+  const hapsim::test::RunResult typo = hapsim::test::run_hapsim("control pauze" + kControl);
   EXPECT_EQ(typo.exit_code, 2);
   EXPECT_NE(typo.output.find("expected pause, resume, reset or material"), std::string::npos);
   const hapsim::test::RunResult unknown =
-      hapsim::test::run_hapsim("control material bone --stiffness 10" + kNet);
+      hapsim::test::run_hapsim("control material bone --stiffness 10" + kControl);
   EXPECT_EQ(unknown.exit_code, 2);
   EXPECT_NE(unknown.output.find("has no such material (it has plastic)"), std::string::npos)
       << unknown.output;
   const hapsim::test::RunResult no_values =
-      hapsim::test::run_hapsim("control material plastic" + kNet);
+      hapsim::test::run_hapsim("control material plastic" + kControl);
   EXPECT_EQ(no_values.exit_code, 2);
   const hapsim::test::RunResult nobody =
       hapsim::test::run_hapsim("control pause --session nobody-here --domain 80 --timeout 0.5");

@@ -95,6 +95,9 @@ TEST(DeviceHostProcess, ServeSendsTheLegacyForcePacketEveryCycle) {
   const std::uint64_t valid = glove.count(LegacyPacketVerdict::kAccepted);
   // One packet per cycle (loopback drops none; a slow poll only merges them).
   EXPECT_GT(valid, 2000u);
+  if (const std::string why = test::serve_too_slow_for_real_time(serve.output()); !why.empty()) {
+    GTEST_SKIP() << why;
+  }
   // The glove palpation presses with the index and middle fingers (hapsim run: 2.14 and 2.61 N).
   const double step_n = 4.0 / 10'000.0;  // the packet's resolution at the glove's 4 N full scale
   EXPECT_NEAR(peak_n[1], 2.139, 0.02 * 2.139 + step_n);

@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <regex>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -21,6 +22,22 @@ inline ::testing::AssertionResult on_loopback_config() {
                                          << " (run through ctest), is " << (uri ? uri : "unset");
   }
   return ::testing::AssertionSuccess();
+}
+
+/// Why serve's forces cannot be compared with the one-process run's, or "" when they can. Serve
+/// keeps its 1 kHz only if its step fits the period; where the step alone takes over half of it (a
+/// Debug ASan build: p50 1.8 ms on the procedural knee) the loop is late every cycle, ramps the
+/// force after each gap, and renders something else. Read from serve's summary line
+/// "step cost: p50 X us"; a release build's step is a few microseconds.
+inline std::string serve_too_slow_for_real_time(const std::string& serve_output) {
+  static const std::regex kStepCost(R"(step cost: p50 ([0-9.]+) us)");
+  std::smatch m;
+  if (std::regex_search(serve_output, m, kStepCost) && std::stod(m[1].str()) > 500.0) {
+    return "serve's step takes " + m[1].str() +
+           " us (p50), over half its 1000 us period: this build cannot run the scene in real time "
+           "(a sanitizer or Debug build), so its forces are not the scene's";
+  }
+  return {};
 }
 
 inline constexpr std::uint64_t kSceneHash = 0x68617073696d2121ULL;

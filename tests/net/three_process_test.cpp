@@ -131,6 +131,9 @@ TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
     EXPECT_TRUE(std::filesystem::exists(view_png));
   }
 
+  if (const std::string why = test::serve_too_slow_for_real_time(serve.output()); !why.empty()) {
+    GTEST_SKIP() << why;
+  }
   const nlohmann::json a = read_json(one_json);
   const nlohmann::json b = read_json(served_json);
   const nlohmann::json d = read_json(device_json);
@@ -163,7 +166,9 @@ TEST(ThreeProcesses, KillingServeFadesTheForceAndTheDeviceRendersAgainWhenItRetu
   auto serve = std::make_unique<BackgroundHapsim>("serve " + kScene + net,
                                                   hapsim::test::temp_path("serve-1.log"));
   ASSERT_TRUE(serve->wait_for("dds ", 20s)) << serve->output();
-  BackgroundHapsim device("device --duration 9" + net + " --json " + device_json.string(),
+  // The device runs until stopped (120 s bounds a hang): a slow build's second serve may take
+  // longer than the palpation's 9 s to load and join.
+  BackgroundHapsim device("device --duration 120" + net + " --json " + device_json.string(),
                           hapsim::test::temp_path("device-kill.log"));
   ASSERT_TRUE(device.wait_for("host answering", 20s)) << device.output();
   // The palpation presses the patella hardest around 3.3 s into the device's script.
@@ -174,10 +179,12 @@ TEST(ThreeProcesses, KillingServeFadesTheForceAndTheDeviceRendersAgainWhenItRetu
   std::this_thread::sleep_for(500ms);
   serve = std::make_unique<BackgroundHapsim>("serve " + kScene + net,
                                              hapsim::test::temp_path("serve-2.log"));
-  EXPECT_TRUE(device.wait_for("host back", 20s)) << device.output();
+  EXPECT_TRUE(device.wait_for("host back", 120s)) << device.output();
+  std::this_thread::sleep_for(1s);  // rendering the new serve's models
+  device.signal(SIGTERM);
   EXPECT_EQ(device.wait(), 0) << device.output();
   // The device is gone: serve goes on with the scene's script and says so.
-  EXPECT_TRUE(serve->wait_for("device host  silent", 5s)) << serve->output();
+  EXPECT_TRUE(serve->wait_for("device host  silent", 30s)) << serve->output();
   serve->signal(SIGTERM);
   EXPECT_EQ(serve->wait(), 0) << serve->output();
   std::printf("%s\n%s\n", device.output().c_str(), serve->output().c_str());
