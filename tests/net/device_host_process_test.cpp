@@ -52,13 +52,16 @@ TEST(DeviceHostProcess, TheExamplePluginDrivesAServedWorld) {
   ASSERT_TRUE(test::on_loopback_config());
   const auto device_json = hapsim::test::temp_path("plugin-device.json");
   const std::string net = " --session plugin-test --domain 77";
-  BackgroundHapsim serve("serve " + kScenes + "knee_procedural.json --duration 6" + net,
+  // Serve runs until stopped after the device (60 s bounds a hang): a fixed 6 s could end before a
+  // loaded machine's device had joined (5 models rendered, once, beside an ASan run).
+  BackgroundHapsim serve("serve " + kScenes + "knee_procedural.json --duration 60" + net,
                          hapsim::test::temp_path("plugin-serve.log"));
   ASSERT_TRUE(serve.wait_for("dds ", 20s)) << serve.output();
   BackgroundHapsim device(std::string("device --device plugin:") + HAPSIM_EXAMPLE_DRIVER +
                               " --duration 3 --json " + device_json.string() + net,
                           hapsim::test::temp_path("plugin-device.log"));
   EXPECT_EQ(device.wait(), 0) << device.output();
+  serve.signal(SIGINT);
   EXPECT_EQ(serve.wait(), 0) << serve.output();
   EXPECT_NE(serve.output().find("device host  joined"), std::string::npos) << serve.output();
   std::ifstream in(device_json);
