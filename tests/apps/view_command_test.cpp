@@ -99,8 +99,19 @@ TEST(ViewCommand, MouseProbeUnderXvfbDentsTheKneeAndShowsTheForce) {
   const RgbaImage last = read_png((out / "last.png").string());
   ASSERT_EQ(first.width, 1280);
   ASSERT_EQ(last.height, 720);
-  // The force bar (its own colour) stands in the force panel at the bottom right.
-  EXPECT_GT(count_colour(last, ForceGraph::kBarColour, 940, 360, 1280, 720), 50);
+  // The force bar (its own colour) stands in the force panel at the bottom right, while the probe
+  // still presses. Only where the haptic loop kept its period: a build too slow for it (Debug
+  // ASan: 540 Hz, 2 500 late cycles in 12 s) ramps the force to zero after each gap, so its last
+  // frame shows 0 N while the probe touches (the peak above still shows the press).
+  const double rate_hz = j["haptic"]["rate_hz"].get<double>();
+  if (rate_hz >= 900.0) {
+    EXPECT_GT(count_colour(last, ForceGraph::kBarColour, 940, 360, 1280, 720), 50);
+  } else {
+    std::printf(
+        "not checked: the force bar in the last frame (the haptic loop ran at %.0f Hz: "
+        "this build cannot keep real time)\n",
+        rate_hz);
+  }
   EXPECT_EQ(count_colour(first, ForceGraph::kBarColour, 940, 360, 1280, 720), 0);
   // The 3D view (between the panels) changed: the probe moved in and the skin dented.
   const ImageDiff d = compare_images(columns(first, 320, 600), columns(last, 320, 600), 600, 720);
