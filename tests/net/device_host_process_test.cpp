@@ -65,6 +65,9 @@ TEST(DeviceHostProcess, TheExamplePluginDrivesAServedWorld) {
   serve.signal(SIGINT);
   EXPECT_EQ(serve.wait(), 0) << serve.output();
   EXPECT_NE(serve.output().find("device host  joined"), std::string::npos) << serve.output();
+  if (const std::string why = test::serve_too_slow_for_real_time(serve.output()); !why.empty()) {
+    GTEST_SKIP() << why;  // the counts below are rates: a model per state, 1 kHz
+  }
   std::ifstream in(device_json);
   const nlohmann::json d = nlohmann::json::parse(in);
   EXPECT_GT(d["states_published"].get<int>(), 2500);

@@ -103,6 +103,10 @@ TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
     viewer.join();
   }
   EXPECT_EQ(watch.wait(), 0) << watch.output();
+  // Everything below assumes serve kept its 1 kHz (rates, and forces compared with one process).
+  if (const std::string why = test::serve_too_slow_for_real_time(serve.output()); !why.empty()) {
+    GTEST_SKIP() << why;
+  }
   {
     const nlohmann::json w = read_json(watch_json);
     // Progress, not rate: the views span the palpation (10.5 s of 1 kHz cycles) and came at
@@ -133,9 +137,6 @@ TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
     EXPECT_TRUE(std::filesystem::exists(view_png));
   }
 
-  if (const std::string why = test::serve_too_slow_for_real_time(serve.output()); !why.empty()) {
-    GTEST_SKIP() << why;
-  }
   const nlohmann::json a = read_json(one_json);
   const nlohmann::json b = read_json(served_json);
   const nlohmann::json d = read_json(device_json);
@@ -174,12 +175,12 @@ TEST(ThreeProcesses, KillingServeFadesTheForceAndTheDeviceRendersAgainWhenItRetu
   // longer than the palpation's 9 s to load and join.
   BackgroundHapsim device("device --duration 120" + net + " --json " + device_json.string(),
                           hapsim::test::temp_path("device-kill.log"));
-  ASSERT_TRUE(device.wait_for("host answering", 20s)) << device.output();
+  ASSERT_TRUE(device.wait_for("host answering", 60s)) << device.output();
   // The palpation presses the patella hardest around 3.3 s into the device's script.
   std::this_thread::sleep_for(3300ms);
   serve->signal(SIGKILL);
   serve->wait();
-  ASSERT_TRUE(device.wait_for("host silent", 3s)) << device.output();
+  ASSERT_TRUE(device.wait_for("host silent", 30s)) << device.output();
   std::this_thread::sleep_for(500ms);
   serve = std::make_unique<BackgroundHapsim>("serve " + kScene + net,
                                              hapsim::test::temp_path("serve-2.log"));
