@@ -25,21 +25,15 @@ inline ::testing::AssertionResult on_loopback_config() {
 }
 
 /// Why serve's forces cannot be compared with the one-process run's, or "" when they can. Serve
-/// keeps its 1 kHz only if the machine runs its step and its peers in time; where the step alone
-/// takes over half the period (a Debug ASan build: p50 1.8 ms on the procedural knee), or serve
-/// simulated under 0.9 s per wall-clock second (Debug ASan processes on two busy cores: 0.6x), the
-/// loop is late, ramps the force after each gap, and renders something else. Read from serve's
-/// summary ("N steps, S s simulated in W s wall", "step cost: p50 X us"); a release build keeps
-/// 1.0x with a step of a few microseconds.
+/// keeps its 1 kHz only if the machine runs its step and its peers in time; where serve simulated
+/// under 0.9 s per wall-clock second (Debug ASan: 0.4x with a step of 1.8 ms, 0.6x with the
+/// device host's processes on two busy cores) its loop is late, ramps the force after each gap,
+/// and renders something else. Read from serve's summary ("N steps, S s simulated in W s wall");
+/// a release build keeps 1.0x. (Not the step cost: with a device host driving it, serve's step
+/// includes the wait for the device's state, 0.5 ms in release.)
 inline std::string serve_too_slow_for_real_time(const std::string& serve_output) {
-  static const std::regex kStepCost(R"(step cost: p50 ([0-9.]+) us)");
   static const std::regex kPace(R"(([0-9.]+) s simulated in ([0-9.]+) s wall)");
   std::smatch m;
-  if (std::regex_search(serve_output, m, kStepCost) && std::stod(m[1].str()) > 500.0) {
-    return "serve's step takes " + m[1].str() +
-           " us (p50), over half its 1000 us period: this build cannot run the scene in real time "
-           "(a sanitizer or Debug build), so its forces are not the scene's";
-  }
   if (std::regex_search(serve_output, m, kPace) && std::stod(m[2].str()) > 0.0 &&
       std::stod(m[1].str()) / std::stod(m[2].str()) < 0.9) {
     return "serve simulated " + m[1].str() + " s in " + m[2].str() +
