@@ -1,6 +1,7 @@
 #include "hapsim/core/isolated_call.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/sanitizer_build.h"
 
 #include <gtest/gtest.h>
 
@@ -39,7 +40,7 @@ TEST(IsolatedCall, ReturnsTheChildsBytesExactly) {
 }
 
 TEST(IsolatedCall, ACrashInTheChildIsAnErrorNamingTheInput) {
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if HAPSIM_SHADOW_SANITIZER
   // The sanitizer's report (a slow unwind through every frame, in a Debug build) took over 10 s on
   // a loaded machine: the limit is not what this test is about.
   constexpr double kTimeLimitS = 120.0;
@@ -52,7 +53,7 @@ TEST(IsolatedCall, ACrashInTheChildIsAnErrorNamingTheInput) {
         return "unreachable";
       },
       kTimeLimitS);
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#if HAPSIM_SHADOW_SANITIZER
   // A sanitizer's own SEGV handler reports the crash and exits instead of dying on the signal:
   // still one error naming the file, with what the child said.
   EXPECT_NE(message.find("the parser"), std::string::npos) << message;
@@ -83,11 +84,12 @@ TEST(IsolatedCall, AnErrorThrownInTheChildKeepsItsWhereAndText) {
   EXPECT_EQ(message, "a bad vertex");
 }
 
-#if !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+#if !HAPSIM_SHADOW_SANITIZER
 TEST(IsolatedCall, RunawayAllocationMeetsTheMemoryLimit) {
   const std::string message = failure(
       []() -> std::string {
         std::vector<std::vector<char>> hoard;
+        hoard.reserve(64);
         for (int i = 0; i < 64; ++i) {
           hoard.emplace_back(std::size_t{64} << 20, 'x');  // 4 GiB in all
         }

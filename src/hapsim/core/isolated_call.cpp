@@ -1,6 +1,7 @@
 #include "hapsim/core/isolated_call.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/sanitizer_build.h"
 
 #include <poll.h>
 #include <signal.h>
@@ -17,15 +18,6 @@
 #include <exception>
 #include <fstream>
 #include <new>
-
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define HAPSIM_SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
-    __has_feature(memory_sanitizer)
-#define HAPSIM_SANITIZED 1
-#endif
-#endif
 
 namespace hapsim {
 namespace {
@@ -49,7 +41,7 @@ bool write_all(int fd, const char* data, std::size_t size) {
   return true;
 }
 
-#ifndef HAPSIM_SANITIZED
+#if !HAPSIM_SHADOW_SANITIZER
 // Bytes of address space this process holds now (the child starts with a copy of it). Not in a
 // sanitized build, which sets no address-space limit (its shadow memory reserves terabytes).
 std::size_t current_address_space() {
@@ -72,7 +64,7 @@ std::size_t current_address_space() {
   const auto cpu_s = static_cast<rlim_t>(std::ceil(limits.time_s)) + 1;
   const rlimit cpu{cpu_s, cpu_s + 1};
   ::setrlimit(RLIMIT_CPU, &cpu);
-#ifndef HAPSIM_SANITIZED
+#if !HAPSIM_SHADOW_SANITIZER
   const rlim_t as = current_address_space() + limits.memory_bytes;
   const rlimit memory{as, as};
   ::setrlimit(RLIMIT_AS, &memory);

@@ -1,22 +1,16 @@
 #include "hapsim/core/leak_check.h"
 
+#include "hapsim/core/sanitizer_build.h"
+
 #include <dlfcn.h>
 #include <link.h>
 
 #include <cstddef>
 
-#if defined(__SANITIZE_ADDRESS__)
-#define HAPSIM_LEAK_CHECKED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(leak_sanitizer)
-#define HAPSIM_LEAK_CHECKED 1
-#endif
-#endif
-
 namespace hapsim {
 
 void keep_libraries_mapped_for_leak_check() {
-#if defined(HAPSIM_LEAK_CHECKED)
+#if HAPSIM_LEAK_SANITIZER
   dl_iterate_phdr(
       [](dl_phdr_info* info, std::size_t /*size*/, void* /*data*/) -> int {
         if (info->dlpi_name != nullptr && info->dlpi_name[0] != '\0') {
@@ -33,11 +27,7 @@ void keep_libraries_mapped_for_leak_check() {
 }
 
 bool built_with_leak_checks() {
-#if defined(HAPSIM_LEAK_CHECKED)
-  return true;
-#else
-  return false;
-#endif
+  return kBuiltWithLeakSanitizer;
 }
 
 }  // namespace hapsim

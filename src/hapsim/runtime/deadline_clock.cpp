@@ -1,5 +1,7 @@
 #include "hapsim/runtime/deadline_clock.h"
 
+#include "hapsim/core/sanitizer_build.h"
+
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
@@ -44,22 +46,9 @@ bool try_set_realtime_priority(int priority) noexcept {
   return pthread_setschedparam(pthread_self(), SCHED_FIFO, &param) == 0;
 }
 
-// Sanitizers reserve terabytes of shadow memory: never lock those processes.
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
-    __has_feature(memory_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
-
 bool try_lock_process_memory() noexcept {
-  if (kSanitized) {
+  // Sanitizers reserve terabytes of shadow memory: never lock those processes.
+  if constexpr (kBuiltWithShadowSanitizer) {
     return false;
   }
   rlimit limit{};
@@ -74,7 +63,7 @@ bool try_lock_process_memory() noexcept {
 }
 
 void prefault_stack(std::size_t bytes) noexcept {
-  constexpr std::size_t kMax = 512 * 1024;
+  constexpr std::size_t kMax = std::size_t{512} * 1024;
   volatile unsigned char stack[kMax];
   const std::size_t n = std::min(bytes, kMax);
   for (std::size_t i = 0; i < n; i += 4096) {
