@@ -33,6 +33,13 @@ TEST(RunCommand, RealtimeAddsTheLoopFiguresToTheSummary) {
             rt["period_jitter_us"]["max"].get<double>());
   EXPECT_TRUE(rt.contains("missed_deadlines"));
   EXPECT_EQ(j["steps"].get<int>() + rt["dropped_records"].get<int>(), 500);
+  // The loop's own count of cycles, and the share of them a safety ramp held down (with the
+  // sentence saying so only when that share is large: the run may be slow here, so not asserted).
+  EXPECT_EQ(rt["cycles"].get<int>(), 500);
+  const double share = rt["ramped_cycle_share"].get<double>();
+  EXPECT_GE(share, 0.0);
+  EXPECT_LE(share, 1.0);
+  EXPECT_NEAR(share, rt["ramp_cycles"].get<double>() / 500.0, 1e-12);
   EXPECT_EQ(j["pop_throughs"].get<int>(), 0);
 }
 

@@ -3,6 +3,7 @@
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/core/error.h"
 #include "hapsim/device/force_safety.h"
+#include "hapsim/runtime/ramp_warning.h"
 #include "hapsim/runtime/record_drain.h"
 #include "hapsim/runtime/world_haptic_client.h"
 
@@ -432,6 +433,7 @@ RealtimeSummary realtime_summary(const HapticLoopStatus& status, std::size_t dro
   rt.realtime_priority = status.realtime_priority;
   rt.stall_events = status.stall_events;
   rt.ramp_cycles = status.ramp_cycles;
+  rt.cycles = status.cycles;
   rt.failed_steps = status.failed_steps;
   rt.resume_gaps = status.resume_gaps;
   rt.memory_locked = status.memory_locked;
@@ -453,6 +455,10 @@ std::string format_realtime_summary(const RealtimeSummary& rt) {
     text += "real time: " + std::to_string(rt.dropped_records) +
             " cycle record(s) not accounted (bookkeeping fell behind), " +
             std::to_string(rt.failed_steps) + " failed step(s)\n";
+  }
+  if (const std::string warning = ramped_force_warning(rt.cycles, rt.ramp_cycles);
+      !warning.empty()) {
+    text += "real time: " + warning + "\n";
   }
   return text;
 }

@@ -1,24 +1,34 @@
 #include "hapsim/runtime/session_json.h"
 
+#include "hapsim/runtime/ramp_warning.h"
+
+#include <string>
 #include <vector>
 
 namespace hapsim {
 
 nlohmann::json realtime_json(const RealtimeSummary& rt) {
-  return {{"rate_hz", rt.rate_hz},
-          {"period_jitter_us",
-           {{"p50", rt.period_jitter_us.p50},
-            {"p99", rt.period_jitter_us.p99},
-            {"max", rt.period_jitter_us.max}}},
-          {"missed_deadlines", rt.missed_deadlines},
-          {"scheduling", rt.realtime_priority ? "SCHED_FIFO" : "normal"},
-          {"stall_events", rt.stall_events},
-          {"ramp_cycles", rt.ramp_cycles},
-          {"failed_steps", rt.failed_steps},
-          {"resume_gaps", rt.resume_gaps},
-          {"memory_locked", rt.memory_locked},
-          {"haptic_page_faults", rt.haptic_page_faults},
-          {"dropped_records", rt.dropped_records}};
+  nlohmann::json j = {{"rate_hz", rt.rate_hz},
+                      {"cycles", rt.cycles},
+                      {"period_jitter_us",
+                       {{"p50", rt.period_jitter_us.p50},
+                        {"p99", rt.period_jitter_us.p99},
+                        {"max", rt.period_jitter_us.max}}},
+                      {"missed_deadlines", rt.missed_deadlines},
+                      {"scheduling", rt.realtime_priority ? "SCHED_FIFO" : "normal"},
+                      {"stall_events", rt.stall_events},
+                      {"ramp_cycles", rt.ramp_cycles},
+                      {"failed_steps", rt.failed_steps},
+                      {"resume_gaps", rt.resume_gaps},
+                      {"memory_locked", rt.memory_locked},
+                      {"haptic_page_faults", rt.haptic_page_faults},
+                      {"dropped_records", rt.dropped_records},
+                      {"ramped_cycle_share", ramped_cycle_share(rt.cycles, rt.ramp_cycles)}};
+  if (const std::string warning = ramped_force_warning(rt.cycles, rt.ramp_cycles);
+      !warning.empty()) {
+    j["warning"] = warning;
+  }
+  return j;
 }
 
 nlohmann::json session_summary_json(const SceneDescription& scene, const World& world,

@@ -8,6 +8,7 @@
 #include "hapsim/render/png_image.h"
 #include "hapsim/render/renderer.h"
 #include "hapsim/render/snapshot_writer.h"
+#include "hapsim/runtime/ramp_warning.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/ui/force_graph.h"
 #include "hapsim/ui/mouse_probe.h"
@@ -747,6 +748,12 @@ class Viewer {
       ImGui::TextColored(ImVec4(1, 0.5f, 0.2f, 1), "stalls ramped to zero: %llu",
                          static_cast<unsigned long long>(st.stall_events));
     }
+    if (const std::string warning = ramped_force_warning(st.cycles, st.ramp_cycles);
+        !warning.empty()) {
+      ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.5f, 0.2f, 1));
+      ImGui::TextWrapped("%s", warning.c_str());
+      ImGui::PopStyleColor();
+    }
     ImGui::Text("graphics %.1f fps (draw %.1f ms)", stats_.fps_recent, stats_.draw_ms_recent);
     draw_triangle_line();
   }
@@ -760,6 +767,7 @@ class Viewer {
 
   int finish(double wall_s) {
     const HapticLoopStatus st = session_->loop_status();
+    const std::string ramp_warning = ramped_force_warning(st.cycles, st.ramp_cycles);
     const double fps = wall_s > 0.0 ? static_cast<double>(stats_.frames) / wall_s : 0.0;
     std::vector<double> frame_ms = stats_.frame_ms;
     const double frame_p50 = nearest_rank_percentile(frame_ms, 0.5);
@@ -800,6 +808,9 @@ class Viewer {
             st.period_jitter_us.p50, st.period_jitter_us.p99, st.period_jitter_us.max,
             static_cast<unsigned long long>(st.missed_deadlines), st.cycle_cost_us.p50,
             st.cycle_cost_us.p99);
+        if (!ramp_warning.empty()) {
+          std::printf("haptic       %s\n", ramp_warning.c_str());
+        }
       } else {
         std::printf(
             "served       %.1f views/s from the simulation host (the haptic loop is the "
@@ -845,7 +856,11 @@ class Viewer {
                        {"p99", st.cycle_cost_us.p99},
                        {"max", st.cycle_cost_us.max}}},
                      {"missed_deadlines", st.missed_deadlines},
-                     {"stall_events", st.stall_events}};
+                     {"stall_events", st.stall_events},
+                     {"ramp_cycles", st.ramp_cycles}};
+      if (!ramp_warning.empty()) {
+        j["haptic"]["warning"] = ramp_warning;
+      }
       j["peak_force_n"] = forces_.peaks();
       j["max_deflection_m"] = peak_deflection_m_;
       j["warnings"] = warnings_;
