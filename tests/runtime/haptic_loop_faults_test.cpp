@@ -471,6 +471,9 @@ TEST_P(StalledStep, ForceFallsThenComesBackOverTheRamp) {
   }
   const HapticLoopStatus st = loop.status();
   EXPECT_GE(st.resume_gaps, 1u);  // the haptic thread's own measure of every stall past the grace
+  // The cycles after it came back under the timing ceiling, with the device healthy: lateness.
+  EXPECT_GE(st.late_ramp_cycles, 1u);
+  EXPECT_LE(st.late_ramp_cycles, st.ramp_cycles);
   // A stall well past the ramp's end: the supervisor got the force to exactly zero while the step
   // slept. With real-time priority its wake-ups are reliable at 5x the bound (50 ms); without it
   // (an ordinary user's ctest on a busy machine) only the 500 ms stall is asserted.

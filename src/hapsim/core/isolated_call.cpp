@@ -62,11 +62,16 @@ std::size_t current_address_space() {
   // The child dies by the signal itself, so the parent can name it. A handler inherited from the
   // host (a sanitizer's or a fuzzer's crash report, which starts a symbolizer: 0.4 s per crash)
   // would run in a process left with half a parser's state and nothing to report to.
+  // Unblocked too: the forking thread's mask is inherited, and a blocked one would stay pending.
+  sigset_t crash_signals;
+  ::sigemptyset(&crash_signals);
   for (const int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
     struct sigaction dfl {};
     dfl.sa_handler = SIG_DFL;
     ::sigaction(sig, &dfl, nullptr);
+    ::sigaddset(&crash_signals, sig);
   }
+  ::pthread_sigmask(SIG_UNBLOCK, &crash_signals, nullptr);
   const rlimit no_core{0, 0};
   ::setrlimit(RLIMIT_CORE, &no_core);
   const auto cpu_s = static_cast<rlim_t>(std::ceil(limits.time_s)) + 1;

@@ -15,7 +15,7 @@ struct IsolationLimits {
   /// Wall-clock seconds before the child is killed.
   double time_s = 30.0;
   /// Bytes of address space the child may add to what it inherits (not enforced under the
-  /// address or thread sanitizer, whose shadow memory needs the whole address space).
+  /// address, thread or memory sanitizer, whose shadow memory needs the whole address space).
   std::size_t memory_bytes = std::size_t{2} << 30;
 };
 

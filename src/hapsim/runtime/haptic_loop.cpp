@@ -53,6 +53,7 @@ struct HapticLoop::Shared {
   std::atomic<std::uint64_t> missed{0};
   std::atomic<std::uint64_t> stall_events{0};
   std::atomic<std::uint64_t> ramp_cycles{0};
+  std::atomic<std::uint64_t> late_ramp_cycles{0};  // of those, capped for lateness alone
   std::atomic<std::uint64_t> health_losses{0};
   std::atomic<std::uint64_t> failed_steps{0};
   std::atomic<std::uint64_t> resume_gaps{0};  // haptic thread: gaps its ceiling cut for
@@ -256,8 +257,11 @@ void HapticLoop::haptic_thread_main() noexcept {
       resume.lower_to(std::min(watchdog_gain, cap));
       bump(s.ramp_cycles);
     } else if (ceiling < 1.0) {
+      // Capped for lateness alone (a stall, a gap, the ramp back after either), with the device
+      // healthy and the step fine: what says the build or the machine cannot keep the rate.
       out = scaled_command(out, ceiling);
       bump(s.ramp_cycles);
+      bump(s.late_ramp_cycles);
     }
     s.heartbeat_ns.store(write_ns, std::memory_order_release);
     if (try_write(out, &resume)) {
@@ -414,6 +418,7 @@ HapticLoopStatus HapticLoop::status() const noexcept {
   st.missed_deadlines = s.missed.load();
   st.stall_events = s.stall_events.load();
   st.ramp_cycles = s.ramp_cycles.load();
+  st.late_ramp_cycles = s.late_ramp_cycles.load();
   st.device_health_losses = s.health_losses.load();
   st.failed_steps = s.failed_steps.load();
   st.resume_gaps = s.resume_gaps.load();

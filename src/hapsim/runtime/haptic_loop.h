@@ -117,8 +117,14 @@ struct HapticLoopStatus {
   std::uint64_t missed_deadlines = 0;
   /// Times the supervisor found the haptic thread stalled and ramped the force down.
   std::uint64_t stall_events = 0;
-  /// Cycles in which the output was below the simulation's command because of a ramp.
+  /// Cycles whose output a ramp capped (the watchdog's, for an unhealthy device or failed steps,
+  /// or the timing ceiling's), whether or not there was force to cap.
   std::uint64_t ramp_cycles = 0;
+  /// Of those, the cycles capped for lateness alone, with the device healthy and the step fine:
+  /// the supervisor's stall ramp, the haptic thread's own gap cut, the ramp back after either
+  /// (and the rare soft start after a reset or unpause, or the ramp back after a device
+  /// recovered). Many of them mean the build or the machine cannot keep the rate.
+  std::uint64_t late_ramp_cycles = 0;
   /// Transitions of the device from healthy to not.
   std::uint64_t device_health_losses = 0;
   /// Steps that threw (each yields zero fresh force).

@@ -434,6 +434,7 @@ RealtimeSummary realtime_summary(const HapticLoopStatus& status, std::size_t dro
   rt.stall_events = status.stall_events;
   rt.ramp_cycles = status.ramp_cycles;
   rt.cycles = status.cycles;
+  rt.late_ramp_cycles = status.late_ramp_cycles;
   rt.failed_steps = status.failed_steps;
   rt.resume_gaps = status.resume_gaps;
   rt.memory_locked = status.memory_locked;
@@ -456,7 +457,7 @@ std::string format_realtime_summary(const RealtimeSummary& rt) {
             " cycle record(s) not accounted (bookkeeping fell behind), " +
             std::to_string(rt.failed_steps) + " failed step(s)\n";
   }
-  if (const std::string warning = ramped_force_warning(rt.cycles, rt.ramp_cycles);
+  if (const std::string warning = late_ramp_warning(rt.cycles, rt.late_ramp_cycles);
       !warning.empty()) {
     text += "real time: " + warning + "\n";
   }

@@ -114,8 +114,10 @@ struct RealtimeSummary {
   long haptic_page_faults = -1;
   /// Cycle records the bookkeeping could not keep up with (not accounted, not recorded).
   std::size_t dropped_records = 0;
-  /// Cycles the loop ran (the denominator of ramp_cycles).
+  /// Cycles the loop ran, and those a ramp capped for lateness alone
+  /// (HapticLoopStatus::late_ramp_cycles).
   std::size_t cycles = 0;
+  std::size_t late_ramp_cycles = 0;
 };
 
 /// What a teleoperation rig did over the run (the pick-and-place of paper 000).

@@ -23,8 +23,9 @@ nlohmann::json realtime_json(const RealtimeSummary& rt) {
                       {"memory_locked", rt.memory_locked},
                       {"haptic_page_faults", rt.haptic_page_faults},
                       {"dropped_records", rt.dropped_records},
-                      {"ramped_cycle_share", ramped_cycle_share(rt.cycles, rt.ramp_cycles)}};
-  if (const std::string warning = ramped_force_warning(rt.cycles, rt.ramp_cycles);
+                      {"late_ramp_cycles", rt.late_ramp_cycles},
+                      {"late_ramp_share", late_ramp_share(rt.cycles, rt.late_ramp_cycles)}};
+  if (const std::string warning = late_ramp_warning(rt.cycles, rt.late_ramp_cycles);
       !warning.empty()) {
     j["warning"] = warning;
   }

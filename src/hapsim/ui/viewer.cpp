@@ -748,7 +748,7 @@ class Viewer {
       ImGui::TextColored(ImVec4(1, 0.5f, 0.2f, 1), "stalls ramped to zero: %llu",
                          static_cast<unsigned long long>(st.stall_events));
     }
-    if (const std::string warning = ramped_force_warning(st.cycles, st.ramp_cycles);
+    if (const std::string warning = late_ramp_warning(st.cycles, st.late_ramp_cycles);
         !warning.empty()) {
       ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.5f, 0.2f, 1));
       ImGui::TextWrapped("%s", warning.c_str());
@@ -767,7 +767,7 @@ class Viewer {
 
   int finish(double wall_s) {
     const HapticLoopStatus st = session_->loop_status();
-    const std::string ramp_warning = ramped_force_warning(st.cycles, st.ramp_cycles);
+    const std::string ramp_warning = late_ramp_warning(st.cycles, st.late_ramp_cycles);
     const double fps = wall_s > 0.0 ? static_cast<double>(stats_.frames) / wall_s : 0.0;
     std::vector<double> frame_ms = stats_.frame_ms;
     const double frame_p50 = nearest_rank_percentile(frame_ms, 0.5);
@@ -857,7 +857,9 @@ class Viewer {
                        {"max", st.cycle_cost_us.max}}},
                      {"missed_deadlines", st.missed_deadlines},
                      {"stall_events", st.stall_events},
-                     {"ramp_cycles", st.ramp_cycles}};
+                     {"ramp_cycles", st.ramp_cycles},
+                     {"late_ramp_cycles", st.late_ramp_cycles},
+                     {"late_ramp_share", late_ramp_share(st.cycles, st.late_ramp_cycles)}};
       if (!ramp_warning.empty()) {
         j["haptic"]["warning"] = ramp_warning;
       }
