@@ -1,5 +1,6 @@
 #include "bench/passivity_cases.h"
 
+#include "bench/fem_cases.h"
 #include "hapsim/core/device_profile.h"
 #include "hapsim/core/error.h"
 #include "hapsim/scene/run_setup.h"
@@ -173,7 +174,35 @@ struct Surface {
   std::string name;
   std::function<std::unique_ptr<World>(const DeviceProfile&, double k)> build;
   PortLine line;
+  /// The stiffness of the energy's storage term F²/2K when it is not the material's k (a FEM
+  /// body renders its contact spring in series with the tissue): from a world built for k.
+  std::function<double(World&, const PortLine&, double k)> port_stiffness;
 };
+
+// The FEM block of `hapsim bench fem` (scenes/fem_block.json's block and material), about 1k
+// tets, corotational, backward Euler at 100 Hz: the world steps its FEM update itself (inline),
+// so the port sees the one-period latency of the coupling and the local model in between.
+FemBlockSpec passivity_fem_block() {
+  FemBlockSpec spec;
+  spec.cells = fem_block_cells(spec.size_m, 1000);
+  return spec;
+}
+
+// What the FEM world renders along the port's normal: the stiffness of the local model adopted
+// with the tool held 0.5 mm beyond the first touch (the contact spring in series with the
+// tissue's condensed compliance there). Smaller than k, so F²/2K counts more stored energy than
+// F²/2k would: E is not made to look passive by the tissue's give.
+double fem_port_stiffness(World& world, const PortLine& line, double k) {
+  DeviceInput input;
+  input.p_world = line.p_touch_world - line.n_world * 5e-4;
+  for (int i = 0; i < 50; ++i) {
+    input.time_s = i * 1e-3;
+    (void)world.step(input, 1e-3);
+  }
+  const LocalContactModel& m = world.state().fem_contacts[0].model;
+  const double k_n = m.normal_world.dot(m.stiffness_n_per_m * m.normal_world);
+  return m.valid && std::isfinite(k_n) && k_n > 0.0 ? std::min(k_n, k) : k;
+}
 
 double limit_n(const DeviceProfile& profile) {
   // A glove has no tip actuator: its finger actuator pushes on the pressing finger.
@@ -221,7 +250,7 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
   }
   std::vector<std::string> surface_names = options.surfaces;
   if (surface_names.empty()) {
-    surface_names = {"plane", "sphere", "sheet", "knee"};
+    surface_names = {"plane", "sphere", "sheet", "knee", "fem"};
   }
 
   std::vector<Surface> surfaces;
@@ -238,7 +267,8 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
                   }
                   return std::make_unique<World>(std::move(world));
                 },
-                knee_touch(*knee)};
+                knee_touch(*knee),
+                {}};
       surfaces.push_back(std::move(s));
     } else if (name == "plane" || name == "sphere" || name == "sheet") {
       Surface s{name,
@@ -248,15 +278,32 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
                                   "passivity-" + name + ".json");
                   return std::make_unique<World>(scene.world);
                 },
+                {},
                 {}};
       // Every built-in surface's top is at the origin, facing +z.
       const DeviceProfile& any = builtin_device_profiles().front();
       std::unique_ptr<World> probe = s.build(any, any.max_stiffness_n_per_m);
       s.line = find_touch(*probe, Vec3(0.0, 0.0, 0.02), Vec3::UnitZ());
       surfaces.push_back(std::move(s));
+    } else if (name == "fem") {
+      Surface s{name,
+                [](const DeviceProfile& profile, double k) {
+                  FemBlockSpec spec = passivity_fem_block();
+                  spec.contact_stiffness_n_per_m = k;
+                  spec.max_force_n = limit_n(profile);
+                  return std::make_unique<World>(fem_block_world(spec));
+                },
+                {},
+                fem_port_stiffness};
+      // The block's top is at z = its height, centred in x and y.
+      const DeviceProfile& any = builtin_device_profiles().front();
+      std::unique_ptr<World> probe = s.build(any, any.max_stiffness_n_per_m);
+      s.line = find_touch(*probe, Vec3(0.0, 0.0, passivity_fem_block().size_m.z() + 0.02),
+                          Vec3::UnitZ());
+      surfaces.push_back(std::move(s));
     } else {
       throw Error("--surfaces",
-                  "unknown surface '" + name + "', expected plane, sphere, sheet or knee");
+                  "unknown surface '" + name + "', expected plane, sphere, sheet, knee or fem");
     }
   }
 
@@ -265,16 +312,24 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
   std::size_t done = 0;
   for (const DeviceProfile* profile : profiles) {
     for (const Surface& surface : surfaces) {
+      const auto port_stiffness = [&](double k) {
+        return surface.port_stiffness ? surface.port_stiffness(*surface.build(*profile, k),
+                                                               surface.line, k)
+                                      : k;
+      };
       const auto run_at = [&](double k) {
+        const double k_port = port_stiffness(k);
         std::unique_ptr<World> world = surface.build(*profile, k);
         const PortEnvironment env =
             world_port(*world, surface.line, *profile, options.port.sample_period_s);
-        return run_port(env, k, options.port);
+        return run_port(env, k_port, options.port);
       };
       const double rated = profile->max_stiffness_n_per_m;
       for (const double factor : {1.0, 1.5}) {
-        result.rows.push_back({profile->name, surface.name, rated, factor,
-                               options.port.device_mass_kg, run_at(factor * rated)});
+        PassivityRow row{profile->name, surface.name, rated, factor, options.port.device_mass_kg,
+                         run_at(factor * rated)};
+        row.port_stiffness_n_per_m = port_stiffness(factor * rated);
+        result.rows.push_back(row);
       }
       if (options.bisection_steps > 0) {
         ZWidthRow z{profile->name, surface.name, rated, 0.0, false};
@@ -315,6 +370,21 @@ std::string format_passivity_table(const PassivityResult& result) {
                   r.run.late_motion_m * 1e3, r.run.peak_force_n, r.run.stable ? "yes" : "NO");
     out << line;
   }
+  bool noted = false;
+  for (const PassivityRow& r : result.rows) {
+    if (r.port_stiffness_n_per_m > 0.0 &&
+        r.port_stiffness_n_per_m != r.factor * r.rated_stiffness_n_per_m) {
+      if (!noted) {
+        out << "K in F^2/2K where it is not the material's (the FEM block: its contact spring in "
+               "series with the tissue, as rendered 0.5 mm in):\n";
+        noted = true;
+      }
+      std::snprintf(line, sizeof line, "  %-16s %-7s %4.1fx: k %.0f N/m, K %.1f N/m\n",
+                    r.profile.c_str(), r.surface.c_str(), r.factor,
+                    r.factor * r.rated_stiffness_n_per_m, r.port_stiffness_n_per_m);
+      out << line;
+    }
+  }
   if (!result.z_width.empty()) {
     out << "\nZ-width: the largest stable stiffness (bisection between 1/64 and 64x the rating)\n";
     std::snprintf(line, sizeof line, "%-16s %-7s %10s %14s %8s\n", "profile", "surface",
@@ -342,6 +412,7 @@ nlohmann::json passivity_to_json(const PassivityResult& result) {
                     {"rated_stiffness_n_per_m", r.rated_stiffness_n_per_m},
                     {"stiffness_factor", r.factor},
                     {"device_mass_kg", r.device_mass_kg},
+                    {"port_stiffness_n_per_m", r.port_stiffness_n_per_m},
                     {"energy_end_j", finite_or_null(r.run.energy_end_j)},
                     {"energy_max_j", finite_or_null(r.run.energy_max_j)},
                     {"late_energy_j", finite_or_null(r.run.late_energy_j)},

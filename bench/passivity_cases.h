@@ -1,5 +1,5 @@
 // The passivity sweep (issue 14 item 4, `hapsim bench passivity`): each shipped device profile
-// rendering a plane, a sphere, the virtual sheet and the knee at 1.0x and 1.5x its rated
+// rendering a plane, a sphere, the virtual sheet, the knee and a FEM block at 1.0x and 1.5x its rated
 // stiffness, held by a simulated device and hand; the energy the rendering generated at the
 // device port, and the largest stiffness that stays stable (the profile's Z-width) beside its
 // rating.
@@ -65,7 +65,9 @@ struct PortRun {
 struct PassivityOptions {
   /// Profiles to run (default: every shipped profile).
   std::vector<std::string> profiles;
-  /// "plane", "sphere", "sheet", "knee" (default: all).
+  /// "plane", "sphere", "sheet", "knee", "fem" (default: all). "fem": the FEM block of `hapsim
+  /// bench fem` (bench/fem_cases.h; about 1k tets, corotational, backward Euler at 100 Hz)
+  /// through the world's local contact model, pressed at its top's centre.
   std::vector<std::string> surfaces;
   std::filesystem::path scenes_dir;
   PortOptions port;
@@ -81,6 +83,9 @@ struct PassivityRow {
   double factor = 1.0;  ///< of the rated stiffness
   double device_mass_kg = 0.0;
   PortRun run;
+  /// The K of the energy's F²/2K: the material's stiffness (factor × rated), or for the FEM
+  /// block the series stiffness it renders (contact spring and tissue), which is smaller.
+  double port_stiffness_n_per_m = 0.0;
 };
 
 struct ZWidthRow {

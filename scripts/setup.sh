@@ -42,6 +42,9 @@ HAPSIM_PACKAGES=(
   # reference oracles for tests and benchmarks only (HAPSIM_REQUIRE_ORACLES: configure fails
   # without them rather than skipping their tests): CGAL, FCL, Embree 3, orocos-kdl
   libcgal-dev libfcl-dev libembree-dev liborocos-kdl-dev
+  # CalculiX (find_program(ccx)): the FEM body's oracle, a separate GPL program the deform oracle
+  # tests run on the same tet mesh (never linked)
+  calculix-ccx
   # the Python module (python/): Python's headers and find_package(pybind11) build it; NumPy for
   # its arrays; pytest runs its tests under ctest; the examples' plots use the matplotlib above
   python3-dev python3-numpy pybind11-dev python3-pytest

@@ -2,8 +2,9 @@
 // cost of hapsim's exact BVH, sphere tree and contact-radius query against CGAL, FCL and Embree
 // on the same meshes and points (bench/collision_cases.h). `hapsim bench step`: the haptic step's
 // cost per contact method (bench/step_cases.h). `hapsim bench network`: raw force against the
-// local contact model over a simulated link (net/link_sweep.h). Progress on stderr, the table on
-// stdout, rows as JSON on request.
+// local contact model over a simulated link (net/link_sweep.h). `hapsim bench fem`: a FEM block's
+// solver, the haptic step beside it and the local model's force error (bench/fem_cases.h).
+// Progress on stderr, the table on stdout, rows as JSON on request.
 #ifdef HAPSIM_WITH_BENCH
 
 #include "commands.h"
@@ -12,6 +13,7 @@
 #include "progress_printer.h"
 
 #include "bench/collision_cases.h"
+#include "bench/fem_cases.h"
 #include "bench/passivity_cases.h"
 #include "bench/soak_cases.h"
 #include "bench/step_cases.h"
@@ -27,6 +29,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -239,6 +242,91 @@ void run_passivity(const PassivityArgs& args) {
   if (json_out) {
     std::cout << std::flush;
     json_out.write(bench::passivity_to_json(result));
+  }
+}
+
+struct FemArgs {
+  std::vector<std::size_t> sizes;
+  bool large = false;
+  std::vector<std::string> elasticities;
+  std::vector<double> speeds_mm_per_s;
+  int steps = 200;
+  double haptic_s = 2.0;
+  double reference_spacing_mm = 0.1;
+  bool no_error = false;
+  std::string json_path;
+};
+
+// The 1-minute load average now ("-" when unknown): the machine is shared, the figures say so.
+double load_average() {
+  double load[1] = {-1.0};
+  return getloadavg(load, 1) == 1 ? load[0] : -1.0;
+}
+
+void run_fem(const FemArgs& args) {
+  JsonOutput json_out(args.json_path);
+  bench::FemBenchOptions options;
+  if (!args.sizes.empty()) {
+    options.tet_counts = args.sizes;
+  }
+  if (args.large) {
+    options.tet_counts.push_back(80000);  // factoring it takes long: on request
+  }
+  if (!args.elasticities.empty()) {
+    options.elasticities.clear();
+    for (const std::string& e : args.elasticities) {
+      options.elasticities.push_back(e == "linear" ? FemElasticity::kLinear
+                                                   : FemElasticity::kCorotational);
+    }
+  }
+  if (!args.speeds_mm_per_s.empty()) {
+    options.speeds_m_per_s.clear();
+    for (const double v : args.speeds_mm_per_s) {
+      options.speeds_m_per_s.push_back(1e-3 * v);
+    }
+  }
+  options.fem_steps = args.steps;
+  options.haptic_s = args.haptic_s;
+  options.reference_spacing_m = 1e-3 * args.reference_spacing_mm;
+  options.measure_error = !args.no_error;
+  std::string sizes;
+  for (const std::size_t n : options.tet_counts) {
+    sizes += (sizes.empty() ? "" : ", ") + std::to_string(n);
+  }
+  const double load_before = load_average();
+  std::cerr << "hapsim bench fem: about " << sizes << " tets; load average " << load_before << '\n';
+  ProgressPrinter printer;
+  options.progress = [&printer](std::string_view label, double fraction) {
+    printer(label, fraction);
+  };
+  const Stopwatch watch;
+  const bench::FemBenchResult result = bench::run_fem_bench(options);
+  const double load_after = load_average();
+  const bench::FemBlockSpec& b = result.block;
+  char setup[600];
+  std::snprintf(setup, sizeof setup,
+                "Block %.0f x %.0f x %.0f mm (make_tet_block), bottom fixed; E %.0f kPa, nu %.2f, "
+                "Rayleigh %.0f 1/s, %.2f s; contact %.0f N/m, %.1f N s/m, tool r %.0f mm, patch r "
+                "%.0f mm\nFEM step: bare FemBody, backward Euler dt %.0f ms, one core, %d steps of a "
+                "0-2-0 N press at 1 Hz; haptic step: World::step pressed 6 mm sliding at 20 mm/s, "
+                "FEM deferred (advance_fem between cycles, untimed), %.1f s\n",
+                b.size_m.x() * 1e3, b.size_m.y() * 1e3, b.size_m.z() * 1e3,
+                b.material.youngs_modulus_pa / 1e3, b.material.poisson_ratio,
+                b.material.rayleigh_mass_per_s, b.material.rayleigh_stiffness_s,
+                b.contact_stiffness_n_per_m, b.contact_damping_n_s_per_m, b.tool_radius_m * 1e3,
+                b.patch_radius_m * 1e3, b.dt_s * 1e3, options.fem_steps, options.haptic_s);
+  std::cout << setup << bench::format_fem_table(result);
+  std::snprintf(setup, sizeof setup, "%zu rows in %.1f s; load average %.2f before, %.2f after\n",
+                result.rows.size(), watch.elapsed_s(), load_before, load_after);
+  std::cout << setup;
+  if (json_out) {
+    nlohmann::json j = bench::fem_bench_to_json(result);
+    j["machine"] = {{"load_average_before", load_before},
+                    {"load_average_after", load_after},
+                    {"hardware_threads", sysconf(_SC_NPROCESSORS_ONLN)},
+                    {"wall_s", watch.elapsed_s()}};
+    std::cout << std::flush;
+    json_out.write(j);
   }
 }
 
@@ -560,15 +648,15 @@ void add_bench_command(CLI::App& app) {
   CLI::App* passivity = bench->add_subcommand(
       "passivity",
       "Energy generated at the device port: every device profile at 1.0x and 1.5x its rated "
-      "stiffness on a plane, a sphere, the sheet and the knee, held by a simulated device and "
-      "hand; the largest stable stiffness (Z-width) beside the rating");
+      "stiffness on a plane, a sphere, the sheet, the knee and a FEM block, held by a simulated "
+      "device and hand; the largest stable stiffness (Z-width) beside the rating");
   passivity->add_option("--profiles", passivity_args->profiles, "Device profiles (default: all)")
       ->delimiter(',');
   passivity
       ->add_option("--surfaces", passivity_args->surfaces,
-                   "plane, sphere, sheet, knee (default: all)")
+                   "plane, sphere, sheet, knee, fem (default: all)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"plane", "sphere", "sheet", "knee"}));
+      ->check(CLI::IsMember({"plane", "sphere", "sheet", "knee", "fem"}));
   passivity
       ->add_option("--device-mass", passivity_args->device_mass_kg,
                    "The device's apparent mass at the handle, kg (default 0.1: no profile states "
@@ -594,6 +682,37 @@ void add_bench_command(CLI::App& app) {
   passivity->callback([passivity_args] { run_passivity(*passivity_args); });
 
   add_snapshot_bench(*bench);
+
+  auto fem_args = std::make_shared<FemArgs>();
+  CLI::App* fem = bench->add_subcommand(
+      "fem",
+      "A FEM block (80 x 60 x 30 mm, bottom fixed) per tet count, linear and corotational: the "
+      "solver's step rate on one core, factorisation time and memory, the haptic step with the "
+      "block in contact, and the 1 kHz local model's force error against a full solve along a "
+      "palpation");
+  fem->add_option("--sizes", fem_args->sizes,
+                  "Approximate tet counts (default 1000,5000,20000)")
+      ->delimiter(',')
+      ->check(CLI::Range(std::size_t{6}, std::size_t{2000000}));
+  fem->add_flag("--large", fem_args->large, "Add the 80k-tet block (its factorisation takes long)");
+  fem->add_option("--elasticity", fem_args->elasticities, "linear, corotational (default: both)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"linear", "corotational"}));
+  fem->add_option("--speeds", fem_args->speeds_mm_per_s,
+                  "Palpation speeds for the force error, mm/s (default 10,50,200)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.1, 2000.0));
+  fem->add_option("--steps", fem_args->steps, "Timed FEM steps per row (default 200)")
+      ->check(CLI::Range(1, 100000));
+  fem->add_option("--haptic-seconds", fem_args->haptic_s,
+                  "Timed haptic steps per row, simulated s (default 2)")
+      ->check(CLI::Range(0.01, 600.0));
+  fem->add_option("--reference-spacing", fem_args->reference_spacing_mm,
+                  "Path length between full solves, mm (default 0.1; linear in between)")
+      ->check(CLI::Range(0.001, 5.0));
+  fem->add_flag("--no-error", fem_args->no_error, "Skip the local model's force error");
+  fem->add_option("--json", fem_args->json_path, "Write the rows as JSON to FILE");
+  fem->callback([fem_args] { run_fem(*fem_args); });
 
   auto soak_args = std::make_shared<SoakArgs>();
   CLI::App* soak = bench->add_subcommand(

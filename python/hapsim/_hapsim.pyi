@@ -7,6 +7,7 @@ import numpy.typing as npt
 
 _Path = Union[str, PathLike[str]]
 _Floats = Union[Sequence[float], npt.NDArray[np.float64]]
+_Body = Union[str, int]
 
 class Error(ValueError):
     """A bad input, naming where: `where` as the CLI prints it, split into `file` and `pointer`
@@ -124,6 +125,31 @@ class World:
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32]]: ...
     def record(self, path: _Path) -> None: ...
     def stop_recording(self) -> int: ...
+    # FEM bodies (docs/python.md#fem-bodies): `body` is a FEM body's name or its index among the
+    # world's bodies; every array is a copy, in the world frame, SI units.
+    def fem_bodies(self) -> list[dict[str, Any]]:
+        """Per FEM body: name, body, nodes, tets, fixed_nodes, elasticity, integration, dt_s,
+        mass_kg"""
+    def fem_node_positions(self, body: _Body) -> npt.NDArray[np.float64]:
+        """(N, 3) node positions now, world frame, m"""
+    def fem_rest_nodes(self, body: _Body) -> npt.NDArray[np.float64]:
+        """(N, 3) node rest positions, world frame, m"""
+    def fem_displacement(self, body: _Body) -> npt.NDArray[np.float64]:
+        """(N, 3) node displacements from rest, world frame, m"""
+    def fem_tets(self, body: _Body) -> npt.NDArray[np.uint32]:
+        """(T, 4) node indices per tetrahedron"""
+    def fem_regions(self, body: _Body) -> npt.NDArray[np.int32]:
+        """(T,) region per tetrahedron"""
+    def fem_fixed_nodes(self, body: _Body) -> npt.NDArray[np.bool_]:
+        """(N,) whether each node is held fixed"""
+    def fem_von_mises_pa(self, body: _Body) -> npt.NDArray[np.float64]:
+        """(T,) von Mises stress per tetrahedron, Pa"""
+    def fem_stress_pa(self, body: _Body) -> npt.NDArray[np.float64]:
+        """(T, 3, 3) Cauchy stress per tetrahedron, world frame, Pa"""
+    def fem_energies(self, body: _Body) -> dict[str, float]:
+        """elastic_j, kinetic_j"""
+    def fem_stats(self) -> Optional[dict[str, Any]]:
+        """The 'fem' object of `hapsim run --json` (None without FEM bodies)"""
 
 class Recording:
     def __len__(self) -> int: ...
@@ -166,6 +192,45 @@ class Mesh:
     ) -> dict[str, npt.NDArray[Any]]: ...
 
 def load_mesh(path: _Path, scale: float = 1.0) -> Mesh: ...
+
+class TetMesh:
+    """A tetrahedral mesh: nodes (N, 3) m, tets (T, 4), regions (T,); arrays are read-only
+    views."""
+
+    def __init__(
+        self,
+        nodes: npt.ArrayLike,
+        tets: npt.ArrayLike,
+        regions: Optional[npt.ArrayLike] = None,
+    ) -> None: ...
+    @property
+    def source(self) -> str: ...
+    @property
+    def node_count(self) -> int: ...
+    @property
+    def tet_count(self) -> int: ...
+    @property
+    def nodes(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def tets(self) -> npt.NDArray[np.uint32]: ...
+    @property
+    def regions(self) -> npt.NDArray[np.int32]: ...
+    @property
+    def volume_m3(self) -> float: ...
+    def quality(self) -> dict[str, Any]: ...
+    def validate(self, allow_disconnected: bool = False) -> None: ...
+    def boundary(
+        self,
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint32], npt.NDArray[np.uint32]]:
+        """(vertices (V, 3), triangles (F, 3), node_of_vertex (V,))"""
+
+def read_tet_mesh(path: _Path, scale: float = 1.0) -> TetMesh: ...
+def make_tet_block(
+    size_m: _Floats,
+    cells: Sequence[int],
+    origin_m: _Floats = (0.0, 0.0, 0.0),
+) -> TetMesh: ...
+def tet_mesh_quality(mesh: TetMesh) -> dict[str, Any]: ...
 
 class Chain:
     @property

@@ -327,4 +327,5 @@ PYBIND11_MODULE(_hapsim, m) {
 
   bind_world(m);
   bind_geometry(m);
+  bind_fem(m);
 }

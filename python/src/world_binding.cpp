@@ -194,6 +194,10 @@ py::array_t<double> tool_view(const py::object& self, Field field) {
 
 }  // namespace
 
+const World& world_of(const py::handle& py_world) {
+  return py_world.cast<const PyWorld&>().world();
+}
+
 void bind_world(py::module_& m) {
   py::class_<DeviceInput>(m, "DeviceInput",
                           "One cycle of device input: pose, finger angles, joints (SI units)")

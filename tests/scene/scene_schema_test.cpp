@@ -223,9 +223,10 @@ Json small_scene() {
 
 TEST(SceneSchema, ShippedScenesAndASmallSceneSatisfyIt) {
   const SchemaValidator v = schema();
-  for (const char* name : {"knee.json", "knee_procedural.json", "knee_vhf.json",
-                           "knee_hand_procedural.json", "knee_hand.json", "teleop.json",
-                           "teleop_gp7.json", "csg_block.json", "hand_ball_sheet.json"}) {
+  for (const char* name :
+       {"knee.json", "knee_procedural.json", "knee_vhf.json", "knee_hand_procedural.json",
+        "knee_hand.json", "teleop.json", "teleop_gp7.json", "csg_block.json",
+        "hand_ball_sheet.json", "fem_block.json"}) {
     EXPECT_EQ(v.validate(read_json(kScenes / name)), "") << name;
   }
   EXPECT_EQ(v.validate(small_scene()), "");

@@ -1,5 +1,7 @@
 #include "hapsim/render/world_scene.h"
 
+#include "hapsim/world/fem_coupling.h"
+
 #include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/sphere_tree.h"
 #include "hapsim/core/error.h"
@@ -469,6 +471,24 @@ void WorldScene::update(const WorldSnapshot& snapshot) {
   }
   hand_ = snapshot.hand;
   rebuild_overlays(snapshot.tools, snapshot.tool_force_n);
+}
+
+void WorldScene::update_fem_surfaces(World& world) {
+  FemCoupling* fem = world.fem();
+  if (fem == nullptr) {
+    return;
+  }
+  for (std::size_t b = 0; b < fem->body_count(); ++b) {
+    const std::vector<Vec3>* vertices = fem->take_published_surface(b);
+    if (vertices == nullptr) {
+      continue;
+    }
+    for (const auto& seg : segments_) {
+      if (seg->body == fem->world_body(b)) {
+        scene_.update_positions(seg->mesh, *vertices);
+      }
+    }
+  }
 }
 
 void WorldScene::update_from_world(const World& world) {

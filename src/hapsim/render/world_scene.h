@@ -91,6 +91,9 @@ class WorldScene {
   void update(const WorldSnapshot& snapshot);
   /// From the world itself (only on the thread that steps it, while it is not stepping).
   void update_from_world(const World& world);
+  /// FEM bodies' surfaces as their FEM side last published them (world/fem_coupling.h; the one
+  /// display thread): in a live session they move on the FEM thread, not in the snapshots.
+  void update_fem_surfaces(World& world);
 
   void set_options(const WorldSceneOptions& options);
   [[nodiscard]] const WorldSceneOptions& options() const { return options_; }

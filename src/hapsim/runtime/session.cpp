@@ -2,10 +2,14 @@
 
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/core/error.h"
+#include "hapsim/core/statistics.h"
+#include "hapsim/deform/fem_body.h"
 #include "hapsim/device/force_safety.h"
+#include "hapsim/runtime/fem_thread.h"
 #include "hapsim/runtime/ramp_warning.h"
 #include "hapsim/runtime/record_drain.h"
 #include "hapsim/runtime/world_haptic_client.h"
+#include "hapsim/world/fem_coupling.h"
 
 #include <algorithm>
 #include <chrono>
@@ -309,6 +313,15 @@ SessionSummary run_inline(World& world, Device& device, const SessionOptions& op
   CycleRecord record;
   const auto wall_start = std::chrono::steady_clock::now();
   const std::size_t progress_every = std::max<std::size_t>(1, steps / 100);
+  // FEM updates run between cycles, outside the timed step (the same updates at the same steps
+  // as when the step runs them itself: the same bits).
+  struct FemBetweenCycles {
+    explicit FemBetweenCycles(World& w) : world(w) { world.set_fem_deferred(true); }
+    FemBetweenCycles(const FemBetweenCycles&) = delete;
+    FemBetweenCycles& operator=(const FemBetweenCycles&) = delete;
+    ~FemBetweenCycles() { world.set_fem_deferred(false); }
+    World& world;
+  } fem_between_cycles(world);
   for (std::size_t i = 0; i < steps; ++i) {
     const double t_s = static_cast<double>(i) * options.dt_s;
     // The timed haptic cycle: read, step (collision, force, deformation), safety, write.
@@ -319,6 +332,7 @@ SessionSummary run_inline(World& world, Device& device, const SessionOptions& op
     const DeviceCommand out = watchdog.update(t_s, &result.command, healthy);
     device.write(out);
     const auto c1 = std::chrono::steady_clock::now();
+    world.advance_fem();
     // Bookkeeping (outside the timed cycle).
     fill_cycle_record(record, i, input, result, out,
                       std::chrono::duration<double, std::micro>(c1 - c0).count());
@@ -388,6 +402,7 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
   loop_options.max_cycles = steps;
   loop_options.missed_period_s = 2.0 * options.dt_s;
   HapticLoop loop(device, client, loop_options);
+  const FemThread fem_thread(world);  // FEM bodies step on their own thread meanwhile
   SpscRing<CycleRecord>& records = *client.records();
   const std::size_t progress_every = std::max<std::size_t>(1, steps / 100);
   std::size_t accounted = 0;
@@ -490,7 +505,43 @@ SessionSummary run_session(World& world, Device& device, const SessionOptions& o
   SessionSummary summary = options.realtime ? run_realtime(world, device, options, steps)
                                             : run_inline(world, device, options, steps);
   summary.stiffness_clamps = stiffness_clamps(world);
+  summary.fem = fem_summary(world);
   return summary;
+}
+
+std::optional<FemSummary> fem_summary(const World& world) {
+  const FemCoupling* fem = world.fem();
+  if (fem == nullptr) {
+    return std::nullopt;
+  }
+  FemSummary s;
+  const FemCouplingStats& st = fem->stats();
+  s.updates = st.updates;
+  s.adopted = fem->adopted();
+  s.late_adopted = fem->late_adopted();
+  s.skipped_launches = st.skipped_launches;
+  s.period_steps = fem->period_steps();
+  if (!st.update_ms.empty()) {
+    std::vector<double> ms = st.update_ms;
+    s.update_ms_p50 = nearest_rank_percentile(ms, 0.50);
+    s.update_ms_p99 = nearest_rank_percentile(ms, 0.99);
+    s.update_ms_max = *std::max_element(ms.begin(), ms.end());
+  }
+  for (std::size_t b = 0; b < fem->body_count(); ++b) {
+    const FemBody& body = fem->body(b);
+    FemSummary::Body out;
+    out.name = world.description().bodies[fem->world_body(b)].name;
+    out.tets = body.tet_count();
+    out.nodes = body.node_count();
+    out.elasticity = std::string(to_string(body.options().elasticity));
+    for (std::size_t i = 0; i < body.node_count(); ++i) {
+      out.final_max_displacement_m = std::max(
+          out.final_max_displacement_m, body.displacement(static_cast<std::uint32_t>(i)).norm());
+    }
+    s.bodies.push_back(std::move(out));
+  }
+  s.failures = world.state().fem_failures;
+  return s;
 }
 
 std::vector<StiffnessClamp> stiffness_clamps(const World& world) {
@@ -603,6 +654,27 @@ std::string format_session_summary(const SessionSummary& s) {
       out << "; NON-FINITE in " << b.nonfinite_steps << " steps";
     }
     out << "\n";
+  }
+  if (s.fem) {
+    for (const FemSummary::Body& b : s.fem->bodies) {
+      std::snprintf(line, sizeof line,
+                    "fem   %-7s %zu tets, %zu nodes, %s; largest displacement at the end %.2f mm\n",
+                    b.name.c_str(), b.tets, b.nodes, b.elasticity.c_str(),
+                    b.final_max_displacement_m * 1e3);
+      out << line;
+    }
+    std::snprintf(line, sizeof line,
+                  "fem   %llu updates (every %llu steps), %llu adopted, %llu late; update p50 %.2f "
+                  "ms, p99 %.2f ms, max %.2f ms\n",
+                  static_cast<unsigned long long>(s.fem->updates),
+                  static_cast<unsigned long long>(s.fem->period_steps),
+                  static_cast<unsigned long long>(s.fem->adopted),
+                  static_cast<unsigned long long>(s.fem->late_adopted), s.fem->update_ms_p50,
+                  s.fem->update_ms_p99, s.fem->update_ms_max);
+    out << line;
+    if (s.fem->failures > 0) {
+      out << "fem   FAILED " << s.fem->failures << " update(s): " << s.fem->error << "\n";
+    }
   }
   for (const SheetSummary& sh : s.sheets) {
     std::snprintf(line, sizeof line, "sheet %-7s deepest dent %.2f mm, %.2f mm at the end\n",

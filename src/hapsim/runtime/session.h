@@ -162,6 +162,33 @@ struct SheetSummary {
   double final_depth_m = 0.0;
 };
 
+/// What the FEM bodies did over the run (world/fem_coupling.h).
+struct FemSummary {
+  std::uint64_t updates = 0;       ///< FEM updates run
+  std::uint64_t adopted = 0;       ///< adopted by the haptic path
+  std::uint64_t late_adopted = 0;  ///< adopted after their due step (real time: the FEM was late)
+  std::uint64_t skipped_launches = 0;
+  std::uint64_t period_steps = 0;  ///< haptic steps per FEM step
+  /// Wall-clock cost of one update (every FEM body), ms: p50, p99, max.
+  double update_ms_p50 = 0.0;
+  double update_ms_p99 = 0.0;
+  double update_ms_max = 0.0;
+  /// Per FEM body: its name, tets, nodes, and its largest node displacement at the end, m.
+  struct Body {
+    std::string name;
+    std::size_t tets = 0;
+    std::size_t nodes = 0;
+    std::string elasticity;
+    double final_max_displacement_m = 0.0;
+  };
+  std::vector<Body> bodies;
+  std::uint64_t failures = 0;
+  std::string error;
+};
+
+/// The FEM figures of `world` after a run (nullopt without FEM bodies).
+[[nodiscard]] std::optional<FemSummary> fem_summary(const World& world);
+
 /// A material the world renders softer than described: its stiffness is above the device's
 /// rated maximum (WorldOptions::max_stiffness_n_per_m, which run assembly sets from the device
 /// profile), so contact on it uses the maximum instead.
@@ -206,6 +233,8 @@ struct SessionSummary {
   std::vector<SheetSummary> sheets;
   /// Materials rendered at the device's rated stiffness instead of their own (stiffness_clamps).
   std::vector<StiffnessClamp> stiffness_clamps;
+  /// Worlds with FEM bodies.
+  std::optional<FemSummary> fem;
 };
 
 /// Runs `world` with `device` for options.duration_s. Throws hapsim::Error on bad options.

@@ -94,6 +94,26 @@ nlohmann::json session_summary_json(const SceneDescription& scene, const World& 
                              {"final_depth_m", sh.final_depth_m}});
     }
   }
+  if (s.fem) {
+    const FemSummary& f = *s.fem;
+    nlohmann::json bodies = nlohmann::json::array();
+    for (const FemSummary::Body& b : f.bodies) {
+      bodies.push_back({{"name", b.name},
+                        {"tets", b.tets},
+                        {"nodes", b.nodes},
+                        {"elasticity", b.elasticity},
+                        {"final_max_displacement_m", b.final_max_displacement_m}});
+    }
+    j["fem"] = {{"bodies", bodies},
+                {"updates", f.updates},
+                {"period_steps", f.period_steps},
+                {"adopted", f.adopted},
+                {"late_adopted", f.late_adopted},
+                {"skipped_launches", f.skipped_launches},
+                {"update_ms",
+                 {{"p50", f.update_ms_p50}, {"p99", f.update_ms_p99}, {"max", f.update_ms_max}}},
+                {"failures", f.failures}};
+  }
   std::vector<std::string> methods;
   for (const BodyDescription& b : world.description().bodies) {
     methods.emplace_back(to_string(b.method));

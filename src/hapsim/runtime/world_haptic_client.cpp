@@ -118,6 +118,11 @@ void WorldHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
     double& peak = max_deflection_m_[seg.flat];
     peak = std::max(peak, seg.deflection->max_deflection_m());
   }
+  for (const std::size_t body : world_.model().fem_bodies()) {
+    // A FEM body's surface moves on the FEM thread: its newest update's largest displacement.
+    double& peak = max_deflection_m_[world_.flat_segment(body, 0)];
+    peak = std::max(peak, world_.current_deflection_m(body, 0));
+  }
   if (snapshots_) {
     publish_snapshot(cycle);
   }

@@ -4,6 +4,7 @@
 #include "hapsim/geometry/body_part_size.h"
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/procedural.h"
+#include "hapsim/geometry/tet_mesh_io.h"
 #include "hapsim/scene/csg_reader.h"
 
 #include <algorithm>
@@ -81,10 +82,86 @@ double GeometryReader::capped(double value, double cap, const std::string& ptr) 
   return cap;
 }
 
+// A volume for a FEM body: a generated block, or a tet mesh file (Gmsh, TetGen, VTK), with its
+// boundary as the surface or a finer surface mesh embedded in it.
+void GeometryReader::read_tets(const Json& j, const std::string& kp, const std::string& kind,
+                               const std::string& body_name, BodyGeometry& body) {
+  const Json& g = r_.object(j, kp, kind + " settings");
+  TetMesh tets;
+  std::optional<std::filesystem::path> surface_file;
+  double scale = 1.0;
+  if (kind == "tet_block") {
+    r_.allow_keys(g, kp, {"size_m", "cells", "origin_m"});
+    const Vec3 size = r_.vec3(r_.required(g, kp, "size_m"), JsonReader::at(kp, "size_m"), "m");
+    if (!(size.minCoeff() > 0.0) || size.maxCoeff() > 100.0) {
+      r_.fail(JsonReader::at(kp, "size_m"), "expected three sizes in (0, 100] m");
+    }
+    const std::string cp = JsonReader::at(kp, "cells");
+    const Json& c = r_.array(r_.required(g, kp, "cells"), cp, "three cell counts");
+    if (c.size() != 3) {
+      r_.fail(cp, "expected three cell counts [nx, ny, nz]");
+    }
+    std::array<int, 3> cells{};
+    double total = 1.0;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const double n = r_.number(c[i], JsonReader::at(cp, i), "cells");
+      if (!(n >= 1.0 && n <= 200.0) || n != std::floor(n)) {
+        r_.fail(JsonReader::at(cp, i), "expected a whole number of cells in 1..200");
+      }
+      cells[i] = static_cast<int>(n);
+      total *= n;
+    }
+    if (6.0 * total > 2e6) {
+      r_.fail(cp, "more than 2 million tetrahedra");
+    }
+    tets = make_tet_block(size, cells);
+    if (g.contains("origin_m")) {
+      tets.transform(
+          Iso3(Eigen::Translation3d(r_.vec3(g["origin_m"], JsonReader::at(kp, "origin_m"), "m"))));
+    }
+    body.tets_source = r_.file().string() + ":" + kp;
+  } else {
+    r_.allow_keys(g, kp, {"file", "scale", "surface"});
+    const std::string fp = JsonReader::at(kp, "file");
+    const std::filesystem::path file = r_.existing_file(
+        r_.required(g, kp, "file"), fp, "a tet mesh file (.msh, .node, .ele, .vtk)");
+    scale = r_.number_in(g, kp, "scale", 1.0, 0.0, 1e6, "metres per file unit", true);
+    try {
+      tets = read_tet_mesh(file);
+    } catch (const Error& e) {
+      r_.fail(fp, "cannot load tet mesh " + e.where() + ": " + e.detail());
+    }
+    tets.scale(scale);
+    if (g.contains("surface")) {
+      surface_file = r_.existing_file(g["surface"], JsonReader::at(kp, "surface"),
+                                      "a surface mesh file to embed in the tets");
+    }
+    body.tets_source = file.string();
+  }
+  SegmentDescription s;
+  s.name = body_name;
+  if (surface_file) {
+    MeshLoadOptions lo;
+    lo.scale = scale;
+    try {
+      s.mesh = load_mesh(*surface_file, lo);
+    } catch (const Error& e) {
+      r_.fail(JsonReader::at(kp, "surface"), "cannot load mesh " + e.where() + ": " + e.detail());
+    }
+    body.embedded_surface = true;
+  } else {
+    s.mesh = tet_boundary(tets).surface;
+  }
+  body.segments.push_back(std::move(s));
+  body.tissues.emplace_back(std::nullopt);
+  body.tets = std::make_shared<const TetMesh>(std::move(tets));
+}
+
 BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
                                   const std::string& body_name) {
   r_.object(j, ptr, "a geometry");
-  const char* kinds[] = {"procedural", "box", "sphere", "sheet", "mesh", "mesh_folder", "csg"};
+  const char* kinds[] = {"procedural",  "box", "sphere",    "sheet",   "mesh",
+                         "mesh_folder", "csg", "tet_block", "tet_mesh"};
   std::string kind;
   for (const char* k : kinds) {
     if (j.contains(k)) {
@@ -96,7 +173,8 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
   }
   if (kind.empty()) {
     r_.fail(ptr,
-            "expected one geometry kind: procedural, box, sphere, sheet, mesh, mesh_folder or csg");
+            "expected one geometry kind: procedural, box, sphere, sheet, mesh, mesh_folder, csg, "
+            "tet_block or tet_mesh");
   }
   const std::string kp = JsonReader::at(ptr, kind);
   BodyGeometry body;
@@ -147,6 +225,10 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
     return body;
   }
   r_.allow_keys(j, ptr, {kind.c_str()});
+  if (kind == "tet_block" || kind == "tet_mesh") {
+    read_tets(j[kind], kp, kind, body_name, body);
+    return body;
+  }
   if (kind == "box") {
     const Json& b = r_.object(j[kind], kp, "box settings");
     r_.allow_keys(b, kp, {"half_extents_m"});

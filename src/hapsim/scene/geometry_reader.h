@@ -5,10 +5,12 @@
 #pragma once
 
 #include "hapsim/geometry/procedural_knee.h"
+#include "hapsim/geometry/tet_mesh.h"
 #include "hapsim/scene/scene_reader.h"
 #include "hapsim/world/world_description.h"
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -22,6 +24,11 @@ namespace hapsim {
 struct BodyGeometry {
   std::vector<SegmentDescription> segments;
   std::vector<std::optional<TissueKind>> tissues;
+  /// A volume ("tet_block", "tet_mesh"): its tetrahedra (body frame), whether the one segment's
+  /// mesh is a finer surface embedded in them (else their boundary), and where it came from.
+  std::shared_ptr<const TetMesh> tets;
+  bool embedded_surface = false;
+  std::string tets_source;
 };
 
 /// Reads the geometries of one scene's bodies, and collects its warnings: a mesh file whose size
@@ -48,6 +55,10 @@ class GeometryReader {
   /// Checks the sizes of the meshes loaded at `ptr` (a mesh, or a mesh_folder's `folder`).
   void check_sizes(const std::string& ptr, const std::vector<LoadedMesh>& meshes, double scale,
                    const std::filesystem::path& folder);
+
+  /// The "tet_block" / "tet_mesh" geometry at `kp` into `body`.
+  void read_tets(const JsonReader::Json& j, const std::string& kp, const std::string& kind,
+                 const std::string& body_name, BodyGeometry& body);
 
   /// `value`, or `cap` (SceneDetailCaps; 0: none) when larger, with a warning naming `ptr`.
   double capped(double value, double cap, const std::string& ptr);

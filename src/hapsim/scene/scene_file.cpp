@@ -6,11 +6,13 @@
 #include "hapsim/geometry/mass_properties.h"
 #include "hapsim/scene/assessment_reader.h"
 #include "hapsim/scene/device_reader.h"
+#include "hapsim/scene/fem_reader.h"
 #include "hapsim/scene/geometry_reader.h"
 #include "hapsim/scene/json_text.h"
 #include "hapsim/scene/scene_reader.h"
 #include "hapsim/scene/teleop_reader.h"
 #include "hapsim/scene/view_reader.h"
+#include "hapsim/world/fem_coupling.h"
 
 #include <nlohmann/json.hpp>
 
@@ -46,6 +48,8 @@ class Parser : public SceneReader {
   void parse_body(const Json& j, const std::string& ptr, WorldDescription& world);
   void parse_dynamics(const Json& j, const std::string& ptr, BodyDescription& body) const;
   void parse_deformation(const Json& j, const std::string& ptr, BodyDescription& body) const;
+  /// FEM bodies: what they are attached to exists, and there are few enough of them.
+  void check_fem_attachments(const WorldDescription& world) const;
   void parse_body_materials(const Json& j, const std::string& ptr, BodyDescription& body,
                             const std::vector<std::optional<TissueKind>>& tissues);
   ToolDescription parse_tool(const Json& j, const std::string& ptr) const;
@@ -127,6 +131,7 @@ SceneDescription Parser::parse(const Json& root) {
            "expected a unique body name; '" + scene.world.bodies.back().name + "' is used twice");
     }
   }
+  check_fem_attachments(scene.world);
   scene.warnings = geometry_.warnings();
 
   const Json& tools = array(required(root, "", "tools"), "/tools", "a list of tools");
@@ -234,7 +239,7 @@ void Parser::parse_body(const Json& j, const std::string& ptr, WorldDescription&
   object(j, ptr, "a body");
   allow_keys(j, ptr,
              {"name", "type", "pose", "contact_method", "geometry", "materials", "mass_kg",
-              "deformation", "sheet"});
+              "deformation", "sheet", "fem"});
   BodyDescription body;
   body.name = nonempty_string(required(j, ptr, "name"), at(ptr, "name"), "a body name");
   if (j.contains("type")) {
@@ -259,7 +264,51 @@ void Parser::parse_body(const Json& j, const std::string& ptr, WorldDescription&
   parse_body_materials(required(j, ptr, "materials"), at(ptr, "materials"), body, geometry.tissues);
   parse_dynamics(j, ptr, body);
   parse_deformation(j, ptr, body);
+  const bool fem = body.deformation == BodyDeformation::kFem;
+  if (fem != static_cast<bool>(geometry.tets)) {
+    fail(at(ptr, fem ? "geometry" : "deformation"),
+         fem ? "a FEM body needs a volume: the \"tet_block\" or \"tet_mesh\" geometry"
+             : "a tet_block or tet_mesh geometry is a volume for \"deformation\": \"fem\"");
+  }
+  if (j.contains("fem") && !fem) {
+    fail(at(ptr, "fem"), "FEM settings need \"deformation\": \"fem\"");
+  }
+  if (fem) {
+    body.fem = std::make_shared<const FemBodyDescription>(
+        read_fem_settings(*this, j.contains("fem") ? &j["fem"] : nullptr, at(ptr, "fem"),
+                          *geometry.tets, geometry.embedded_surface, geometry.tets_source));
+  }
   world.bodies.push_back(std::move(body));
+}
+
+void Parser::check_fem_attachments(const WorldDescription& world) const {
+  std::size_t fem_bodies = 0;
+  for (std::size_t b = 0; b < world.bodies.size(); ++b) {
+    const BodyDescription& body = world.bodies[b];
+    if (!body.fem) {
+      continue;
+    }
+    if (++fem_bodies > kMaxFemBodies) {
+      fail(at("/bodies", b), "more than " + std::to_string(kMaxFemBodies) +
+                                 " FEM bodies in one scene (the coupling carries that many)");
+    }
+    for (std::size_t a = 0; a < body.fem->attached_to.size(); ++a) {
+      const FemAttachment& att = body.fem->attached_to[a];
+      const std::string ptr = at(at(at(at(at("/bodies", b), "fem"), "fixed"), "attached_to"), a);
+      const auto other = std::find_if(world.bodies.begin(), world.bodies.end(),
+                                      [&](const BodyDescription& o) { return o.name == att.body; });
+      if (other == world.bodies.end() || &*other == &body) {
+        fail(at(ptr, "body"), other == world.bodies.end()
+                                  ? "no body named '" + att.body + "' in /bodies"
+                                  : "a FEM body cannot be attached to itself");
+      }
+      if (!att.segment.empty() &&
+          std::none_of(other->segments.begin(), other->segments.end(),
+                       [&](const SegmentDescription& s) { return s.name == att.segment; })) {
+        fail(at(ptr, "segment"), "body '" + att.body + "' has no segment '" + att.segment + "'");
+      }
+    }
+  }
 }
 
 // A dynamic body's mass; its centre of mass and inertia follow from its shape at uniform density
@@ -302,10 +351,20 @@ void Parser::parse_dynamics(const Json& j, const std::string& ptr, BodyDescripti
 // How a deformable body deforms: vertex deflection, or the virtual sheet (its sheet geometry's
 // grid, with the Gaussian profile of "sheet").
 void Parser::parse_deformation(const Json& j, const std::string& ptr, BodyDescription& body) const {
-  const bool sheet = j.contains("deformation") && one_of(j["deformation"], at(ptr, "deformation"),
-                                                         {"deflection", "sheet"}) == "sheet";
+  const std::string how =
+      j.contains("deformation")
+          ? one_of(j["deformation"], at(ptr, "deformation"), {"deflection", "sheet", "fem"})
+          : std::string("deflection");
+  const bool sheet = how == "sheet";
   if (j.contains("deformation") && body.kind != BodyKind::kDeformable) {
     fail(at(ptr, "deformation"), "only a \"deformable\" body has a deformation");
+  }
+  if (how == "fem") {
+    if (j.contains("sheet")) {
+      fail(at(ptr, "sheet"), "sheet settings need \"deformation\": \"sheet\"");
+    }
+    body.deformation = BodyDeformation::kFem;
+    return;
   }
   if (j.contains("sheet") && !sheet) {
     fail(at(ptr, "sheet"), "sheet settings need \"deformation\": \"sheet\"");

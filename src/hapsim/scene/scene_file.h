@@ -1,6 +1,7 @@
 // Reading scene files ("format": "hapsim-scene/1", docs/scene-format.md, scenes/scene.schema.json)
 // into a SceneDescription: materials, bodies and their geometry (procedural knee, box, sphere,
-// sheet, a mesh file, a folder of mesh files (one segment each), or a CSG solid), tools, the
+// sheet, a mesh file, a folder of mesh files (one segment each), a CSG solid, or a FEM body's
+// volume: a tet_block or tet_mesh with its "fem" settings in fem_reader.h), tools, the
 // device and the run; or, for a teleoperation scene, the rig and its master device. This file
 // reads the top level, materials, bodies, tools and run; the parts have their own readers on the
 // same SceneReader (scene_reader.h: JSON pointers in errors, paths): geometry_reader.h (a body's

@@ -11,6 +11,7 @@
 #include "hapsim/render/assessment_markers.h"
 #include "hapsim/render/force_scale.h"
 #include "hapsim/render/world_scene.h"
+#include "hapsim/runtime/fem_thread.h"
 #include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
@@ -175,6 +176,7 @@ class WorldViewerSession final : public ViewerSession {
   }
   ~WorldViewerSession() override {
     loop_->stop();
+    fem_thread_.reset();  // nothing steps the FEM bodies while the world is not stepped
     if (recorder_) {
       drain_records();  // the last cycles too
       recorder_->close();
@@ -210,6 +212,7 @@ class WorldViewerSession final : public ViewerSession {
     snapshots.update();
     const WorldSnapshot& s = snapshots.read_slot();
     view_->update(s);
+    view_->update_fem_surfaces(*world_);
     if (s.teleop) {
       update_rig(s, *s.teleop);
     } else {
@@ -305,6 +308,7 @@ class WorldViewerSession final : public ViewerSession {
   // again, in step with the world. The probe stays where the user left it.
   void reset() override {
     loop_->stop();
+    fem_thread_.reset();  // nothing steps the FEM bodies while the world is not stepped
     if (recorder_) {
       // Cycles after a reset would not replay on one world: the recording ends here.
       drain_records();
@@ -419,6 +423,7 @@ class WorldViewerSession final : public ViewerSession {
     client_->set_paused(paused_);
     loop_ = std::make_unique<HapticLoop>(*device_, *client_);
     loop_->start();
+    fem_thread_ = std::make_unique<FemThread>(*world_);  // FEM bodies step on their own thread
   }
 
   // The rig's readout: the slave tool and the master hand, grasp and pad forces, ball, gripper,
@@ -511,6 +516,7 @@ class WorldViewerSession final : public ViewerSession {
   InteractiveDevice* mouse_ = nullptr;
   std::unique_ptr<WorldHapticClient> client_;
   std::unique_ptr<HapticLoop> loop_;
+  std::unique_ptr<FemThread> fem_thread_;
   std::unique_ptr<SessionRecorder> recorder_;
   std::size_t recorded_dropped_ = 0;
   std::vector<ContactMaterial> materials_;  // the UI's copy (the world's is the haptic thread's)

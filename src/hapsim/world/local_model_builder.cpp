@@ -2,6 +2,7 @@
 
 #include "hapsim/deform/sheet_profile.h"
 #include "hapsim/force/penalty_force.h"
+#include "hapsim/world/fem_coupling.h"
 
 #include <algorithm>
 #include <array>
@@ -56,6 +57,25 @@ void LocalModelBuilder::build(const WorldState& state, std::uint64_t sequence,
     const ContactMaterial& material = state.materials[model_->segments()[flat].material];
     LocalContactModel& m = out[t];
     const Mat3 nn = c.normal_world * c.normal_world.transpose();
+    if (model_->segments()[flat].fem) {
+      // A FEM body's contact already is a local model: its series stiffness (contact spring and
+      // the tissue's compliance from the FEM) and its cap travel on.
+      const auto& fem_bodies = model_->fem_bodies();
+      const auto b = static_cast<std::size_t>(
+          std::find(fem_bodies.begin(), fem_bodies.end(), static_cast<std::size_t>(c.body)) -
+          fem_bodies.begin());
+      const LocalContactModel& fm = state.fem_contacts[t * kMaxFemBodies + b].model;
+      const double cap = std::min(fm.max_normal_force_n, material.max_force_n);
+      if (c.force_n < cap * (1.0 - 1e-9)) {
+        m.stiffness_n_per_m += fm.stiffness_n_per_m;
+      }
+      m.damping_n_s_per_m += std::max(material.damping_n_s_per_m, 0.0) * nn;
+      m.max_normal_force_n += cap;
+      if (m.normal_world.isZero()) {
+        m.normal_world = c.normal_world;
+      }
+      continue;
+    }
     // A saturated spring (at its maximum penetration or force) pushes no harder deeper in.
     const bool saturated =
         c.depth_m >= material.max_penetration_m || c.force_n >= material.max_force_n * (1.0 - 1e-9);

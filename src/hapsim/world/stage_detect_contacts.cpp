@@ -101,8 +101,8 @@ void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) no
     const Vec3& p_world = tool.p_world;
     for (std::size_t i = 0; i < segs.size(); ++i) {
       const SegmentModel& seg = segs[i];
-      if (seg.response != ContactResponse::kPenalty) {
-        continue;
+      if (seg.response != ContactResponse::kPenalty || seg.fem) {
+        continue;  // FEM bodies: their local contact models (stage_fem_contacts.cpp)
       }
       const ContactMaterial& material = state.materials[seg.material];
       const Vec3 p_body = state.X_body_world(seg) * p_world;

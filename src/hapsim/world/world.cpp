@@ -3,6 +3,7 @@
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/deform/vertex_deflection.h"
+#include "hapsim/world/fem_coupling.h"
 #include "hapsim/world/world_step.h"
 
 #include <algorithm>
@@ -49,7 +50,20 @@ const TriangleMesh& World::surface(std::size_t body, std::size_t segment) const 
   if (seg.sheet) {
     return seg.sheet->mesh();
   }
+  if (model_.segments()[flat].fem && state_.fem) {
+    const auto& fem_bodies = model_.fem_bodies();
+    const auto it = std::find(fem_bodies.begin(), fem_bodies.end(), body);
+    return state_.fem->surface(static_cast<std::size_t>(it - fem_bodies.begin()));
+  }
   return seg.deflection ? seg.deflection->mesh() : model_.segments()[flat].description->mesh;
+}
+
+void World::set_fem_deferred(bool deferred) noexcept {
+  state_.fem_deferred = deferred;
+}
+
+bool World::advance_fem() {
+  return state_.fem && state_.fem->run_pending();
 }
 
 const VirtualSheet* World::sheet(std::size_t body) const {
@@ -80,6 +94,11 @@ const VertexDeflection* World::deflection(std::size_t body, std::size_t segment)
 }
 
 double World::current_deflection_m(std::size_t body, std::size_t segment) const {
+  if (state_.fem && model_.segments().at(flat_segment(body, segment)).fem) {
+    const auto& fem_bodies = model_.fem_bodies();
+    const auto it = std::find(fem_bodies.begin(), fem_bodies.end(), body);
+    return state_.fem->max_displacement_m(static_cast<std::size_t>(it - fem_bodies.begin()));
+  }
   const VertexDeflection* d = deflection(body, segment);
   return d != nullptr ? d->max_deflection_m() : 0.0;
 }

@@ -24,6 +24,7 @@
 
 namespace hapsim {
 
+class FemCoupling;
 class VertexDeflection;
 class VirtualSheet;
 
@@ -56,6 +57,18 @@ class World {
   /// model, the tissue must give way to what the hand felt, or the model's error over the delay
   /// comes back through the tissue. Entries beyond the tool count are ignored.
   void set_rendered_push(std::span<const double> push_n) noexcept;
+
+  /// FEM bodies (world/fem_coupling.h): by default each step runs the FEM update it launches
+  /// (deterministic, and the step pays for it). Deferred, the step only launches and adopts, and
+  /// whoever drives the FEM calls advance_fem(): an inline session between cycles (the same
+  /// updates at the same steps: the same bits), or the FEM thread in real time.
+  void set_fem_deferred(bool deferred) noexcept;
+  /// Runs the newest launched FEM update not yet run; false when there was none (or no FEM
+  /// body). Only one thread may call it; it may run beside the stepping thread.
+  bool advance_fem();
+  /// The FEM bodies' coupling, or null when the world has none.
+  [[nodiscard]] FemCoupling* fem() { return state_.fem.get(); }
+  [[nodiscard]] const FemCoupling* fem() const { return state_.fem.get(); }
 
   /// The description the world was built from (materials as described: live edits are in
   /// material_contact()).

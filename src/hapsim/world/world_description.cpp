@@ -48,7 +48,15 @@ std::string_view to_string(BodyKind kind) {
 }
 
 std::string_view to_string(BodyDeformation deformation) {
-  return deformation == BodyDeformation::kGaussianSheet ? "sheet" : "deflection";
+  switch (deformation) {
+    case BodyDeformation::kGaussianSheet:
+      return "sheet";
+    case BodyDeformation::kFem:
+      return "fem";
+    case BodyDeformation::kVertexDeflection:
+      break;
+  }
+  return "deflection";
 }
 
 namespace {
@@ -221,6 +229,44 @@ std::string content_hash(const WorldDescription& description) {
       h.number(b.sheet_profile.cutoff_radius_m);
       h.number(b.sheet_profile.width_m);
       h.number(b.sheet_profile.sensitivity_n_per_m);
+    }
+    if (b.kind == BodyKind::kDeformable && b.deformation == BodyDeformation::kFem && b.fem) {
+      // The volume, its materials, supports and solver: all of it steps differently.
+      const FemBodyDescription& f = *b.fem;
+      h.text("fem");
+      for (const Vec3& v : f.tets.nodes) {
+        h.bytes(v.data(), sizeof(double) * 3);
+      }
+      for (const TetIndices& t : f.tets.tets) {
+        h.bytes(t.data(), sizeof(std::uint32_t) * 4);
+      }
+      for (const std::int32_t r : f.tets.regions) {
+        h.number(r);
+      }
+      for (const FemRegionMaterial& m : f.materials) {
+        for (const double x : {static_cast<double>(m.region), m.material.youngs_modulus_pa,
+                               m.material.poisson_ratio, m.material.density_kg_per_m3,
+                               m.material.rayleigh_mass_per_s, m.material.rayleigh_stiffness_s}) {
+          h.number(x);
+        }
+      }
+      for (const double x :
+           {static_cast<double>(f.options.elasticity), static_cast<double>(f.options.integration),
+            f.options.dt_s, static_cast<double>(f.options.max_cg_iterations),
+            f.options.cg_relative_tolerance, static_cast<double>(f.options.quasi_static_iterations),
+            f.fixed_below_z_m.value_or(-kInf), f.contact_patch_radius_m, f.contact_margin_m,
+            f.embedded_surface ? 1.0 : 0.0}) {
+        h.number(x);
+      }
+      h.bytes(f.options.gravity_m_per_s2.data(), sizeof(double) * 3);
+      for (const std::uint32_t n : f.fixed_nodes) {
+        h.number(n);
+      }
+      for (const FemAttachment& a : f.attached_to) {
+        h.text(a.body);
+        h.text(a.segment);
+        h.number(a.within_m);
+      }
     }
     for (const SegmentDescription& s : b.segments) {
       h.text(s.name);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "hapsim/core/types.h"
+#include "hapsim/deform/fem_body_description.h"
 #include "hapsim/deform/sheet_profile.h"
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/deform/virtual_sheet.h"
@@ -62,6 +63,9 @@ enum class BodyDeformation : std::uint8_t {
   /// The virtual sheet (paper 000 §3.2.2): an N×N height grid displaced by the Gaussian profile of
   /// every force pressing it this step; a sphere resting on it transcribes its lower cap.
   kGaussianSheet,
+  /// A volumetric FEM body (SPEC §12): tetrahedra, linear or corotational elasticity, on its own
+  /// thread; touched through the local contact model it hands the haptic path (fem_coupling.h).
+  kFem,
 };
 
 [[nodiscard]] std::string_view to_string(ContactResponse response);
@@ -130,6 +134,9 @@ struct BodyDescription {
   VirtualSheetOptions sheet;
   /// The sheet's Gaussian profile (d0, ξ, F0; the paper's by default).
   GaussianSheetParams sheet_profile;
+  /// kFem: the volume, its materials, fixed nodes and solver; the body's one segment is its
+  /// surface at rest (the tets' boundary, or a finer mesh embedded in them).
+  std::shared_ptr<const FemBodyDescription> fem;
 };
 
 /// The most tools a world has: what a cycle's record, the run's accounting and the snapshots carry

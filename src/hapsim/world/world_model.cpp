@@ -228,15 +228,25 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
       if (s == 0 && sheet) {
         check_sheet(description_, body);
       }
+      const bool fem =
+          body.kind == BodyKind::kDeformable && body.deformation == BodyDeformation::kFem;
+      if (fem && (!body.fem || body.segments.size() != 1)) {
+        throw Error("body '" + body.name + "'",
+                    "a FEM body needs its volume and exactly one segment (its surface)");
+      }
+      if (fem && s == 0) {
+        fem_bodies_.push_back(b);
+      }
       SegmentModel seg;
       seg.sheet = sheet;
+      seg.fem = fem;
       seg.dynamic = body.kind == BodyKind::kDynamic;
       seg.body = b;
       seg.index_in_body = s;
       seg.description = &sd;
       seg.material = sd.material;
       seg.response = description_.materials[sd.material].response;
-      seg.deformable = body.kind == BodyKind::kDeformable && !sheet;
+      seg.deformable = body.kind == BodyKind::kDeformable && !sheet && !fem;  // vertex deflection
       seg.X_world_body = body.X_world_body;
       seg.X_body_world = body.X_world_body.inverse();
       seg.rest_bounds_body = sd.mesh.bounds();
@@ -247,7 +257,9 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
         seg.rest_bounds_body.extend(seg.rest_bounds_body.min() - Vec3(0.0, 0.0, deepest));
       }
       seg.rest_query = make_query(body.method, sd);
-      (seg.response == ContactResponse::kProxy ? proxy_segments_ : penalty_segments_) += 1;
+      if (!fem) {
+        (seg.response == ContactResponse::kProxy ? proxy_segments_ : penalty_segments_) += 1;
+      }
       segments_.push_back(std::move(seg));
     }
   }

@@ -63,6 +63,9 @@ struct SegmentModel {
   ContactResponse response = ContactResponse::kProxy;
   bool deformable = false;
   bool sheet = false;  ///< a Gaussian sheet: contact with its live field (WorldState), not rest
+  /// A FEM body's surface: touched only through its local contact models (stage_fem_contacts),
+  /// never through its rest query or the god-object.
+  bool fem = false;
   bool dynamic = false;
   /// The body's pose at the start (a dynamic body's current pose is in WorldState::bodies).
   Iso3 X_world_body = Iso3::Identity();
@@ -111,6 +114,9 @@ class WorldModel {
   [[nodiscard]] const std::vector<std::size_t>& dynamic_segments() const {
     return dynamic_segments_;
   }
+  /// Indices of the FEM bodies (BodyDeformation::kFem), in body order: FEM body b is
+  /// fem_bodies()[b] (world/fem_coupling.h).
+  [[nodiscard]] const std::vector<std::size_t>& fem_bodies() const { return fem_bodies_; }
   /// Whether some dynamic body is not an exact sphere (it meets others through its vertices).
   [[nodiscard]] bool has_dynamic_meshes() const { return has_dynamic_meshes_; }
   [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const {
@@ -145,6 +151,7 @@ class WorldModel {
   std::vector<BodyModel> bodies_;
   std::vector<std::size_t> dynamic_bodies_;
   std::vector<std::size_t> dynamic_segments_;
+  std::vector<std::size_t> fem_bodies_;
   bool has_dynamic_meshes_ = false;
   std::vector<std::size_t> body_first_segment_;
   std::size_t proxy_segments_ = 0;

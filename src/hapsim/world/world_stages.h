@@ -17,6 +17,8 @@
 //                    penalty segments: F = k·x with damping and friction, the reaction on a dynamic
 //                    body, the push on a sheet; contacts reported, deformation fed; a rig's grasp
 //                    read off its pads' contacts with the ball
+//   fem_contacts     FEM bodies: the local contact model the FEM thread handed over, at the tool's
+//                    fresh position (series stiffness, damping floor, cap, push-only)
 //   integrate        dynamic bodies move under gravity and this step's forces (semi-implicit Euler,
 //                    the contacts' springs and dampers taken implicitly)
 //   deform           deformable segments deflect under this step's contacts (eq. 1), the rest
@@ -47,6 +49,9 @@ void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) no
 /// contacts are found and answered where they are found; stage_body_contacts.cpp).
 void body_contacts(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void respond(const WorldModel& model, WorldState& state, double dt_s) noexcept;
+/// FEM bodies: each tool's local contact model from the FEM side, rendered at the tool's fresh
+/// position (stage_fem_contacts.cpp); the force is added to the tool's and kept as the FEM's load.
+void fem_contacts(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void integrate(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void deform(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 void safety(const WorldModel& model, WorldState& state) noexcept;

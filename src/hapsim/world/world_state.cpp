@@ -1,5 +1,7 @@
 #include "hapsim/world/world_state.h"
 
+#include "hapsim/world/fem_coupling.h"
+
 #include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/collision/sphere_tree.h"
@@ -259,7 +261,7 @@ WorldState::WorldState(const WorldModel& model) {
   for (ToolRuntime& tool : tools) {
     for (std::size_t i = 0; i < segs.size(); ++i) {
       const SegmentModel& seg = segs[i];
-      if (seg.response != ContactResponse::kProxy) {
+      if (seg.response != ContactResponse::kProxy || seg.fem) {
         continue;
       }
       tool.surfaces.push_back(ProxySurface{seg.rest_query.get(), seg.X_world_body,
@@ -270,11 +272,15 @@ WorldState::WorldState(const WorldModel& model) {
   }
   tool_states.resize(tool_count);
   rendered_push_n.assign(tool_count, std::numeric_limits<double>::quiet_NaN());
-  // Per tool: at most kMaxContacts proxy contacts plus one per penalty segment.
+  // Per tool: at most kMaxContacts proxy contacts plus one per penalty segment and FEM body.
   contacts.resize(std::max<std::size_t>(
-      tool_count *
-          (static_cast<std::size_t>(GodObject::kMaxContacts) + model.penalty_segment_count()),
+      tool_count * (static_cast<std::size_t>(GodObject::kMaxContacts) +
+                    model.penalty_segment_count() + model.fem_bodies().size()),
       1));
+  if (!model.fem_bodies().empty()) {
+    fem_contacts.assign(tool_count * kMaxFemBodies, FemToolContact{});
+    fem = std::make_unique<FemCoupling>(model);
+  }
   if (d.teleop) {
     rig = std::make_unique<RigState>(*d.teleop);
     find_slave_collision_pairs(model, *rig);
@@ -327,6 +333,10 @@ void WorldState::reset() {
   vertex_pass = 0;
   std::fill(sheet_depth_m.begin(), sheet_depth_m.end(), 0.0);
   body_contact_count = 0;
+  std::fill(fem_contacts.begin(), fem_contacts.end(), FemToolContact{});
+  if (fem) {
+    fem->reset();
+  }
   for (ToolState& state : tool_states) {
     state = ToolState{};
   }

@@ -14,6 +14,7 @@
 #include "hapsim/force/contact_friction.h"
 #include "hapsim/force/contact_material.h"
 #include "hapsim/force/god_object.h"
+#include "hapsim/force/local_contact_model.h"
 #include "hapsim/kinematics/slave_follower.h"
 #include "hapsim/world/world_description.h"
 #include "hapsim/world/world_model.h"
@@ -27,6 +28,7 @@
 namespace hapsim {
 
 class MeshBvh;
+class FemCoupling;
 
 /// One contact of one tool with one segment this step.
 struct WorldContact {
@@ -230,6 +232,14 @@ struct SegmentState {
   std::vector<std::uint32_t> vertex_pass;
 };
 
+/// One tool against one FEM body (fem_coupling.h): the local contact model the FEM side handed
+/// the haptic path (adopted before the step), and the force the step rendered from it.
+struct FemToolContact {
+  LocalContactModel model;
+  /// Respond stage: this step's force on the tool from the body, world frame (the FEM's load).
+  Vec3 push_world_n = Vec3::Zero();
+};
+
 /// Per-step state of one tool.
 struct ToolRuntime {
   GodObject proxy;                           ///< respond stage
@@ -364,6 +374,18 @@ struct WorldState {
   /// Deform stage: per sheet (in flat segment order), its deepest dent below rest.
   std::vector<double> sheet_depth_m;
   std::unique_ptr<RigState> rig;  ///< when the world has a teleoperation rig
+  /// Per (tool t, FEM body b): [t · kMaxFemBodies + b] (world/fem_coupling.h); empty without FEM
+  /// bodies.
+  std::vector<FemToolContact> fem_contacts;
+  /// The FEM bodies and their coupling to the cycle (null without FEM bodies). The step adopts
+  /// and launches; FemCoupling::run_pending() runs on the FEM side (World::advance_fem).
+  std::unique_ptr<FemCoupling> fem;
+  /// False: the step itself runs each FEM update right after launching it (tests, replays:
+  /// deterministic, costly steps). True: someone else calls World::advance_fem() (an inline
+  /// session between cycles, or the FEM thread in real time).
+  bool fem_deferred = false;
+  /// Updates the step ran itself that failed (an exception from the solver), counted.
+  std::uint64_t fem_failures = 0;
   double time_s = 0.0;
   /// Steps taken since construction or reset (the first step is 1).
   std::uint64_t step_index = 0;

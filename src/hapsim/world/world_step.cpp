@@ -1,5 +1,6 @@
 #include "hapsim/world/world_step.h"
 
+#include "hapsim/world/fem_coupling.h"
 #include "hapsim/world/world_stages.h"
 
 #include <algorithm>
@@ -46,6 +47,9 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   refresh_materials(model, state, dt);
   state.time_s += dt;
   ++state.step_index;
+  if (state.fem) {
+    state.fem->adopt(state, dt);  // the update due at this step, if any
+  }
   state.contact_count = 0;
   state.dropped_contacts = 0;
   state.pop_throughs = 0;
@@ -70,9 +74,20 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   stage::detect_contacts(model, state, dt);
   stage::body_contacts(model, state, dt);
   stage::respond(model, state, dt);
+  stage::fem_contacts(model, state, dt);
   stage::integrate(model, state, dt);
   stage::deform(model, state, dt);
   stage::safety(model, state);
+  if (state.fem) {
+    state.fem->capture(model, state);
+    if (!state.fem_deferred) {
+      try {
+        state.fem->run_pending();  // inline: deterministic, at the cost of this step
+      } catch (...) {
+        ++state.fem_failures;
+      }
+    }
+  }
   std::fill(state.rendered_push_n.begin(), state.rendered_push_n.end(),
             std::numeric_limits<double>::quiet_NaN());  // one step's input
 

@@ -1,0 +1,750 @@
+#include "bench/fem_cases.h"
+
+#include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/core/error.h"
+#include "hapsim/core/statistics.h"
+#include "hapsim/core/stopwatch.h"
+#include "hapsim/deform/fem_body_description.h"
+#include "hapsim/force/local_contact_model.h"
+#include "hapsim/geometry/tet_mesh.h"
+#include "hapsim/world/fem_coupling.h"
+#include "hapsim/world/world.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <numbers>
+#include <sstream>
+
+namespace hapsim::bench {
+namespace {
+
+constexpr double kHapticDtS = 1e-3;
+// The palpation's geometry: from 1 mm above the first touch, 6 mm beyond it, 20 mm sideways.
+constexpr double kClearanceM = 0.001;
+constexpr double kDepthM = 0.006;
+constexpr double kSlideM = 0.020;
+// The haptic-step run: down at x = −10 mm at 20 mm/s, then to and fro along x, pressed.
+constexpr double kHapticSpeedMPerS = 0.020;
+// The bare solver's load: a press on the top's centre, 0 → 2 N → 0 once a second.
+constexpr double kPressPeakN = 2.0;
+constexpr double kPressPeriodS = 1.0;
+// The reference's Newton iteration on the contact force.
+constexpr int kReferenceMaxIterations = 60;
+constexpr int kReferencePlainIterations = 6;
+constexpr double kReferenceForceTolN = 1e-4;  // the corotational solves' own noise is ~2e-5 N
+// A patch moved by 10 µm changes its weights by under 0.3 %; a normal by 1e-3, the force's
+// direction by 0.1 %.
+constexpr double kReferencePointTolM = 1e-5;
+constexpr double kReferenceNormalTol = 1e-3;
+
+std::uint32_t as_node(std::size_t i) { return static_cast<std::uint32_t>(i); }
+
+// The nodes the block's world fixes: its bottom face (FemBodyDescription::fixed_below_z_m).
+constexpr double kFixedBelowZM = 1e-6;
+
+std::vector<std::uint32_t> bottom_nodes(const TetMesh& tets) {
+  std::vector<std::uint32_t> fixed;
+  for (std::size_t i = 0; i < tets.nodes.size(); ++i) {
+    if (tets.nodes[i].z() <= kFixedBelowZM) {
+      fixed.push_back(as_node(i));
+    }
+  }
+  return fixed;
+}
+
+TetMesh block_tets(const FemBlockSpec& spec) {
+  TetMesh tets = make_tet_block(spec.size_m, spec.cells);
+  tets.transform(Iso3(Eigen::Translation3d(-0.5 * spec.size_m.x(), -0.5 * spec.size_m.y(), 0.0)));
+  return tets;
+}
+
+FemOptions block_options(const FemBlockSpec& spec) {
+  FemOptions o;
+  o.elasticity = spec.elasticity;
+  o.integration = spec.integration;
+  o.dt_s = spec.dt_s;
+  return o;
+}
+
+// The coupling's contact patch (world/fem_coupling.cpp, update_body), restated: the surface
+// vertices within the patch radius of the contact point, weighted by 1 − (r/R)², or the closest
+// triangle's corners when none is that close; weights summing to one.
+void contact_patch(const TriangleMesh& surface, const std::vector<std::uint32_t>& node_of_vertex,
+                   const SurfacePoint& sp, double radius_m, std::vector<FemNodeWeight>& patch) {
+  patch.clear();
+  double sum = 0.0;
+  const double r2 = radius_m * radius_m;
+  for (std::size_t v = 0; v < surface.vertices.size(); ++v) {
+    const double d2 = (surface.vertices[v] - sp.point).squaredNorm();
+    if (d2 < r2) {
+      const double w = 1.0 - d2 / r2;
+      patch.push_back({node_of_vertex[v], w});
+      sum += w;
+    }
+  }
+  if (!(sum > 0.0) && sp.triangle < surface.triangles.size()) {
+    for (const std::uint32_t c : surface.triangles[sp.triangle]) {
+      patch.push_back({node_of_vertex[c], 1.0 / 3.0});
+      sum += 1.0 / 3.0;
+    }
+  }
+  if (!(sum > 0.0)) {
+    patch.clear();
+    return;
+  }
+  for (FemNodeWeight& w : patch) {
+    w.weight /= sum;
+  }
+}
+
+DeviceInput probe_at(const Vec3& p_world, double time_s) {
+  DeviceInput in;
+  in.time_s = time_s;
+  in.p_world = p_world;
+  return in;
+}
+
+std::string elasticity_name(FemElasticity e) { return std::string(to_string(e)); }
+
+}  // namespace
+
+std::array<int, 3> fem_block_cells(const Vec3& size_m, std::size_t target_tets) {
+  const double volume = size_m.x() * size_m.y() * size_m.z();
+  const double h = std::cbrt(6.0 * volume / static_cast<double>(std::max<std::size_t>(target_tets, 6)));
+  std::array<int, 3> cells{};
+  for (int a = 0; a < 3; ++a) {
+    cells[static_cast<std::size_t>(a)] = std::max(1, static_cast<int>(std::lround(size_m[a] / h)));
+  }
+  return cells;
+}
+
+WorldDescription fem_block_world(const FemBlockSpec& spec) {
+  WorldDescription w;
+  w.name = "fem-bench-block";
+  MaterialDescription m;
+  m.name = "soft_block";
+  m.response = ContactResponse::kPenalty;
+  m.contact.stiffness_n_per_m = spec.contact_stiffness_n_per_m;
+  m.contact.damping_n_s_per_m = spec.contact_damping_n_s_per_m;
+  m.contact.max_force_n = spec.max_force_n;
+  m.contact.max_penetration_m = 0.02;
+  w.materials.push_back(m);
+  auto fem = std::make_shared<FemBodyDescription>();
+  fem->tets = block_tets(spec);
+  fem->materials = {{0, spec.material}};
+  fem->options = block_options(spec);
+  fem->fixed_below_z_m = kFixedBelowZM;
+  fem->contact_patch_radius_m = spec.patch_radius_m;
+  fem->source = "fem bench block";
+  BodyDescription b;
+  b.name = "block";
+  b.kind = BodyKind::kDeformable;
+  b.deformation = BodyDeformation::kFem;
+  SegmentDescription s;
+  s.name = "block";
+  s.material = 0;
+  s.mesh = tet_boundary(fem->tets).surface;
+  b.segments.push_back(std::move(s));
+  b.fem = fem;
+  w.bodies.push_back(std::move(b));
+  w.tools.push_back(ToolDescription{"tip", spec.tool_radius_m, Vec3::Zero(), -1});
+  return w;
+}
+
+// --- the full solve ------------------------------------------------------------------------------
+
+struct FemContactReference::Impl {
+  double k_c = 0.0;
+  double tool_radius_m = 0.0;
+  double patch_radius_m = 0.0;
+  std::unique_ptr<FemBody> body;
+  TriangleMesh surface;
+  std::vector<std::uint32_t> node_of_vertex;
+  std::unique_ptr<MeshBvh> bvh;
+  QueryHint hint;
+  // The load on the body now (solved): its force along its normal on its patch.
+  double applied_n = 0.0;
+  Vec3 applied_normal = Vec3::UnitZ();
+  Vec3 applied_point = Vec3::Zero();
+  std::vector<FemNodeWeight> patch;
+  std::vector<FemNodeForce> loads;
+
+  void refresh_surface() {
+    const std::vector<Vec3>& x = body->positions();
+    for (std::size_t v = 0; v < surface.vertices.size(); ++v) {
+      surface.vertices[v] = x[node_of_vertex[v]];
+    }
+    bvh->refit();
+  }
+};
+
+FemContactReference::FemContactReference(const FemBlockSpec& spec) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  FemBlockSpec quasi_static = spec;
+  quasi_static.integration = FemIntegration::kQuasiStatic;
+  m.k_c = spec.contact_stiffness_n_per_m;
+  m.tool_radius_m = spec.tool_radius_m;
+  m.patch_radius_m = std::max(spec.patch_radius_m, spec.tool_radius_m);
+  TetMesh tets = block_tets(spec);
+  const TetBoundary boundary = tet_boundary(tets);
+  m.surface = boundary.surface;
+  m.node_of_vertex = boundary.node_of_vertex;
+  const std::vector<std::uint32_t> fixed = bottom_nodes(tets);
+  m.body = std::make_unique<FemBody>(std::move(tets), std::vector<FemRegionMaterial>{FemRegionMaterial{0, spec.material}},
+                                     fixed, block_options(quasi_static), "fem bench reference");
+  m.bvh = std::make_unique<MeshBvh>(m.surface);
+}
+
+FemContactReference::~FemContactReference() = default;
+
+Vec3 FemContactReference::force_at(const Vec3& p_m) {
+  Impl& m = *impl_;
+  // Newton on g(F) = F − k_c·max(0, penetration(F)), slope 1 + k_c·c with c the patch's
+  // condensed compliance along the normal; converged when g is below the tolerance and the
+  // contact point and normal the load went on (hence the patch and the load's direction) no
+  // longer move. After a few plain iterations the point and normal are the running mean of the
+  // iterates: on a mesh coarser than the patch the load sits on one node, which sinks into a
+  // funnel whose facets take turns at being closest to the tool (no fixed point; the
+  // penetration, a distance, stays continuous), and the mean is the symmetric answer.
+  for (int it = 1; it <= kReferenceMaxIterations; ++it) {
+    const SurfacePoint sp = m.bvh->closest_point(p_m, &m.hint);
+    if (!sp.found()) {
+      throw Error("fem bench reference", "the block's surface answered no closest point");
+    }
+    const double penetration = m.tool_radius_m - sp.signed_distance;
+    const double g = m.applied_n - m.k_c * std::max(0.0, penetration);
+    SurfacePoint at = sp;
+    if (m.applied_n > 0.0 && it > kReferencePlainIterations) {
+      const double w = 1.0 / static_cast<double>(it - kReferencePlainIterations + 1);
+      at.point = m.applied_point + w * (sp.point - m.applied_point);
+      at.normal = (m.applied_normal + w * (sp.normal - m.applied_normal)).normalized();
+    }
+    const bool same_contact = m.applied_n == 0.0 ||
+                              ((at.point - m.applied_point).norm() <= kReferencePointTolM &&
+                               (at.normal - m.applied_normal).norm() <= kReferenceNormalTol);
+    if (std::abs(g) <= kReferenceForceTolN && same_contact) {
+      max_iterations = std::max(max_iterations, it);
+      return m.applied_n * m.applied_normal;
+    }
+    contact_patch(m.surface, m.node_of_vertex, at, m.patch_radius_m, m.patch);
+    const double compliance = m.patch.empty() ? 0.0 : m.body->compliance_along(m.patch, at.normal);
+    const double slope = 1.0 + m.k_c * std::max(0.0, compliance);
+    const double next_n = std::max(0.0, m.applied_n - g / slope);
+    m.loads.clear();
+    for (const FemNodeWeight& w : m.patch) {
+      m.loads.push_back({w.node, -next_n * w.weight * at.normal});
+    }
+    m.body->set_loads(m.loads);
+    const FemStepStats st = m.body->solve_static();
+    if (std::getenv("FEMDBG")) {
+      std::fprintf(stderr, "it %d pen %.6g g %.3g F %.5g->%.5g dpt %.3g dn %.3g c %.4g cg %d conv %d ms %.2f patch %zu\n", it,
+                   penetration, g, m.applied_n, next_n, (at.point - m.applied_point).norm(),
+                   (at.normal - m.applied_normal).norm(), compliance, st.cg_iterations, st.converged ? 1 : 0, st.solve_ms, m.patch.size());
+    }
+    ++solves;
+    m.applied_n = next_n;
+    m.applied_normal = at.normal;
+    m.applied_point = at.point;
+    m.refresh_surface();
+  }
+  max_iterations = std::max(max_iterations, kReferenceMaxIterations);
+  ++unconverged;
+  return m.applied_n * m.applied_normal;
+}
+
+// --- the palpation -------------------------------------------------------------------------------
+
+double FemPalpationPath::length_m() const {
+  return (pressed_m - start_m).norm() + (slid_m - pressed_m).norm() + (end_m - slid_m).norm();
+}
+
+Vec3 FemPalpationPath::at(double s_m) const {
+  const std::array<Vec3, 4> corners{start_m, pressed_m, slid_m, end_m};
+  double s = std::max(0.0, s_m);
+  for (std::size_t k = 0; k + 1 < corners.size(); ++k) {
+    const double leg = (corners[k + 1] - corners[k]).norm();
+    if (s <= leg || k + 2 == corners.size()) {
+      return corners[k] + (corners[k + 1] - corners[k]) * std::min(1.0, s / leg);
+    }
+    s -= leg;
+  }
+  return end_m;
+}
+
+FemPalpationPath fem_palpation_path(const FemBlockSpec& spec) {
+  const double touch_z = spec.size_m.z() + spec.tool_radius_m;
+  const double x0 = -0.5 * kSlideM;
+  FemPalpationPath p;
+  p.start_m = Vec3(x0, 0.0, touch_z + kClearanceM);
+  p.pressed_m = Vec3(x0, 0.0, touch_z - kDepthM);
+  p.slid_m = Vec3(x0 + kSlideM, 0.0, touch_z - kDepthM);
+  p.end_m = Vec3(x0 + kSlideM, 0.0, touch_z + kClearanceM);
+  return p;
+}
+
+double FemErrorRow::max_error_percent() const {
+  return peak_force_n > 0.0 ? 100.0 * max_error_n / peak_force_n : 0.0;
+}
+
+double FemErrorRow::rms_error_percent() const {
+  return peak_force_n > 0.0 ? 100.0 * rms_error_n / peak_force_n : 0.0;
+}
+
+double fem_error_target_fraction(double speed_m_per_s) {
+  if (std::abs(speed_m_per_s - 0.010) < 1e-9) {
+    return 0.05;
+  }
+  if (std::abs(speed_m_per_s - 0.050) < 1e-9) {
+    return 0.10;
+  }
+  return 0.0;
+}
+
+bool fem_error_meets_target(const FemErrorRow& row) {
+  const double fraction = fem_error_target_fraction(row.speed_m_per_s);
+  if (fraction <= 0.0) {
+    return true;
+  }
+  // 10 mm/s: "within 5 % (or 0.05 N)"; 50 mm/s: within 10 %.
+  const double floor_n = fraction <= 0.05 ? 0.05 : 0.0;
+  return row.max_error_n <= std::max(fraction * row.peak_force_n, floor_n);
+}
+
+FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
+                                                 const std::vector<double>& speeds_m_per_s,
+                                                 double reference_spacing_m,
+                                                 const ProgressFn& progress) {
+  spec.integration = FemIntegration::kQuasiStatic;
+  const FemPalpationPath path = fem_palpation_path(spec);
+  if (const char* hold = std::getenv("FEMHOLD")) {
+    const double depth = std::atof(hold);
+    const Vec3 p(-0.01, 0.0, spec.size_m.z() + spec.tool_radius_m - depth);
+    World world(fem_block_world(spec));
+    Vec3 f = Vec3::Zero();
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 q = path.start_m + std::min(1.0, i / 500.0) * (p - path.start_m);
+      f = world.step(probe_at(q, i * 1e-3), 1e-3).command.force_world_n;
+      if (i % 100 == 99) std::fprintf(stderr, "world %d %.6f %.6f %.6f\n", i, f.x(), f.y(), f.z());
+    }
+    FemContactReference ref(spec);
+    for (int k = 1; k <= 10; ++k) {
+      const Vec3 r = ref.force_at(path.start_m + (k / 10.0) * (p - path.start_m));
+      std::fprintf(stderr, "ref %d %.6f %.6f %.6f it %d\n", k, r.x(), r.y(), r.z(), ref.max_iterations);
+    }
+  }
+  const double length = path.length_m();
+  FemLocalModelError out;
+  // The full solve along the path (it depends on the position only: quasi-static, elastic,
+  // frictionless), once for every speed.
+  const auto intervals = static_cast<std::size_t>(std::ceil(length / std::max(reference_spacing_m, 1e-6)));
+  const double ds = length / static_cast<double>(intervals);
+  std::vector<Vec3> reference(intervals + 1);
+  {
+    const Stopwatch watch;
+    FemContactReference full(spec);
+    for (std::size_t j = 0; j <= intervals; ++j) {
+      reference[j] = full.force_at(path.at(static_cast<double>(j) * ds));
+      if (j % 32 == 0) {
+        report_progress(progress, "full solve along the path",
+                        0.5 * static_cast<double>(j) / static_cast<double>(intervals));
+      }
+    }
+    out.reference_points = intervals + 1;
+    out.reference_solves = full.solves;
+    out.reference_max_iterations = full.max_iterations;
+    out.reference_unconverged = full.unconverged;
+    out.reference_ms = watch.elapsed_ms();
+  }
+  const auto reference_at = [&](double s) -> Vec3 {
+    const double u = std::clamp(s / ds, 0.0, static_cast<double>(intervals));
+    const auto j = std::min(static_cast<std::size_t>(u), intervals - 1);
+    const double f = u - static_cast<double>(j);
+    return (1.0 - f) * reference[j] + f * reference[j + 1];
+  };
+  double peak = 0.0;
+  for (const Vec3& f : reference) {
+    peak = std::max(peak, f.norm());
+  }
+
+  for (std::size_t k = 0; k < speeds_m_per_s.size(); ++k) {
+    const double v = speeds_m_per_s[k];
+    char label[64];
+    std::snprintf(label, sizeof label, "local model at %.0f mm/s", v * 1e3);
+    report_progress(progress, label,
+                    0.5 + 0.5 * static_cast<double>(k) / static_cast<double>(speeds_m_per_s.size()));
+    World world(fem_block_world(spec));
+    world.set_fem_deferred(true);
+    const double duration = 2.0 * kFemPathHoldS + length / v;
+    const auto steps = static_cast<std::size_t>(std::lround(duration / kHapticDtS));
+    const ContactMaterial& material = world.description().materials[0].contact;
+    FemErrorRow row;
+    row.speed_m_per_s = v;
+    row.steps = steps;
+    row.peak_force_n = peak;
+    double sum2 = 0.0;
+    double sum2_spring = 0.0;
+    for (std::size_t i = 0; i < steps; ++i) {
+      const double t = static_cast<double>(i) * kHapticDtS;
+      const double s = std::clamp(v * (t - kFemPathHoldS), 0.0, length);
+      const Vec3 p = path.at(s);
+      const Vec3 rendered = world.step(probe_at(p, t), kHapticDtS).command.force_world_n;
+      // The model's spring alone (the stage's push before its damping), at this position.
+      const LocalContactModel& model = world.state().fem_contacts[0].model;
+      Vec3 spring = Vec3::Zero();
+      if (model.valid && (p - model.x0_world_m).norm() <= model.validity_radius_m) {
+        const double push = model.normal_world.dot(local_model_force(model, p, model.v0_world_m_per_s));
+        if (push > 0.0 && std::isfinite(push)) {
+          spring = std::min(push, std::min(model.max_normal_force_n, material.max_force_n)) *
+                   model.normal_world;
+        }
+      }
+      world.advance_fem();
+      const Vec3 ref = reference_at(s);
+      if (std::getenv("FEMDBG2") && i % 10 == 0) {
+        std::fprintf(stderr, "t %.3f s %.4f p %.4f %.4f  F %.4f %.4f %.4f  ref %.4f %.4f %.4f  n %.3f %.3f %.3f\n", t, s, p.x(), p.z(),
+                     rendered.x(), rendered.y(), rendered.z(), ref.x(), ref.y(), ref.z(), model.normal_world.x(), model.normal_world.y(), model.normal_world.z());
+      }
+      if (rendered.norm() > 0.0 || ref.norm() > 0.0) {
+        ++row.contact_steps;
+        const double e = (rendered - ref).norm();
+        const double e_spring = (spring - ref).norm();
+        sum2 += e * e;
+        sum2_spring += e_spring * e_spring;
+        if (e > row.max_error_n) {
+          row.max_error_n = e;
+          row.max_error_at_m = s;
+        }
+        row.max_spring_error_n = std::max(row.max_spring_error_n, e_spring);
+      }
+    }
+    if (row.contact_steps > 0) {
+      row.rms_error_n = std::sqrt(sum2 / static_cast<double>(row.contact_steps));
+      row.rms_spring_error_n = std::sqrt(sum2_spring / static_cast<double>(row.contact_steps));
+    }
+    out.rows.push_back(row);
+  }
+  return out;
+}
+
+// --- the whole benchmark -------------------------------------------------------------------------
+
+namespace {
+
+void measure_solver(const FemBlockSpec& spec, int steps, FemBenchRow& row) {
+  FemBlockSpec dynamic = spec;
+  dynamic.integration = FemIntegration::kBackwardEuler;
+  TetMesh tets = block_tets(dynamic);
+  const TetBoundary boundary = tet_boundary(tets);
+  const std::vector<std::uint32_t> fixed = bottom_nodes(tets);
+  const Stopwatch build;
+  FemBody body(std::move(tets), std::vector<FemRegionMaterial>{FemRegionMaterial{0, spec.material}},
+               fixed, block_options(dynamic), "fem bench");
+  row.build_ms = build.elapsed_ms();
+  row.tets = body.tet_count();
+  row.nodes = body.node_count();
+  row.unknowns = body.unknowns();
+  row.factorisation_ms = body.factorisation_ms();
+  row.factor_memory_bytes = body.factor_memory_bytes();
+  row.factor_nonzeros = body.factor_nonzeros();
+  // The press: on the top's centre, over the coupling's patch about it.
+  SurfacePoint top;
+  top.point = Vec3(0.0, 0.0, spec.size_m.z());
+  top.normal = Vec3::UnitZ();
+  std::vector<FemNodeWeight> patch;
+  contact_patch(boundary.surface, boundary.node_of_vertex, top,
+                std::max(spec.patch_radius_m, spec.tool_radius_m), patch);
+  std::vector<FemNodeForce> loads;
+  std::vector<double> ms;
+  ms.reserve(static_cast<std::size_t>(steps));
+  long cg_sum = 0;
+  for (int i = 0; i < steps; ++i) {
+    const double t = (i + 1) * spec.dt_s;
+    const double f = kPressPeakN * 0.5 * (1.0 - std::cos(2.0 * std::numbers::pi * t / kPressPeriodS));
+    loads.clear();
+    for (const FemNodeWeight& w : patch) {
+      loads.push_back({w.node, Vec3(0.0, 0.0, -f * w.weight)});
+    }
+    body.set_loads(loads);
+    const Stopwatch watch;
+    const FemStepStats stats = body.step();
+    ms.push_back(watch.elapsed_ms());
+    cg_sum += stats.cg_iterations;
+    row.cg_iterations_max = std::max(row.cg_iterations_max, stats.cg_iterations);
+    row.unconverged_steps += stats.converged ? 0U : 1U;
+  }
+  row.fem_steps = ms.size();
+  row.cg_iterations_mean = steps > 0 ? static_cast<double>(cg_sum) / steps : 0.0;
+  const SampleSummary s = summarize_samples(ms);
+  row.step_ms_p50 = s.p50;
+  row.step_ms_p99 = s.p99;
+  row.step_ms_max = s.max;
+  row.step_ms_mean = s.mean;
+}
+
+void measure_haptic(const FemBlockSpec& spec, double seconds, FemBenchRow& row) {
+  FemBlockSpec dynamic = spec;
+  dynamic.integration = FemIntegration::kBackwardEuler;
+  World world(fem_block_world(dynamic));
+  world.set_fem_deferred(true);  // FEM updates between cycles, as `hapsim run` does
+  const FemPalpationPath path = fem_palpation_path(dynamic);
+  // Down into the top at the slide's start (untimed).
+  const double down_m = (path.pressed_m - path.start_m).norm();
+  const auto down_steps = static_cast<std::size_t>(std::lround(down_m / kHapticSpeedMPerS / kHapticDtS));
+  double t = 0.0;
+  for (std::size_t i = 0; i <= down_steps; ++i) {
+    const double f = static_cast<double>(i) / static_cast<double>(down_steps);
+    (void)world.step(probe_at(path.start_m + f * (path.pressed_m - path.start_m), t), kHapticDtS);
+    world.advance_fem();
+    t += kHapticDtS;
+  }
+  const std::size_t updates_before = world.fem()->stats().update_ms.size();
+  const auto steps = static_cast<std::size_t>(std::lround(seconds / kHapticDtS));
+  std::vector<double> us;
+  us.reserve(steps);
+  const double leg_s = kSlideM / kHapticSpeedMPerS;
+  for (std::size_t i = 0; i < steps; ++i) {
+    // To and fro along the slide, pressed 6 mm.
+    const double phase = std::fmod(static_cast<double>(i + 1) * kHapticDtS, 2.0 * leg_s) / leg_s;
+    const double f = phase <= 1.0 ? phase : 2.0 - phase;
+    const DeviceInput in = probe_at(path.pressed_m + f * (path.slid_m - path.pressed_m), t);
+    const Stopwatch watch;
+    const StepResult& r = world.step(in, kHapticDtS);
+    us.push_back(watch.elapsed_s() * 1e6);
+    row.haptic_contact_steps += r.tools[0].contact_count > 0 ? 1U : 0U;
+    row.haptic_peak_force_n = std::max(row.haptic_peak_force_n, r.command.force_world_n.norm());
+    world.advance_fem();  // outside the timed region
+    t += kHapticDtS;
+  }
+  row.haptic_steps = us.size();
+  const SampleSummary s = summarize_samples(us);
+  row.haptic_us_p50 = s.p50;
+  row.haptic_us_p99 = s.p99;
+  row.haptic_us_max = s.max;
+  row.haptic_us_mean = s.mean;
+  const std::vector<double>& all = world.fem()->stats().update_ms;
+  std::vector<double> update_ms(all.begin() + static_cast<std::ptrdiff_t>(updates_before), all.end());
+  row.fem_updates = update_ms.size();
+  const SampleSummary u = summarize_samples(update_ms);
+  row.update_ms_p50 = u.p50;
+  row.update_ms_max = u.max;
+}
+
+}  // namespace
+
+FemBenchResult run_fem_bench(const FemBenchOptions& options) {
+  FemBenchResult result;
+  result.options = options;
+  result.options.progress = nullptr;
+  const std::size_t total = options.tet_counts.size() * options.elasticities.size();
+  std::size_t done = 0;
+  for (const std::size_t target : options.tet_counts) {
+    for (const FemElasticity elasticity : options.elasticities) {
+      FemBlockSpec spec;
+      spec.cells = fem_block_cells(spec.size_m, target);
+      spec.elasticity = elasticity;
+      result.block = spec;
+      FemBenchRow row;
+      row.target_tets = target;
+      row.cells = spec.cells;
+      row.elasticity = elasticity;
+      const std::string name = std::to_string(6 * spec.cells[0] * spec.cells[1] * spec.cells[2]) +
+                               " tets " + elasticity_name(elasticity);
+      const auto at = [&](double part) {
+        return (static_cast<double>(done) + part) / static_cast<double>(total);
+      };
+      report_progress(options.progress, name + ": FEM steps", at(0.0));
+      measure_solver(spec, options.fem_steps, row);
+      report_progress(options.progress, name + ": haptic steps", at(0.2));
+      measure_haptic(spec, options.haptic_s, row);
+      if (options.measure_error && !options.speeds_m_per_s.empty()) {
+        const ProgressFn inner = [&](std::string_view label, double fraction) {
+          report_progress(options.progress, name + ": " + std::string(label), at(0.3 + 0.7 * fraction));
+        };
+        row.error = measure_fem_local_model_error(spec, options.speeds_m_per_s,
+                                                  options.reference_spacing_m, inner);
+        row.error_measured = true;
+      }
+      result.rows.push_back(std::move(row));
+      ++done;
+    }
+  }
+  report_progress(options.progress, "done", 1.0);
+  return result;
+}
+
+std::string format_fem_table(const FemBenchResult& result) {
+  std::ostringstream out;
+  char line[400];
+  std::snprintf(line, sizeof line, "%6s %6s %-12s %8s %9s %9s %15s %17s %11s %15s %21s\n", "tets",
+                "nodes", "elasticity", "build_ms", "factor_ms", "factor_MB", "step_ms p50/max",
+                "rate_Hz med/worst", "CG mean/max", "update_ms p50/max", "haptic_us p50/p99/max");
+  out << line;
+  for (const FemBenchRow& r : result.rows) {
+    char step[32];
+    char rate[32];
+    char cg[32];
+    char update[32];
+    char haptic[40];
+    std::snprintf(step, sizeof step, "%.2f/%.2f", r.step_ms_p50, r.step_ms_max);
+    std::snprintf(rate, sizeof rate, "%.0f/%.0f", r.rate_hz_median(), r.rate_hz_worst());
+    std::snprintf(cg, sizeof cg, "%.1f/%d", r.cg_iterations_mean, r.cg_iterations_max);
+    std::snprintf(update, sizeof update, "%.2f/%.2f", r.update_ms_p50, r.update_ms_max);
+    std::snprintf(haptic, sizeof haptic, "%.1f/%.1f/%.1f", r.haptic_us_p50, r.haptic_us_p99,
+                  r.haptic_us_max);
+    std::snprintf(line, sizeof line, "%6zu %6zu %-12s %8.1f %9.1f %9.2f %15s %17s %11s %15s %21s\n",
+                  r.tets, r.nodes, elasticity_name(r.elasticity).c_str(), r.build_ms,
+                  r.factorisation_ms, static_cast<double>(r.factor_memory_bytes) / 1e6, step, rate,
+                  cg, update, haptic);
+    out << line;
+  }
+  bool header = false;
+  for (const FemBenchRow& r : result.rows) {
+    if (!r.error_measured) {
+      continue;
+    }
+    if (!header) {
+      out << "\nLocal model vs the full solve (quasi-static; the contact spring in series at the "
+             "device position), palpation path 6 mm deep, 20 mm sideways:\n";
+      std::snprintf(line, sizeof line, "%6s %-12s %6s %7s %9s %7s %9s %7s %12s %8s %s\n", "tets",
+                    "elasticity", "mm/s", "peak_N", "max_err_N", "max_%", "rms_err_N", "rms_%",
+                    "spring_max_N", "target", "met");
+      out << line;
+      header = true;
+    }
+    for (const FemErrorRow& e : r.error.rows) {
+      const double fraction = fem_error_target_fraction(e.speed_m_per_s);
+      char target[24] = "-";
+      if (fraction > 0.0) {
+        std::snprintf(target, sizeof target, fraction <= 0.05 ? "%.0f%%|0.05N" : "%.0f%%",
+                      100.0 * fraction);
+      }
+      std::snprintf(line, sizeof line,
+                    "%6zu %-12s %6.0f %7.3f %9.4f %7.2f %9.4f %7.2f %12.4f %8s %s\n", r.tets,
+                    elasticity_name(r.elasticity).c_str(), e.speed_m_per_s * 1e3, e.peak_force_n,
+                    e.max_error_n, e.max_error_percent(), e.rms_error_n, e.rms_error_percent(),
+                    e.max_spring_error_n, target,
+                    fraction > 0.0 ? (fem_error_meets_target(e) ? "yes" : "NO") : "-");
+      out << line;
+    }
+  }
+  return out.str();
+}
+
+nlohmann::json fem_bench_to_json(const FemBenchResult& result) {
+  const FemBlockSpec& b = result.block;
+  nlohmann::json rows = nlohmann::json::array();
+  for (const FemBenchRow& r : result.rows) {
+    nlohmann::json row{
+        {"target_tets", r.target_tets},
+        {"cells", r.cells},
+        {"tets", r.tets},
+        {"nodes", r.nodes},
+        {"unknowns", r.unknowns},
+        {"elasticity", elasticity_name(r.elasticity)},
+        {"build_ms", r.build_ms},
+        {"factorisation_ms", r.factorisation_ms},
+        {"factor_memory_bytes", r.factor_memory_bytes},
+        {"factor_memory_mb", static_cast<double>(r.factor_memory_bytes) / 1e6},
+        {"factor_nonzeros", r.factor_nonzeros},
+        {"fem_step",
+         {{"steps", r.fem_steps},
+          {"ms", {{"p50", r.step_ms_p50}, {"p99", r.step_ms_p99}, {"max", r.step_ms_max}, {"mean", r.step_ms_mean}}},
+          {"rate_hz", {{"median", r.rate_hz_median()}, {"worst", r.rate_hz_worst()}}},
+          {"cg_iterations", {{"mean", r.cg_iterations_mean}, {"max", r.cg_iterations_max}}},
+          {"unconverged_steps", r.unconverged_steps}}},
+        {"fem_update", {{"updates", r.fem_updates}, {"ms", {{"p50", r.update_ms_p50}, {"max", r.update_ms_max}}}}},
+        {"haptic_step",
+         {{"steps", r.haptic_steps},
+          {"contact_steps", r.haptic_contact_steps},
+          {"us", {{"p50", r.haptic_us_p50}, {"p99", r.haptic_us_p99}, {"max", r.haptic_us_max}, {"mean", r.haptic_us_mean}}},
+          {"peak_force_n", r.haptic_peak_force_n}}},
+    };
+    if (r.error_measured) {
+      nlohmann::json speeds = nlohmann::json::array();
+      for (const FemErrorRow& e : r.error.rows) {
+        const double fraction = fem_error_target_fraction(e.speed_m_per_s);
+        speeds.push_back({{"speed_mm_per_s", e.speed_m_per_s * 1e3},
+                          {"steps", e.steps},
+                          {"contact_steps", e.contact_steps},
+                          {"peak_force_n", e.peak_force_n},
+                          {"max_error_n", e.max_error_n},
+                          {"rms_error_n", e.rms_error_n},
+                          {"max_error_percent", e.max_error_percent()},
+                          {"rms_error_percent", e.rms_error_percent()},
+                          {"max_spring_error_n", e.max_spring_error_n},
+                          {"rms_spring_error_n", e.rms_spring_error_n},
+                          {"max_error_at_path_m", e.max_error_at_m},
+                          {"target_fraction", fraction > 0.0 ? nlohmann::json(fraction) : nlohmann::json(nullptr)},
+                          {"meets_target", fraction > 0.0 ? nlohmann::json(fem_error_meets_target(e)) : nlohmann::json(nullptr)}});
+      }
+      row["local_model_error"] = {{"speeds", speeds},
+                                  {"reference",
+                                   {{"points", r.error.reference_points},
+                                    {"solves", r.error.reference_solves},
+                                    {"max_iterations", r.error.reference_max_iterations},
+                                    {"unconverged", r.error.reference_unconverged},
+                                    {"ms", r.error.reference_ms}}}};
+    } else {
+      row["local_model_error"] = nullptr;
+    }
+    rows.push_back(std::move(row));
+  }
+  const FemPalpationPath path = fem_palpation_path(b);
+  return {
+      {"block",
+       {{"generator", "make_tet_block"},
+        {"size_m", {b.size_m.x(), b.size_m.y(), b.size_m.z()}},
+        {"fixed", "bottom face (z = 0)"},
+        {"material",
+         {{"youngs_modulus_pa", b.material.youngs_modulus_pa},
+          {"poisson_ratio", b.material.poisson_ratio},
+          {"density_kg_per_m3", b.material.density_kg_per_m3},
+          {"rayleigh_mass_per_s", b.material.rayleigh_mass_per_s},
+          {"rayleigh_stiffness_s", b.material.rayleigh_stiffness_s}}},
+        {"contact",
+         {{"stiffness_n_per_m", b.contact_stiffness_n_per_m},
+          {"damping_n_s_per_m", b.contact_damping_n_s_per_m},
+          {"max_force_n", b.max_force_n},
+          {"tool_radius_m", b.tool_radius_m},
+          {"patch_radius_m", b.patch_radius_m}}}}},
+      {"fem_step",
+       {{"integration", "backward_euler"},
+        {"dt_s", b.dt_s},
+        {"steps", result.options.fem_steps},
+        {"threads", 1},
+        {"load", "0 -> 2 N -> 0 once a second (half-cosine) on the contact patch at the top's centre"}}},
+      {"haptic_step",
+       {{"integration", "backward_euler"},
+        {"fem_deferred", true},
+        {"timed", "World::step only; advance_fem() between cycles, untimed (as hapsim run)"},
+        {"motion", "pressed 6 mm, to and fro 20 mm along x at 20 mm/s"},
+        {"seconds", result.options.haptic_s}}},
+      {"local_model_error",
+       {{"integration", "quasi_static"},
+        {"reference",
+         "quasi-static equilibrium with the contact spring in series at the device position, the "
+         "coupling's contact law (load on the patch of surface nodes within the patch radius of the "
+         "closest point on the deformed surface, weights 1-(r/R)^2; F = k_c * (tool radius - distance "
+         "to the deformed surface)); Newton on F with the patch's condensed compliance, each iterate "
+         "FemBody::solve_static; not solve_static_sphere_contact (a rigid sphere with node penalties "
+         "is another contact law)"},
+        {"reference_spacing_m", result.options.reference_spacing_m},
+        {"interpolation", "linear in path length between reference points"},
+        {"error", "|F_rendered - F_reference| (vectors); rms over steps where either is non-zero; "
+                  "percent of the path's peak reference force"},
+        {"path",
+         {{"start_m", {path.start_m.x(), path.start_m.y(), path.start_m.z()}},
+          {"pressed_m", {path.pressed_m.x(), path.pressed_m.y(), path.pressed_m.z()}},
+          {"slid_m", {path.slid_m.x(), path.slid_m.y(), path.slid_m.z()}},
+          {"end_m", {path.end_m.x(), path.end_m.y(), path.end_m.z()}},
+          {"depth_m", kDepthM},
+          {"slide_m", kSlideM},
+          {"hold_s", kFemPathHoldS}}},
+        {"targets", {{"10_mm_per_s", "5 % of peak or 0.05 N"}, {"50_mm_per_s", "10 % of peak"}}}}},
+      {"rows", rows}};
+}
+
+}  // namespace hapsim::bench

@@ -1,0 +1,467 @@
+#include "hapsim/world/fem_coupling.h"
+
+#include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/core/error.h"
+#include "hapsim/core/stopwatch.h"
+#include "hapsim/deform/fem_body_description.h"
+#include "hapsim/geometry/tet_mesh.h"
+#include "hapsim/world/world_model.h"
+#include "hapsim/world/world_state.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <string>
+
+namespace hapsim {
+
+struct FemCoupling::Body {
+  std::size_t world_body = 0;
+  std::size_t flat_segment = 0;
+  Iso3 X_world_body = Iso3::Identity();
+  Iso3 X_body_world = Iso3::Identity();
+  const FemBodyDescription* description = nullptr;
+  std::unique_ptr<FemBody> fem;
+  /// The segment's surface as it is now (body frame): the rest mesh with moved vertices.
+  TriangleMesh surface;
+  /// Boundary surface: the tet node of each surface vertex; embedded: each vertex's tet.
+  std::vector<std::uint32_t> node_of_vertex;
+  std::vector<TetEmbedding> embedding;
+  /// The surface at rest and its BVH: a contact is a material point of the tissue, found on the
+  /// rest surface and followed as it moves (see update_body).
+  TriangleMesh rest_surface;
+  std::unique_ptr<MeshBvh> rest_bvh;
+  double patch_radius_m = 0.004;
+  double margin_m = 0.01;
+  /// Per tool: the node weights of its contact patch from the last update (where its load goes
+  /// next) and its query hint.
+  std::array<std::vector<FemNodeWeight>, kMaxTools> patch;
+  std::array<QueryHint, kMaxTools> hints{};
+  /// Per tool: its patch's weighted displacement at the last update (body frame), to find the
+  /// same material point again when the tool has pushed the surface in.
+  std::array<Vec3, kMaxTools> patch_shift;
+  std::vector<FemNodeForce> loads;
+};
+
+namespace {
+
+// The nodes of a FEM body held fixed: by index, by plane, and by other bodies' segments.
+std::vector<std::uint32_t> fem_fixed_nodes(const WorldModel& model, const BodyDescription& body,
+                                           const FemBodyDescription& fem) {
+  std::set<std::uint32_t> fixed(fem.fixed_nodes.begin(), fem.fixed_nodes.end());
+  const TetMesh& tets = fem.tets;
+  if (fem.fixed_below_z_m) {
+    for (std::size_t i = 0; i < tets.nodes.size(); ++i) {
+      if (tets.nodes[i].z() <= *fem.fixed_below_z_m) {
+        fixed.insert(static_cast<std::uint32_t>(i));
+      }
+    }
+  }
+  const WorldDescription& d = model.description();
+  for (const FemAttachment& a : fem.attached_to) {
+    bool found_body = false;
+    for (std::size_t ob = 0; ob < d.bodies.size(); ++ob) {
+      if (d.bodies[ob].name != a.body) {
+        continue;
+      }
+      found_body = true;
+      std::size_t matched = 0;
+      for (std::size_t s = 0; s < d.bodies[ob].segments.size(); ++s) {
+        if (!a.segment.empty() && d.bodies[ob].segments[s].name != a.segment) {
+          continue;
+        }
+        ++matched;
+        const SegmentModel& seg = model.segments()[model.flat_segment(ob, s)];
+        // Both bodies stand still (a FEM body and what holds it are not dynamic): one transform.
+        const Iso3 X_other_fem = seg.X_body_world * body.X_world_body;
+        for (std::size_t i = 0; i < tets.nodes.size(); ++i) {
+          const SurfacePoint sp = seg.rest_query->closest_point(X_other_fem * tets.nodes[i]);
+          if (sp.found() && sp.signed_distance <= a.within_m) {
+            fixed.insert(static_cast<std::uint32_t>(i));
+          }
+        }
+      }
+      if (matched == 0) {
+        throw Error(a.where.empty() ? fem.source : a.where, "attached_to names segment '" +
+                                                                a.segment + "' of body '" + a.body +
+                                                                "', which has no such segment");
+      }
+    }
+    if (!found_body) {
+      throw Error(a.where.empty() ? fem.source : a.where,
+                  "attached_to names body '" + a.body + "', which the world lacks");
+    }
+  }
+  if (fixed.empty()) {
+    throw Error(fem.source + " (body '" + body.name + "')",
+                "no node is fixed: give fixed nodes, a plane or a body it is attached to (a free "
+                "FEM body has no rest position to return to); the attachments given reach no node");
+  }
+  return {fixed.begin(), fixed.end()};
+}
+
+}  // namespace
+
+FemCoupling::FemCoupling(const WorldModel& model) {
+  const WorldDescription& d = model.description();
+  tool_count_ = std::min<std::size_t>(d.tools.size(), kMaxTools);
+  for (std::size_t t = 0; t < tool_count_; ++t) {
+    tool_radius_m_[t] = d.tools[t].radius_m;
+  }
+  for (std::size_t b = 0; b < d.bodies.size(); ++b) {
+    const BodyDescription& bd = d.bodies[b];
+    if (bd.kind != BodyKind::kDeformable || bd.deformation != BodyDeformation::kFem) {
+      continue;
+    }
+    if (!bd.fem) {
+      throw Error("body '" + bd.name + "'", "a FEM body needs its FEM description");
+    }
+    if (bodies_.size() >= kMaxFemBodies) {
+      throw Error("body '" + bd.name + "'",
+                  "more than " + std::to_string(kMaxFemBodies) + " FEM bodies in one world");
+    }
+    if (bd.segments.size() != 1) {
+      throw Error("body '" + bd.name + "'", "a FEM body has exactly one segment (its surface)");
+    }
+    const FemBodyDescription& fd = *bd.fem;
+    auto body = std::make_unique<Body>();
+    body->world_body = b;
+    body->flat_segment = model.flat_segment(b, 0);
+    body->X_world_body = bd.X_world_body;
+    body->X_body_world = bd.X_world_body.inverse();
+    body->description = &fd;
+    body->fem = std::make_unique<FemBody>(fd.tets, fd.materials, fem_fixed_nodes(model, bd, fd),
+                                          fd.options, fd.source);
+    body->surface = bd.segments.front().mesh;
+    if (fd.embedded_surface) {
+      body->embedding = embed_points(fd.tets, body->surface.vertices);
+    } else {
+      // The segment's mesh is the tets' boundary: match its vertices to the boundary's nodes.
+      const TetBoundary boundary = tet_boundary(fd.tets);
+      if (boundary.surface.vertices.size() != body->surface.vertices.size()) {
+        throw Error(fd.source, "the body's surface is not its tets' boundary (" +
+                                   std::to_string(body->surface.vertices.size()) + " vertices, " +
+                                   std::to_string(boundary.surface.vertices.size()) +
+                                   " on the boundary)");
+      }
+      body->node_of_vertex = boundary.node_of_vertex;
+    }
+    body->rest_surface = body->surface;
+    body->rest_bvh = std::make_unique<MeshBvh>(body->rest_surface);
+    body->patch_radius_m = fd.contact_patch_radius_m;
+    body->margin_m = fd.contact_margin_m;
+    for (auto& p : body->patch) {
+      p.reserve(256);
+    }
+    for (Vec3& shift : body->patch_shift) {
+      shift.setZero();
+    }
+    body->loads.reserve(256 * kMaxTools);
+    published_surfaces_.push_back(
+        std::make_unique<TripleBuffer<std::vector<Vec3>>>(body->surface.vertices));
+    bodies_.push_back(std::move(body));
+  }
+}
+
+const std::vector<Vec3>* FemCoupling::take_published_surface(std::size_t fem_index) {
+  TripleBuffer<std::vector<Vec3>>& buffer = *published_surfaces_.at(fem_index);
+  return buffer.update() ? &buffer.read_slot() : nullptr;
+}
+
+FemCoupling::~FemCoupling() = default;
+
+std::size_t FemCoupling::world_body(std::size_t fem_index) const {
+  return bodies_.at(fem_index)->world_body;
+}
+
+const TriangleMesh& FemCoupling::surface(std::size_t fem_index) const {
+  return bodies_.at(fem_index)->surface;
+}
+
+const std::vector<FemNodeWeight>& FemCoupling::contact_patch(std::size_t fem_index,
+                                                             std::size_t tool) const {
+  return bodies_.at(fem_index)->patch.at(tool);
+}
+
+const FemBody& FemCoupling::body(std::size_t fem_index) const {
+  return *bodies_.at(fem_index)->fem;
+}
+
+FemBody& FemCoupling::body(std::size_t fem_index) {
+  return *bodies_.at(fem_index)->fem;
+}
+
+// haptic path
+void FemCoupling::adopt(WorldState& state, double dt_s) noexcept {
+  if (period_steps_.load(std::memory_order_relaxed) == 0 && dt_s > 0.0 && !bodies_.empty()) {
+    const double fem_dt = bodies_.front()->description->options.dt_s;
+    const double ratio = std::round(fem_dt / dt_s);
+    period_steps_.store(
+        ratio >= 1.0 && std::isfinite(ratio) ? static_cast<std::uint64_t>(ratio) : 1U,
+        std::memory_order_release);
+  }
+  if (!pending_known_) {
+    pending_known_ = updates_.update();
+  }
+  if (!pending_known_) {
+    return;
+  }
+  const FemUpdate& u = updates_.read_slot();
+  if (u.epoch != epoch_.load(std::memory_order_relaxed)) {
+    pending_known_ = false;  // from before a reset
+    return;
+  }
+  const std::uint64_t due = u.launch_step + period_steps_.load(std::memory_order_relaxed);
+  if (state.step_index < due) {
+    return;  // a fixed latency: adopted exactly one FEM period after its launch
+  }
+  for (std::size_t t = 0; t < tool_count_; ++t) {
+    for (std::size_t b = 0; b < bodies_.size(); ++b) {
+      state.fem_contacts[t * kMaxFemBodies + b].model = u.models[t * kMaxFemBodies + b];
+    }
+  }
+  pending_known_ = false;
+  last_adopted_launch_ = u.launch_step;
+  ++adopted_;
+  if (state.step_index > due) {
+    ++late_adopted_;
+  }
+}
+
+// haptic path
+void FemCoupling::capture(const WorldModel& model, const WorldState& state) noexcept {
+  const std::uint64_t period = period_steps_.load(std::memory_order_relaxed);
+  if (period == 0 || state.step_index % period != 0) {
+    return;
+  }
+  FemLaunch& l = launches_.write_slot();
+  l.step_index = state.step_index;
+  l.epoch = epoch_.load(std::memory_order_relaxed);
+  l.time_s = state.time_s;
+  for (std::size_t t = 0; t < tool_count_; ++t) {
+    l.p_world[t] = state.tools[t].p_world;
+    l.v_world[t] = state.tools[t].v_world;
+    l.usable[t] = state.input_usable;
+    for (std::size_t b = 0; b < bodies_.size(); ++b) {
+      l.push_world_n[t * kMaxFemBodies + b] =
+          state.fem_contacts[t * kMaxFemBodies + b].push_world_n;
+    }
+  }
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const ContactMaterial& m = state.materials[model.segments()[bodies_[b]->flat_segment].material];
+    l.contact_stiffness_n_per_m[b] = m.stiffness_n_per_m;
+    l.max_force_n[b] = m.max_force_n;
+  }
+  launches_.publish();
+  last_launch_step_ = state.step_index;
+}
+
+bool FemCoupling::run_pending() {
+  if (!launches_.update()) {
+    return false;
+  }
+  const FemLaunch& launch = launches_.read_slot();
+  if (launch.step_index == 0 || launch.epoch != epoch_.load(std::memory_order_acquire) ||
+      launch.step_index == last_run_launch_) {
+    return false;
+  }
+  if (last_run_launch_ != 0) {
+    const std::uint64_t period = std::max<std::uint64_t>(1, period_steps());
+    stats_.skipped_launches += (launch.step_index - last_run_launch_) / period - 1;
+  }
+  last_run_launch_ = launch.step_index;
+  const Stopwatch watch;
+  FemUpdate& out = updates_.write_slot();
+  out.launch_step = launch.step_index;
+  out.epoch = launch.epoch;
+  out.sequence = ++sequence_;
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    update_body(b, launch, out);
+    // Same size every time: the copy reuses the slot's storage.
+    published_surfaces_[b]->write_slot() = bodies_[b]->surface.vertices;
+    published_surfaces_[b]->publish();
+  }
+  updates_.publish();
+  surface_version_.fetch_add(1, std::memory_order_acq_rel);
+  ++stats_.updates;
+  stats_.update_ms.push_back(watch.elapsed_ms());
+  return true;
+}
+
+void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate& out) {
+  Body& body = *bodies_[b];
+  FemBody& fem = *body.fem;
+  const TetMesh& tets = fem.rest_mesh();
+  // 1. The tissue takes the force each tool felt (what the device rendered), on its patch.
+  body.loads.clear();
+  for (std::size_t t = 0; t < tool_count_; ++t) {
+    const Vec3& push = launch.push_world_n[t * kMaxFemBodies + b];
+    if (body.patch[t].empty() || !(push.squaredNorm() > 0.0)) {
+      continue;
+    }
+    const Vec3 f_tissue_body = body.X_body_world.linear() * (-push);
+    for (const FemNodeWeight& w : body.patch[t]) {
+      body.loads.push_back({w.node, w.weight * f_tissue_body});
+    }
+  }
+  fem.set_loads(body.loads);
+  const FemStepStats st = fem.step();
+  out.solve_ms[b] = st.solve_ms;
+  out.cg_iterations[b] = st.cg_iterations;
+  // 2. The surface follows the volume.
+  const std::vector<Vec3>& x = fem.positions();
+  double max_u = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    max_u = std::max(max_u, (x[i] - tets.nodes[i]).norm());
+  }
+  out.max_displacement_m[b] = max_u;
+  max_displacement_m_[b].store(max_u, std::memory_order_relaxed);
+  if (body.embedding.empty()) {
+    for (std::size_t v = 0; v < body.surface.vertices.size(); ++v) {
+      body.surface.vertices[v] = x[body.node_of_vertex[v]];
+    }
+  } else {
+    for (std::size_t v = 0; v < body.surface.vertices.size(); ++v) {
+      body.surface.vertices[v] = embedded_position(tets, x, body.embedding[v]);
+    }
+  }
+  body.surface.compute_vertex_normals();
+  // 3. Per tool, the local contact model about where the tool is now.
+  for (std::size_t t = 0; t < tool_count_; ++t) {
+    LocalContactModel& m = out.models[t * kMaxFemBodies + b];
+    m = LocalContactModel{};
+    std::vector<FemNodeWeight>& patch = body.patch[t];
+    patch.clear();
+    if (!launch.usable[t]) {
+      continue;
+    }
+    const double radius = tool_radius_m_[t];
+    const Vec3 p_body = body.X_body_world * launch.p_world[t];
+    // The contact is a material point of the tissue: the rest surface's closest point to the tool
+    // less the displacement its patch had (a tool that pushed the surface in finds the same
+    // point, not the rim of its own dent). Its gap is measured along the deformed surface's
+    // normal there from where the patch is now: exactly the series law the model linearises,
+    // F = k_c·(d − n·H·u), whatever the dent's shape.
+    const SurfacePoint sp =
+        body.rest_bvh->closest_point(p_body - body.patch_shift[t], &body.hints[t]);
+    body.patch_shift[t].setZero();
+    if (!sp.found() || !std::isfinite(sp.signed_distance) ||
+        sp.triangle >= body.surface.triangles.size()) {
+      continue;
+    }
+    // The contact patch: surface vertices within the patch radius of the contact point (at
+    // rest), weighted by a smooth bump (their sum is one).
+    const double r_patch = std::max(body.patch_radius_m, radius);
+    double sum = 0.0;
+    Vec3 normal = Vec3::Zero();  // the patch's deformed normal: turns with the tissue
+    for (std::size_t v = 0; v < body.rest_surface.vertices.size(); ++v) {
+      const double d2 = (body.rest_surface.vertices[v] - sp.point).squaredNorm();
+      if (d2 < r_patch * r_patch) {
+        const double w = 1.0 - d2 / (r_patch * r_patch);
+        sum += w;
+        normal += w * body.surface.vertex_normals[v];
+        if (body.embedding.empty()) {
+          patch.push_back({body.node_of_vertex[v], w});
+        } else {
+          const TetEmbedding& e = body.embedding[v];
+          for (int k = 0; k < 4; ++k) {
+            patch.push_back({tets.tets[e.tet][static_cast<std::size_t>(k)], w * e.barycentric[k]});
+          }
+        }
+      }
+    }
+    if (!(sum > 0.0)) {
+      // No vertex that close (a coarse surface): the closest triangle's corners.
+      for (std::uint32_t c : body.rest_surface.triangles[sp.triangle]) {
+        const double w = 1.0 / 3.0;
+        sum += w;
+        if (body.embedding.empty()) {
+          patch.push_back({body.node_of_vertex[c], w});
+        } else {
+          const TetEmbedding& e = body.embedding[c];
+          for (int k = 0; k < 4; ++k) {
+            patch.push_back({tets.tets[e.tet][static_cast<std::size_t>(k)], w * e.barycentric[k]});
+          }
+        }
+      }
+    }
+    Vec3 shift = Vec3::Zero();
+    for (FemNodeWeight& w : patch) {
+      w.weight /= sum;
+      shift += w.weight * (x[w.node] - tets.nodes[w.node]);
+    }
+    normal = normal.squaredNorm() > 0.0 ? Vec3(normal.normalized())
+                                        : body.surface.face_normal(sp.triangle);
+    if (!(normal.squaredNorm() > 0.0)) {
+      normal = sp.normal;
+    }
+    const double penetration_m = radius - normal.dot(p_body - (sp.point + shift));
+    if (penetration_m < -body.margin_m) {
+      patch.clear();  // free space: no model, no load next time
+      continue;
+    }
+    body.patch_shift[t] = shift;
+    // The tissue's own compliance at the patch along the normal, in series with the contact.
+    const double compliance_m_per_n = fem.compliance_along(patch, normal);
+    const double k_tissue = compliance_m_per_n > 0.0 && std::isfinite(compliance_m_per_n)
+                                ? 1.0 / compliance_m_per_n
+                                : kInf;
+    const double k_contact = launch.contact_stiffness_n_per_m[b];
+    const double k_series = series_stiffness_n_per_m(k_contact, k_tissue);
+    const Vec3 n_world = body.X_world_body.linear() * normal;
+    const double rendered_n =
+        std::max(0.0, launch.push_world_n[t * kMaxFemBodies + b].dot(n_world));
+    m.x0_world_m = launch.p_world[t];
+    m.v0_world_m_per_s = launch.v_world[t];
+    m.f0_world_n = tissue_coupled_force_n(rendered_n, penetration_m, k_contact, k_series) * n_world;
+    m.stiffness_n_per_m = k_series * n_world * n_world.transpose();
+    m.damping_n_s_per_m.setZero();  // the step adds the passivity floor with the material's
+    m.normal_world = n_world;
+    m.validity_radius_m = body.margin_m + radius;
+    m.max_normal_force_n = launch.max_force_n[b];
+    m.sim_time_s = launch.time_s;
+    m.sequence = sequence_;
+    m.device_sequence = launch.step_index;
+    m.valid = k_series > 0.0;
+  }
+}
+
+void FemCoupling::reset() {
+  for (auto& body : bodies_) {
+    body->fem->reset();
+    body->surface.vertices.clear();
+    for (auto& p : body->patch) {
+      p.clear();
+    }
+    body->hints = {};
+    for (Vec3& shift : body->patch_shift) {
+      shift.setZero();
+    }
+  }
+  // The rest surfaces again.
+  for (auto& body : bodies_) {
+    const std::vector<Vec3>& x = body->fem->positions();
+    body->surface.vertices.resize(body->embedding.empty() ? body->node_of_vertex.size()
+                                                          : body->embedding.size());
+    for (std::size_t v = 0; v < body->surface.vertices.size(); ++v) {
+      body->surface.vertices[v] =
+          body->embedding.empty()
+              ? x[body->node_of_vertex[v]]
+              : embedded_position(body->fem->rest_mesh(), x, body->embedding[v]);
+    }
+  }
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    published_surfaces_[b]->write_slot() = bodies_[b]->surface.vertices;
+    published_surfaces_[b]->publish();
+  }
+  epoch_.fetch_add(1, std::memory_order_acq_rel);
+  for (auto& u : max_displacement_m_) {
+    u.store(0.0, std::memory_order_relaxed);
+  }
+  pending_known_ = false;
+  last_run_launch_ = 0;
+  last_launch_step_ = 0;
+  last_adopted_launch_ = 0;
+}
+
+}  // namespace hapsim
