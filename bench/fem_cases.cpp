@@ -327,7 +327,45 @@ FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
     for (int i = 0; i < 2000; ++i) {
       const Vec3 q = path.start_m + std::min(1.0, i / 500.0) * (p - path.start_m);
       f = world.step(probe_at(q, i * 1e-3), 1e-3).command.force_world_n;
-      if (i % 100 == 99) std::fprintf(stderr, "world %d %.6f %.6f %.6f\n", i, f.x(), f.y(), f.z());
+      if (i % 100 == 99 || i > 1940) {
+        const FemBody& fb = world.fem()->body(0);
+        double maxu = 0;
+        for (std::size_t k2 = 0; k2 < fb.node_count(); ++k2) maxu = std::max(maxu, fb.displacement(as_node(k2)).norm());
+        const LocalContactModel& mm = world.state().fem_contacts[0].model;
+        std::fprintf(stderr, "world %d %.6f %.6f %.6f maxu %.6f f0 %.6f seq %llu push %.6f\n", i, f.x(), f.y(), f.z(), maxu, mm.f0_world_n.norm(),
+                     static_cast<unsigned long long>(mm.sequence), world.state().fem_contacts[0].push_world_n.norm());
+      }
+    }
+    {
+      const LocalContactModel& mm = world.state().fem_contacts[0].model;
+      const double kn = mm.normal_world.dot(mm.stiffness_n_per_m * mm.normal_world);
+      std::fprintf(stderr, "model f0 %.6f K %.3f x0 %.6f %.6f n %.4f valid %d\n", mm.f0_world_n.norm(), kn,
+                   mm.x0_world_m.x(), mm.x0_world_m.z(), mm.normal_world.z(), mm.valid ? 1 : 0);
+      const TriangleMesh& surf = world.surface(0, 0);
+      MeshBvh bvh(surf);
+      const SurfacePoint sp = bvh.closest_point(p);
+      std::fprintf(stderr, "world surface: sd %.6f pen %.6f point %.6f %.6f %.6f k_c*pen %.6f\n", sp.signed_distance,
+                   spec.tool_radius_m - sp.signed_distance, sp.point.x(), sp.point.y(), sp.point.z(),
+                   3000.0 * (spec.tool_radius_m - sp.signed_distance));
+      {
+        TriangleMesh copy = world.description().bodies[0].segments[0].mesh;
+        MeshBvh refitted(copy);
+        QueryHint hint;
+        (void)refitted.closest_point(p, &hint);
+        copy.vertices = surf.vertices;
+        refitted.refit();
+        const SurfacePoint a1 = refitted.closest_point(p, &hint);
+        QueryHint h2;
+        const SurfacePoint a2 = refitted.closest_point(p, &h2);
+        std::fprintf(stderr, "refit: sd %.6f (hint) %.6f (no hint) fresh %.6f tri %u %u %u\n", a1.signed_distance, a2.signed_distance,
+                     sp.signed_distance, a1.triangle, a2.triangle, sp.triangle);
+      }
+      const FemBody& fb = world.fem()->body(0);
+      double maxu = 0;
+      for (std::size_t i = 0; i < fb.node_count(); ++i) maxu = std::max(maxu, fb.displacement(as_node(i)).norm());
+      std::fprintf(stderr, "world fem max u %.6f updates %llu adopted %llu late %llu failures %llu seq %llu\n", maxu,
+                   static_cast<unsigned long long>(world.fem()->stats().updates), static_cast<unsigned long long>(world.fem()->adopted()),
+                   static_cast<unsigned long long>(world.fem()->late_adopted()), static_cast<unsigned long long>(world.state().fem_failures), static_cast<unsigned long long>(mm.sequence));
     }
     FemContactReference ref(spec);
     for (int k = 1; k <= 10; ++k) {

@@ -139,8 +139,10 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
       seg->mesh = scene_.add_mesh(role.box ? with_creased_normals(sd.mesh, 0.0) : sd.mesh,
                                   seg->tissue_colour, world.body_pose(b));
       scene_.mesh(seg->mesh).name = seg->label;
-      if (seg->sheet) {
-        scene_.drop_lod_levels(seg->mesh);  // flat at rest: the dent is all its detail
+      if (seg->sheet || body.deformation == BodyDeformation::kFem) {
+        // A sheet is flat at rest: the dent is all its detail. A FEM body's levels would be
+        // simplified at rest and then moved far from it: a level's error bound no longer holds.
+        scene_.drop_lod_levels(seg->mesh);
       }
       scene_.mesh(seg->mesh).opacity = static_cast<float>(m.opacity);
       // A rig's floor is a slab much wider than the scene: the checked floor stands for it.
@@ -451,8 +453,9 @@ void WorldScene::update(const WorldSnapshot& snapshot) {
   for (std::size_t i = 0; i < segments_.size(); ++i) {
     Segment& seg = *segments_[i];
     scene_.mesh(seg.mesh).X_world_mesh = body_poses_[seg.body];
+    // A FEM body's surface is not in the snapshot (update_fem_surfaces): its slot stays empty.
     if (!seg.deformable || i >= snapshot.positions_body.size() ||
-        snapshot.positions_version[i] == seg.version) {
+        snapshot.positions_version[i] == seg.version || snapshot.positions_body[i].empty()) {
       continue;
     }
     const std::vector<float>& xyz = snapshot.positions_body[i];

@@ -181,6 +181,9 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
     t.output = s.output;
     fill_teleop_snapshot(t, world_);
   }
+  for (const std::size_t body : world_.model().fem_bodies()) {
+    s.deflection_m[world_.flat_segment(body, 0)] = world_.current_deflection_m(body, 0);
+  }
   for (DeformableSegment& seg : deformable_) {
     std::vector<std::uint32_t>& pending = seg.pending[slot];
     const auto not_owed = static_cast<std::uint8_t>(~(1u << slot));
