@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -32,13 +31,12 @@ constexpr double kHapticSpeedMPerS = 0.020;
 constexpr double kPressPeakN = 2.0;
 constexpr double kPressPeriodS = 1.0;
 // The reference's Newton iteration on the contact force.
-constexpr int kReferenceMaxIterations = 60;
-constexpr int kReferencePlainIterations = 6;
+constexpr int kReferenceMaxIterations = 50;
 constexpr double kReferenceForceTolN = 1e-4;  // the corotational solves' own noise is ~2e-5 N
-// A patch moved by 10 µm changes its weights by under 0.3 %; a normal by 1e-3, the force's
-// direction by 0.1 %.
-constexpr double kReferencePointTolM = 1e-5;
-constexpr double kReferenceNormalTol = 1e-3;
+// A patch moved by 1 µm changes its weights by under 0.05 %; a normal by 1e-4, the force's
+// direction by 0.01 %.
+constexpr double kReferencePointTolM = 1e-6;
+constexpr double kReferenceNormalTol = 1e-4;
 
 std::uint32_t as_node(std::size_t i) { return static_cast<std::uint32_t>(i); }
 
@@ -69,31 +67,80 @@ FemOptions block_options(const FemBlockSpec& spec) {
   return o;
 }
 
-// The coupling's contact patch (world/fem_coupling.cpp, update_body), restated: the surface
-// vertices within the patch radius of the contact point, weighted by 1 − (r/R)², or the closest
-// triangle's corners when none is that close; weights summing to one.
-void contact_patch(const TriangleMesh& surface, const std::vector<std::uint32_t>& node_of_vertex,
-                   const SurfacePoint& sp, double radius_m, std::vector<FemNodeWeight>& patch) {
+// The coupling's contact (world/fem_coupling.cpp, update_body), restated: the contact is a
+// material point of the tissue, the rest surface's closest point to the tool less the patch's
+// displacement; the patch is the rest surface's vertices within the patch radius of it, weighted
+// 1 − (r/R)² (or the closest triangle's corners when none is that close), weights summing to one;
+// the normal is the patch's weighted deformed vertex normal; the penetration is measured along it
+// from where the patch is now. F = k_c·penetration is the series law the local model linearises.
+struct CouplingContact {
+  bool found = false;
+  Vec3 rest_point = Vec3::Zero();
+  Vec3 normal = Vec3::UnitZ();
+  Vec3 shift = Vec3::Zero();  // the patch's mean displacement
+  double penetration_m = 0.0;
+};
+
+CouplingContact coupling_contact(const MeshBvh& rest_bvh, const TriangleMesh& rest_surface,
+                                 const TriangleMesh& surface,
+                                 const std::vector<std::uint32_t>& node_of_vertex,
+                                 const FemBody& body, const Vec3& p, const Vec3& query_shift,
+                                 double tool_radius_m, double patch_radius_m,
+                                 std::vector<FemNodeWeight>& patch) {
+  CouplingContact c;
   patch.clear();
+  const SurfacePoint sp = rest_bvh.closest_point(p - query_shift);
+  if (!sp.found() || !std::isfinite(sp.signed_distance) ||
+      sp.triangle >= surface.triangles.size()) {
+    return c;
+  }
+  const double r2 = patch_radius_m * patch_radius_m;
   double sum = 0.0;
-  const double r2 = radius_m * radius_m;
-  for (std::size_t v = 0; v < surface.vertices.size(); ++v) {
-    const double d2 = (surface.vertices[v] - sp.point).squaredNorm();
+  Vec3 normal = Vec3::Zero();
+  for (std::size_t v = 0; v < rest_surface.vertices.size(); ++v) {
+    const double d2 = (rest_surface.vertices[v] - sp.point).squaredNorm();
     if (d2 < r2) {
       const double w = 1.0 - d2 / r2;
       patch.push_back({node_of_vertex[v], w});
+      normal += w * surface.vertex_normals[v];
       sum += w;
     }
   }
-  if (!(sum > 0.0) && sp.triangle < surface.triangles.size()) {
-    for (const std::uint32_t c : surface.triangles[sp.triangle]) {
-      patch.push_back({node_of_vertex[c], 1.0 / 3.0});
+  if (!(sum > 0.0)) {
+    for (const std::uint32_t corner : rest_surface.triangles[sp.triangle]) {
+      patch.push_back({node_of_vertex[corner], 1.0 / 3.0});
       sum += 1.0 / 3.0;
     }
   }
-  if (!(sum > 0.0)) {
-    patch.clear();
-    return;
+  const TetMesh& rest = body.rest_mesh();
+  const std::vector<Vec3>& x = body.positions();
+  for (FemNodeWeight& w : patch) {
+    w.weight /= sum;
+    c.shift += w.weight * (x[w.node] - rest.nodes[w.node]);
+  }
+  normal = normal.squaredNorm() > 0.0 ? Vec3(normal.normalized()) : surface.face_normal(sp.triangle);
+  if (!(normal.squaredNorm() > 0.0)) {
+    normal = sp.normal;
+  }
+  c.found = true;
+  c.rest_point = sp.point;
+  c.normal = normal;
+  c.penetration_m = tool_radius_m - normal.dot(p - (sp.point + c.shift));
+  return c;
+}
+
+// The bare solver's press: the surface vertices within the patch radius of `point` at rest.
+void rest_patch(const TriangleMesh& rest_surface, const std::vector<std::uint32_t>& node_of_vertex,
+                const Vec3& point, double radius_m, std::vector<FemNodeWeight>& patch) {
+  patch.clear();
+  double sum = 0.0;
+  for (std::size_t v = 0; v < rest_surface.vertices.size(); ++v) {
+    const double d2 = (rest_surface.vertices[v] - point).squaredNorm();
+    if (d2 < radius_m * radius_m) {
+      const double w = 1.0 - d2 / (radius_m * radius_m);
+      patch.push_back({node_of_vertex[v], w});
+      sum += w;
+    }
   }
   for (FemNodeWeight& w : patch) {
     w.weight /= sum;
@@ -161,14 +208,16 @@ struct FemContactReference::Impl {
   double tool_radius_m = 0.0;
   double patch_radius_m = 0.0;
   std::unique_ptr<FemBody> body;
-  TriangleMesh surface;
+  TriangleMesh rest_surface;
+  TriangleMesh surface;  // deformed, with its vertex normals
   std::vector<std::uint32_t> node_of_vertex;
-  std::unique_ptr<MeshBvh> bvh;
-  QueryHint hint;
-  // The load on the body now (solved): its force along its normal on its patch.
+  std::unique_ptr<MeshBvh> rest_bvh;
+  // The load on the body now (solved): its force along its normal on its patch, and the patch's
+  // displacement the next contact query starts from (as the coupling keeps it per tool).
   double applied_n = 0.0;
   Vec3 applied_normal = Vec3::UnitZ();
   Vec3 applied_point = Vec3::Zero();
+  Vec3 query_shift = Vec3::Zero();
   std::vector<FemNodeWeight> patch;
   std::vector<FemNodeForce> loads;
 
@@ -177,11 +226,12 @@ struct FemContactReference::Impl {
     for (std::size_t v = 0; v < surface.vertices.size(); ++v) {
       surface.vertices[v] = x[node_of_vertex[v]];
     }
-    bvh->refit();
+    surface.compute_vertex_normals();
   }
 };
 
-FemContactReference::FemContactReference(const FemBlockSpec& spec) : impl_(std::make_unique<Impl>()) {
+FemContactReference::FemContactReference(const FemBlockSpec& spec)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   FemBlockSpec quasi_static = spec;
   quasi_static.integration = FemIntegration::kQuasiStatic;
@@ -190,12 +240,15 @@ FemContactReference::FemContactReference(const FemBlockSpec& spec) : impl_(std::
   m.patch_radius_m = std::max(spec.patch_radius_m, spec.tool_radius_m);
   TetMesh tets = block_tets(spec);
   const TetBoundary boundary = tet_boundary(tets);
+  m.rest_surface = boundary.surface;
   m.surface = boundary.surface;
+  m.surface.compute_vertex_normals();
   m.node_of_vertex = boundary.node_of_vertex;
   const std::vector<std::uint32_t> fixed = bottom_nodes(tets);
-  m.body = std::make_unique<FemBody>(std::move(tets), std::vector<FemRegionMaterial>{FemRegionMaterial{0, spec.material}},
-                                     fixed, block_options(quasi_static), "fem bench reference");
-  m.bvh = std::make_unique<MeshBvh>(m.surface);
+  m.body = std::make_unique<FemBody>(
+      std::move(tets), std::vector<FemRegionMaterial>{FemRegionMaterial{0, spec.material}}, fixed,
+      block_options(quasi_static), "fem bench reference");
+  m.rest_bvh = std::make_unique<MeshBvh>(m.rest_surface);
 }
 
 FemContactReference::~FemContactReference() = default;
@@ -203,51 +256,38 @@ FemContactReference::~FemContactReference() = default;
 Vec3 FemContactReference::force_at(const Vec3& p_m) {
   Impl& m = *impl_;
   // Newton on g(F) = F − k_c·max(0, penetration(F)), slope 1 + k_c·c with c the patch's
-  // condensed compliance along the normal; converged when g is below the tolerance and the
-  // contact point and normal the load went on (hence the patch and the load's direction) no
-  // longer move. After a few plain iterations the point and normal are the running mean of the
-  // iterates: on a mesh coarser than the patch the load sits on one node, which sinks into a
-  // funnel whose facets take turns at being closest to the tool (no fixed point; the
-  // penetration, a distance, stays continuous), and the mean is the symmetric answer.
+  // condensed compliance along the normal (the coupling's own update is this step, one per FEM
+  // period); converged when g is below the tolerance and the contact point and normal the load
+  // went on (hence the patch and the load's direction) no longer move.
   for (int it = 1; it <= kReferenceMaxIterations; ++it) {
-    const SurfacePoint sp = m.bvh->closest_point(p_m, &m.hint);
-    if (!sp.found()) {
+    const CouplingContact c =
+        coupling_contact(*m.rest_bvh, m.rest_surface, m.surface, m.node_of_vertex, *m.body, p_m,
+                         m.query_shift, m.tool_radius_m, m.patch_radius_m, m.patch);
+    if (!c.found) {
       throw Error("fem bench reference", "the block's surface answered no closest point");
     }
-    const double penetration = m.tool_radius_m - sp.signed_distance;
-    const double g = m.applied_n - m.k_c * std::max(0.0, penetration);
-    SurfacePoint at = sp;
-    if (m.applied_n > 0.0 && it > kReferencePlainIterations) {
-      const double w = 1.0 / static_cast<double>(it - kReferencePlainIterations + 1);
-      at.point = m.applied_point + w * (sp.point - m.applied_point);
-      at.normal = (m.applied_normal + w * (sp.normal - m.applied_normal)).normalized();
-    }
+    m.query_shift = c.shift;
+    const double g = m.applied_n - m.k_c * std::max(0.0, c.penetration_m);
     const bool same_contact = m.applied_n == 0.0 ||
-                              ((at.point - m.applied_point).norm() <= kReferencePointTolM &&
-                               (at.normal - m.applied_normal).norm() <= kReferenceNormalTol);
+                              ((c.rest_point - m.applied_point).norm() <= kReferencePointTolM &&
+                               (c.normal - m.applied_normal).norm() <= kReferenceNormalTol);
     if (std::abs(g) <= kReferenceForceTolN && same_contact) {
       max_iterations = std::max(max_iterations, it);
       return m.applied_n * m.applied_normal;
     }
-    contact_patch(m.surface, m.node_of_vertex, at, m.patch_radius_m, m.patch);
-    const double compliance = m.patch.empty() ? 0.0 : m.body->compliance_along(m.patch, at.normal);
+    const double compliance = m.body->compliance_along(m.patch, c.normal);
     const double slope = 1.0 + m.k_c * std::max(0.0, compliance);
     const double next_n = std::max(0.0, m.applied_n - g / slope);
     m.loads.clear();
     for (const FemNodeWeight& w : m.patch) {
-      m.loads.push_back({w.node, -next_n * w.weight * at.normal});
+      m.loads.push_back({w.node, -next_n * w.weight * c.normal});
     }
     m.body->set_loads(m.loads);
-    const FemStepStats st = m.body->solve_static();
-    if (std::getenv("FEMDBG")) {
-      std::fprintf(stderr, "it %d pen %.6g g %.3g F %.5g->%.5g dpt %.3g dn %.3g c %.4g cg %d conv %d ms %.2f patch %zu\n", it,
-                   penetration, g, m.applied_n, next_n, (at.point - m.applied_point).norm(),
-                   (at.normal - m.applied_normal).norm(), compliance, st.cg_iterations, st.converged ? 1 : 0, st.solve_ms, m.patch.size());
-    }
+    (void)m.body->solve_static();
     ++solves;
     m.applied_n = next_n;
-    m.applied_normal = at.normal;
-    m.applied_point = at.point;
+    m.applied_normal = c.normal;
+    m.applied_point = c.rest_point;
     m.refresh_surface();
   }
   max_iterations = std::max(max_iterations, kReferenceMaxIterations);
@@ -319,61 +359,6 @@ FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
                                                  const ProgressFn& progress) {
   spec.integration = FemIntegration::kQuasiStatic;
   const FemPalpationPath path = fem_palpation_path(spec);
-  if (const char* hold = std::getenv("FEMHOLD")) {
-    const double depth = std::atof(hold);
-    const Vec3 p(-0.01, 0.0, spec.size_m.z() + spec.tool_radius_m - depth);
-    World world(fem_block_world(spec));
-    Vec3 f = Vec3::Zero();
-    for (int i = 0; i < 2000; ++i) {
-      const Vec3 q = path.start_m + std::min(1.0, i / 500.0) * (p - path.start_m);
-      f = world.step(probe_at(q, i * 1e-3), 1e-3).command.force_world_n;
-      if (i % 100 == 99 || i > 1940) {
-        const FemBody& fb = world.fem()->body(0);
-        double maxu = 0;
-        for (std::size_t k2 = 0; k2 < fb.node_count(); ++k2) maxu = std::max(maxu, fb.displacement(as_node(k2)).norm());
-        const LocalContactModel& mm = world.state().fem_contacts[0].model;
-        std::fprintf(stderr, "world %d %.6f %.6f %.6f maxu %.6f f0 %.6f seq %llu push %.6f\n", i, f.x(), f.y(), f.z(), maxu, mm.f0_world_n.norm(),
-                     static_cast<unsigned long long>(mm.sequence), world.state().fem_contacts[0].push_world_n.norm());
-      }
-    }
-    {
-      const LocalContactModel& mm = world.state().fem_contacts[0].model;
-      const double kn = mm.normal_world.dot(mm.stiffness_n_per_m * mm.normal_world);
-      std::fprintf(stderr, "model f0 %.6f K %.3f x0 %.6f %.6f n %.4f valid %d\n", mm.f0_world_n.norm(), kn,
-                   mm.x0_world_m.x(), mm.x0_world_m.z(), mm.normal_world.z(), mm.valid ? 1 : 0);
-      const TriangleMesh& surf = world.surface(0, 0);
-      MeshBvh bvh(surf);
-      const SurfacePoint sp = bvh.closest_point(p);
-      std::fprintf(stderr, "world surface: sd %.6f pen %.6f point %.6f %.6f %.6f k_c*pen %.6f\n", sp.signed_distance,
-                   spec.tool_radius_m - sp.signed_distance, sp.point.x(), sp.point.y(), sp.point.z(),
-                   3000.0 * (spec.tool_radius_m - sp.signed_distance));
-      {
-        TriangleMesh copy = world.description().bodies[0].segments[0].mesh;
-        MeshBvh refitted(copy);
-        QueryHint hint;
-        (void)refitted.closest_point(p, &hint);
-        copy.vertices = surf.vertices;
-        refitted.refit();
-        const SurfacePoint a1 = refitted.closest_point(p, &hint);
-        QueryHint h2;
-        const SurfacePoint a2 = refitted.closest_point(p, &h2);
-        std::fprintf(stderr, "refit: sd %.6f (hint) %.6f (no hint) fresh %.6f tri %u %u %u\n", a1.signed_distance, a2.signed_distance,
-                     sp.signed_distance, a1.triangle, a2.triangle, sp.triangle);
-      }
-      const FemBody& fb = world.fem()->body(0);
-      double maxu = 0;
-      for (std::size_t i = 0; i < fb.node_count(); ++i) maxu = std::max(maxu, fb.displacement(as_node(i)).norm());
-      std::fprintf(stderr, "world fem max u %.6f updates %llu adopted %llu late %llu failures %llu seq %llu\n", maxu,
-                   static_cast<unsigned long long>(world.fem()->stats().updates), static_cast<unsigned long long>(world.fem()->adopted()),
-                   static_cast<unsigned long long>(world.fem()->late_adopted()), static_cast<unsigned long long>(world.state().fem_failures), static_cast<unsigned long long>(mm.sequence));
-    }
-    FemContactReference ref(spec);
-    for (int k = 1; k <= 10; ++k) {
-      const Vec3 r = ref.force_at(path.start_m + (k / 10.0) * (p - path.start_m));
-      std::fprintf(stderr, "ref %d %.6f %.6f %.6f it %d\n", k, r.x(), r.y(), r.z(), ref.max_iterations);
-    }
-  }
-  const double length = path.length_m();
   FemLocalModelError out;
   // The full solve along the path (it depends on the position only: quasi-static, elastic,
   // frictionless), once for every speed.
@@ -441,10 +426,6 @@ FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
       }
       world.advance_fem();
       const Vec3 ref = reference_at(s);
-      if (std::getenv("FEMDBG2") && i % 10 == 0) {
-        std::fprintf(stderr, "t %.3f s %.4f p %.4f %.4f  F %.4f %.4f %.4f  ref %.4f %.4f %.4f  n %.3f %.3f %.3f\n", t, s, p.x(), p.z(),
-                     rendered.x(), rendered.y(), rendered.z(), ref.x(), ref.y(), ref.z(), model.normal_world.x(), model.normal_world.y(), model.normal_world.z());
-      }
       if (rendered.norm() > 0.0 || ref.norm() > 0.0) {
         ++row.contact_steps;
         const double e = (rendered - ref).norm();
@@ -488,12 +469,9 @@ void measure_solver(const FemBlockSpec& spec, int steps, FemBenchRow& row) {
   row.factor_memory_bytes = body.factor_memory_bytes();
   row.factor_nonzeros = body.factor_nonzeros();
   // The press: on the top's centre, over the coupling's patch about it.
-  SurfacePoint top;
-  top.point = Vec3(0.0, 0.0, spec.size_m.z());
-  top.normal = Vec3::UnitZ();
   std::vector<FemNodeWeight> patch;
-  contact_patch(boundary.surface, boundary.node_of_vertex, top,
-                std::max(spec.patch_radius_m, spec.tool_radius_m), patch);
+  rest_patch(boundary.surface, boundary.node_of_vertex, Vec3(0.0, 0.0, spec.size_m.z()),
+             std::max(spec.patch_radius_m, spec.tool_radius_m), patch);
   std::vector<FemNodeForce> loads;
   std::vector<double> ms;
   ms.reserve(static_cast<std::size_t>(steps));
@@ -763,12 +741,15 @@ nlohmann::json fem_bench_to_json(const FemBenchResult& result) {
       {"local_model_error",
        {{"integration", "quasi_static"},
         {"reference",
-         "quasi-static equilibrium with the contact spring in series at the device position, the "
-         "coupling's contact law (load on the patch of surface nodes within the patch radius of the "
-         "closest point on the deformed surface, weights 1-(r/R)^2; F = k_c * (tool radius - distance "
-         "to the deformed surface)); Newton on F with the patch's condensed compliance, each iterate "
-         "FemBody::solve_static; not solve_static_sphere_contact (a rigid sphere with node penalties "
-         "is another contact law)"},
+         "quasi-static equilibrium of the FEM body with the contact spring in series at the device "
+         "position, under the coupling's contact law (world/fem_coupling.cpp): the contact point is "
+         "the rest surface's closest point to the tool less the patch's displacement, the load is "
+         "spread on the rest-surface vertices within the patch radius (weights 1-(r/R)^2) along the "
+         "patch's deformed normal, F = k_c * (tool radius - n.(p - (contact point + patch "
+         "displacement))); solved independently of the world by Newton on F (slope 1 + k_c * the "
+         "patch's condensed compliance), each iterate a FemBody::solve_static. Not "
+         "solve_static_sphere_contact: a rigid sphere held by node penalties is another contact "
+         "law"},
         {"reference_spacing_m", result.options.reference_spacing_m},
         {"interpolation", "linear in path length between reference points"},
         {"error", "|F_rendered - F_reference| (vectors); rms over steps where either is non-zero; "

@@ -11,10 +11,13 @@
 //   position, along a palpation path (down 6 mm into the top, 20 mm sideways pressed, up) at
 //   several speeds. Both with quasi-static integration. The full solve is the quasi-static
 //   equilibrium of the FEM body with the contact spring k_c in series at the device position,
-//   under the coupling's own contact law (the load spread on the surface nodes within the patch
-//   radius of the contact point, weights 1 − (r/R)²; the penetration measured against the
-//   deformed surface): F = k_c·(tool radius − distance to the deformed surface), solved by
-//   Newton on F with the patch's condensed compliance as slope, each iterate a solve_static.
+//   under the coupling's own contact law (world/fem_coupling.cpp, restated here: the contact is
+//   the rest surface's closest point to the tool less its patch's displacement, the load spread
+//   on the rest-surface vertices within the patch radius, weights 1 − (r/R)², along the patch's
+//   deformed normal; F = k_c·(tool radius − n·(p − (contact point + patch displacement)))),
+//   solved apart from the world by Newton on F with the patch's condensed compliance as slope,
+//   each iterate a FemBody::solve_static. Not solve_static_sphere_contact: a rigid sphere held by
+//   node penalties is another contact law, and its difference would not be the local model's.
 //
 // Shared by `hapsim bench fem` (table and JSON) and, for the block world, the passivity sweep's
 // FEM rows (bench/passivity_cases.h).

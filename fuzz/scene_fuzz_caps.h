@@ -14,6 +14,7 @@ namespace hapsim::fuzz {
 inline constexpr SceneDetailCaps kSceneDetailCaps{.csg_grid_nodes = 8000,
                                                   .knee_resolution_scale = 0.5,
                                                   .sphere_segments = 16,
-                                                  .sheet_nodes_per_side = 16};
+                                                  .sheet_nodes_per_side = 16,
+                                                  .tet_block_cells = 4};
 
 }  // namespace hapsim::fuzz

@@ -36,6 +36,9 @@ struct SceneDetailCaps {
   int sphere_segments = 0;
   /// A sheet's nodes per side: more are lowered to this.
   int sheet_nodes_per_side = 0;
+  /// A tet_block's cells along each axis: more are lowered to this (a FEM body factors its
+  /// system when the world is built: seconds for 80k tets).
+  int tet_block_cells = 0;
 };
 
 struct SceneLoadOptions {
