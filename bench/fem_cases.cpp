@@ -359,6 +359,7 @@ FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
                                                  const ProgressFn& progress) {
   spec.integration = FemIntegration::kQuasiStatic;
   const FemPalpationPath path = fem_palpation_path(spec);
+  const double length = path.length_m();
   FemLocalModelError out;
   // The full solve along the path (it depends on the position only: quasi-static, elastic,
   // frictionless), once for every speed.

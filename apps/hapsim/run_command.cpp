@@ -112,6 +112,9 @@ SegmentColouring parse_colouring(const std::string& name) {
   if (name == "groups") {
     return SegmentColouring::kGroups;
   }
+  if (name == "stress") {
+    return SegmentColouring::kStress;
+  }
   return SegmentColouring::kTissue;  // CLI11 has checked the name
 }
 
@@ -182,6 +185,11 @@ class RunSnapshots final : public SnapshotSink {
       std::printf(", and %zu numbered ones", written_ - 1);
     }
     std::printf(")\n");
+    if (scene_ && scene_->options().colouring == SegmentColouring::kStress) {
+      // The picture's legend: FEM bodies from their own colour through yellow to red.
+      std::printf("stress       FEM von Mises drawn red at %.2f kPa (yellow at half)\n",
+                  scene_->fem_stress_full_scale_pa() * 1e-3);
+    }
   }
 
  private:
@@ -520,9 +528,9 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--display-mode", args->display_mode, "Snapshot display mode")
       ->check(CLI::IsMember({"points", "lines", "faces"}));
   cmd->add_option("--colours", args->colours,
-                  "Snapshot colouring: tissue (by material), segments, or groups (knee method's "
-                  "vertex groups)")
-      ->check(CLI::IsMember({"tissue", "segments", "groups"}));
+                  "Snapshot colouring: tissue (by material), segments, groups (knee method's "
+                  "vertex groups) or stress (FEM bodies by von Mises stress)")
+      ->check(CLI::IsMember({"tissue", "segments", "groups", "stress"}));
   cmd->add_option("--size", args->size, "Snapshot size WIDTHxHEIGHT (default 1280x720)");
   cmd->add_option("--view", args->view,
                   "Snapshot from the scene's named view NAME (its \"views\"; default: the final "

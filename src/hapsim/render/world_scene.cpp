@@ -422,6 +422,7 @@ void WorldScene::apply_colouring() {
     RenderMesh& mesh = scene_.mesh(seg.mesh);
     switch (options_.colouring) {
       case SegmentColouring::kTissue:
+      case SegmentColouring::kStress:  // FEM bodies are shaded as their stress comes
         mesh.colour = seg.tissue_colour;
         scene_.set_vertex_colours(seg.mesh, {});
         if (seg.sheet) {
@@ -482,16 +483,45 @@ void WorldScene::update_fem_surfaces(World& world) {
     return;
   }
   for (std::size_t b = 0; b < fem->body_count(); ++b) {
-    const std::vector<Vec3>* vertices = fem->take_published_surface(b);
-    if (vertices == nullptr) {
+    const FemSurfaceFrame* frame = fem->take_published_surface(b);
+    if (frame == nullptr) {
       continue;
     }
     for (const auto& seg : segments_) {
       if (seg->body == fem->world_body(b)) {
-        scene_.update_positions(seg->mesh, *vertices);
+        scene_.update_positions(seg->mesh, frame->vertices);
+        if (options_.colouring == SegmentColouring::kStress) {
+          shade_stress(*seg, frame->von_mises_pa);
+        }
       }
     }
   }
+}
+
+// Tissue colour at no stress, yellow at half the frame's largest, red at it: where the tissue is
+// loaded, at a glance (the scale is the viewer's legend).
+void WorldScene::shade_stress(Segment& seg, std::span<const float> von_mises_pa) {
+  const std::vector<Vec3>& vertices = scene_.mesh(seg.mesh).geometry().vertices;
+  if (von_mises_pa.size() != vertices.size()) {
+    return;
+  }
+  double full = 0.0;
+  for (const float s : von_mises_pa) {
+    full = std::max(full, static_cast<double>(s));
+  }
+  fem_stress_full_scale_pa_ = full;
+  const Vec3f yellow(0.95f, 0.85f, 0.2f);
+  const Vec3f red(0.85f, 0.1f, 0.08f);
+  scratch_colours_.resize(vertices.size());
+  for (std::size_t v = 0; v < vertices.size(); ++v) {
+    const auto u =
+        full > 0.0
+            ? static_cast<float>(std::clamp(static_cast<double>(von_mises_pa[v]) / full, 0.0, 1.0))
+            : 0.0f;
+    scratch_colours_[v] = u < 0.5f ? (1.0f - 2.0f * u) * seg.tissue_colour + 2.0f * u * yellow
+                                   : (2.0f - 2.0f * u) * yellow + (2.0f * u - 1.0f) * red;
+  }
+  scene_.set_vertex_colours(seg.mesh, scratch_colours_);
 }
 
 void WorldScene::update_from_world(const World& world) {
@@ -504,6 +534,14 @@ void WorldScene::update_from_world(const World& world) {
       scene_.update_positions(seg->mesh, world.surface(seg->body, seg->index_in_body).vertices);
       if (seg->sheet && options_.colouring == SegmentColouring::kTissue) {
         shade_dent(*seg);
+      }
+      if (const FemCoupling* fem = world.fem();
+          fem != nullptr && options_.colouring == SegmentColouring::kStress) {
+        for (std::size_t b = 0; b < fem->body_count(); ++b) {
+          if (fem->world_body(b) == seg->body) {
+            shade_stress(*seg, fem->surface_von_mises_pa(b));
+          }
+        }
       }
     }
   }

@@ -18,6 +18,7 @@
 
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,9 @@ enum class SegmentColouring {
   kTissue,    ///< by material: bone ivory, muscle red, ligament pale yellow, skin skin-tone …
   kSegments,  ///< each segment its own palette colour
   kGroups,    ///< each knee-method vertex group its own colour (computed on first use)
+  /// FEM bodies by their von Mises stress (their tissue colour at 0, through yellow to red at
+  /// the largest stress on them this frame: fem_stress_full_scale_pa()); the rest by tissue.
+  kStress,
 };
 
 struct WorldSceneOptions {
@@ -94,6 +98,9 @@ class WorldScene {
   /// FEM bodies' surfaces as their FEM side last published them (world/fem_coupling.h; the one
   /// display thread): in a live session they move on the FEM thread, not in the snapshots.
   void update_fem_surfaces(World& world);
+  /// kStress: the von Mises stress drawn red on the FEM bodies in the last frame (Pa; 0 when
+  /// there is none).
+  [[nodiscard]] double fem_stress_full_scale_pa() const { return fem_stress_full_scale_pa_; }
 
   void set_options(const WorldSceneOptions& options);
   [[nodiscard]] const WorldSceneOptions& options() const { return options_; }
@@ -125,6 +132,8 @@ class WorldScene {
   void build_rig();
   void apply_colouring();
   void shade_dent(Segment& seg);
+  /// kStress: a FEM segment's vertices coloured by their von Mises stress.
+  void shade_stress(Segment& seg, std::span<const float> von_mises_pa);
   void add_sheet_grid(const Segment& seg);
   [[nodiscard]] bool hand_agrees_with_tools() const;
   /// The segment's knee-method index on its rest mesh, built on first use (its groups colour the
@@ -144,6 +153,7 @@ class WorldScene {
   std::vector<std::unique_ptr<Segment>> segments_;  // flat
   std::vector<Vec3> scratch_positions_;
   std::vector<Vec3f> scratch_colours_;
+  double fem_stress_full_scale_pa_ = 0.0;
   std::vector<ToolState> tools_;
   std::vector<double> tool_force_n_;
   int next_group_colour_ = 0;     // palette index of the next segment's first group

@@ -60,6 +60,12 @@ void draw_world_display_controls(WorldScene& view) {
   changed |= ImGui::RadioButton("segments", &colouring, 1);
   ImGui::SameLine();
   changed |= ImGui::RadioButton("groups", &colouring, 2);
+  ImGui::SameLine();
+  changed |= ImGui::RadioButton("stress", &colouring, 3);
+  if (colouring == 3) {
+    // The legend: FEM bodies from their own colour (0) through yellow to red at this stress.
+    ImGui::Text("FEM von Mises: red at %.2f kPa", view.fem_stress_full_scale_pa() * 1e-3);
+  }
   o.colouring = static_cast<SegmentColouring>(colouring);
   changed |= ImGui::SliderInt("sphere-tree level", &o.sphere_tree_level, -1, 6,
                               o.sphere_tree_level < 0 ? "off" : "%d");

@@ -41,6 +41,11 @@ struct FemCoupling::Body {
   /// same material point again when the tool has pushed the surface in.
   std::array<Vec3, kMaxTools> patch_shift;
   std::vector<FemNodeForce> loads;
+  /// Stress for display: per tet, and per surface vertex; a boundary vertex's tets (CSR).
+  std::vector<double> tet_von_mises_pa;
+  FemSurfaceFrame frame;
+  std::vector<std::uint32_t> vertex_tets_start;
+  std::vector<std::uint32_t> vertex_tets;
 };
 
 namespace {
@@ -124,6 +129,13 @@ FemCoupling::FemCoupling(const WorldModel& model) {
       throw Error("body '" + bd.name + "'", "a FEM body has exactly one segment (its surface)");
     }
     const FemBodyDescription& fd = *bd.fem;
+    if (!bodies_.empty() && fd.options.dt_s != bodies_.front()->description->options.dt_s) {
+      // One schedule for every FEM body: they are stepped together, one update after another.
+      throw Error(fd.source, "dt_s " + std::to_string(fd.options.dt_s) +
+                                 " differs from the first FEM body's " +
+                                 std::to_string(bodies_.front()->description->options.dt_s) +
+                                 ": every FEM body of a world steps at the same rate");
+    }
     auto body = std::make_unique<Body>();
     body->world_body = b;
     body->flat_segment = model.flat_segment(b, 0);
@@ -157,15 +169,43 @@ FemCoupling::FemCoupling(const WorldModel& model) {
       shift.setZero();
     }
     body->loads.reserve(256 * kMaxTools);
-    published_surfaces_.push_back(
-        std::make_unique<TripleBuffer<std::vector<Vec3>>>(body->surface.vertices));
+    // Which tets touch each boundary vertex (its stress is their mean), as a flat list.
+    const std::size_t nv = body->surface.vertices.size();
+    if (body->embedding.empty()) {
+      std::vector<std::int64_t> vertex_of_node(fd.tets.nodes.size(), -1);
+      for (std::size_t v = 0; v < nv; ++v) {
+        vertex_of_node[body->node_of_vertex[v]] = static_cast<std::int64_t>(v);
+      }
+      std::vector<std::vector<std::uint32_t>> lists(nv);
+      for (std::size_t t = 0; t < fd.tets.tets.size(); ++t) {
+        for (const std::uint32_t n : fd.tets.tets[t]) {
+          if (vertex_of_node[n] >= 0) {
+            lists[static_cast<std::size_t>(vertex_of_node[n])].push_back(
+                static_cast<std::uint32_t>(t));
+          }
+        }
+      }
+      body->vertex_tets_start.push_back(0);
+      for (const auto& l : lists) {
+        body->vertex_tets.insert(body->vertex_tets.end(), l.begin(), l.end());
+        body->vertex_tets_start.push_back(static_cast<std::uint32_t>(body->vertex_tets.size()));
+      }
+    }
+    body->tet_von_mises_pa.assign(fd.tets.tets.size(), 0.0);
+    body->frame.vertices = body->surface.vertices;
+    body->frame.von_mises_pa.assign(nv, 0.0f);
+    published_surfaces_.push_back(std::make_unique<TripleBuffer<FemSurfaceFrame>>(body->frame));
     bodies_.push_back(std::move(body));
   }
 }
 
-const std::vector<Vec3>* FemCoupling::take_published_surface(std::size_t fem_index) {
-  TripleBuffer<std::vector<Vec3>>& buffer = *published_surfaces_.at(fem_index);
+const FemSurfaceFrame* FemCoupling::take_published_surface(std::size_t fem_index) {
+  TripleBuffer<FemSurfaceFrame>& buffer = *published_surfaces_.at(fem_index);
   return buffer.update() ? &buffer.read_slot() : nullptr;
+}
+
+const std::vector<float>& FemCoupling::surface_von_mises_pa(std::size_t fem_index) const {
+  return bodies_.at(fem_index)->frame.von_mises_pa;
 }
 
 FemCoupling::~FemCoupling() = default;
@@ -277,8 +317,25 @@ bool FemCoupling::run_pending() {
   out.sequence = ++sequence_;
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     update_body(b, launch, out);
-    // Same size every time: the copy reuses the slot's storage.
-    published_surfaces_[b]->write_slot() = bodies_[b]->surface.vertices;
+    // Same sizes every time: the copy reuses the slot's storage.
+    Body& body = *bodies_[b];
+    body.fem->von_mises_pa(body.tet_von_mises_pa);
+    body.frame.vertices = body.surface.vertices;
+    for (std::size_t v = 0; v < body.frame.von_mises_pa.size(); ++v) {
+      double vm = 0.0;
+      if (body.embedding.empty()) {
+        const std::uint32_t first = body.vertex_tets_start[v];
+        const std::uint32_t end = body.vertex_tets_start[v + 1];
+        for (std::uint32_t k = first; k < end; ++k) {
+          vm += body.tet_von_mises_pa[body.vertex_tets[k]];
+        }
+        vm = end > first ? vm / (end - first) : 0.0;
+      } else {
+        vm = body.tet_von_mises_pa[body.embedding[v].tet];
+      }
+      body.frame.von_mises_pa[v] = static_cast<float>(vm);
+    }
+    published_surfaces_[b]->write_slot() = body.frame;
     published_surfaces_[b]->publish();
   }
   updates_.publish();
@@ -451,7 +508,10 @@ void FemCoupling::reset() {
     }
   }
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
-    published_surfaces_[b]->write_slot() = bodies_[b]->surface.vertices;
+    Body& body = *bodies_[b];
+    body.frame.vertices = body.surface.vertices;
+    std::fill(body.frame.von_mises_pa.begin(), body.frame.von_mises_pa.end(), 0.0f);
+    published_surfaces_[b]->write_slot() = body.frame;
     published_surfaces_[b]->publish();
   }
   epoch_.fetch_add(1, std::memory_order_acq_rel);

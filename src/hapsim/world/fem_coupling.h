@@ -38,6 +38,14 @@ namespace hapsim {
 
 class WorldModel;
 struct WorldState;
+
+/// A FEM body's surface as the FEM side last published it for display: its vertices (body frame)
+/// and each vertex's von Mises stress (Pa; a boundary node's: the mean over its tets; an embedded
+/// vertex's: its tet's).
+struct FemSurfaceFrame {
+  std::vector<Vec3> vertices;
+  std::vector<float> von_mises_pa;
+};
 class MeshBvh;
 
 /// The most FEM bodies one world couples.
@@ -118,9 +126,13 @@ class FemCoupling {
   [[nodiscard]] const FemBody& body(std::size_t fem_index) const;
   [[nodiscard]] FemBody& body(std::size_t fem_index);
   /// Display thread (one): the newest surface the FEM side published for FEM body `fem_index`
-  /// (the segment's vertices, body frame) if it changed since the last call, else null. The FEM
+  /// (the segment's vertices, body frame, and their stress) if it changed since the last call,
+  /// else null. The FEM
   /// side publishes after every update; the display reads without ever blocking it.
-  [[nodiscard]] const std::vector<Vec3>* take_published_surface(std::size_t fem_index);
+  [[nodiscard]] const FemSurfaceFrame* take_published_surface(std::size_t fem_index);
+  /// FEM side: each surface vertex's von Mises stress after the newest update (Pa). Only on the
+  /// FEM side's thread, or while nothing steps.
+  [[nodiscard]] const std::vector<float>& surface_von_mises_pa(std::size_t fem_index) const;
   /// A FEM body's largest node displacement after the newest update, m (any thread).
   [[nodiscard]] double max_displacement_m(std::size_t fem_index) const {
     return max_displacement_m_.at(fem_index).load(std::memory_order_relaxed);
@@ -148,7 +160,7 @@ class FemCoupling {
 
   std::vector<std::unique_ptr<Body>> bodies_;
   /// Per FEM body: its surface's vertices for display, from the FEM side to one display thread.
-  std::vector<std::unique_ptr<TripleBuffer<std::vector<Vec3>>>> published_surfaces_;
+  std::vector<std::unique_ptr<TripleBuffer<FemSurfaceFrame>>> published_surfaces_;
   std::size_t tool_count_ = 0;
   std::array<double, kMaxTools> tool_radius_m_{};
   std::atomic<std::uint64_t> period_steps_{0};
