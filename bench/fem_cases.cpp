@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <numbers>
 #include <sstream>
@@ -283,7 +284,12 @@ Vec3 FemContactReference::force_at(const Vec3& p_m) {
       m.loads.push_back({w.node, -next_n * w.weight * c.normal});
     }
     m.body->set_loads(m.loads);
-    (void)m.body->solve_static();
+    const FemStepStats st = m.body->solve_static();
+    if (std::getenv("FEMDBG")) {
+      std::fprintf(stderr, "it %d pen %.6g g %.3g F %.5g->%.5g dpt %.3g dn %.3g c %.4g cg %d conv %d ms %.2f patch %zu\n", it,
+                   c.penetration_m, g, m.applied_n, next_n, (c.rest_point - m.applied_point).norm(),
+                   (c.normal - m.applied_normal).norm(), compliance, st.cg_iterations, st.converged ? 1 : 0, st.solve_ms, m.patch.size());
+    }
     ++solves;
     m.applied_n = next_n;
     m.applied_normal = c.normal;

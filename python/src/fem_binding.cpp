@@ -14,6 +14,7 @@
 #include "hapsim/geometry/tet_mesh.h"
 #include "hapsim/geometry/tet_mesh_io.h"
 #include "hapsim/runtime/session.h"
+#include "hapsim/runtime/session_json.h"
 #include "hapsim/world/fem_coupling.h"
 #include "hapsim/world/world.h"
 
@@ -236,30 +237,8 @@ py::object fem_stats(const World& w) {
   if (!s) {
     return py::none();
   }
-  py::list bodies;
-  for (const FemSummary::Body& b : s->bodies) {
-    py::dict d;
-    d["name"] = b.name;
-    d["tets"] = b.tets;
-    d["nodes"] = b.nodes;
-    d["elasticity"] = b.elasticity;
-    d["final_max_displacement_m"] = b.final_max_displacement_m;
-    bodies.append(d);
-  }
-  py::dict update_ms;
-  update_ms["p50"] = s->update_ms_p50;
-  update_ms["p99"] = s->update_ms_p99;
-  update_ms["max"] = s->update_ms_max;
-  py::dict out;
-  out["bodies"] = bodies;
-  out["updates"] = s->updates;
-  out["period_steps"] = s->period_steps;
-  out["adopted"] = s->adopted;
-  out["late_adopted"] = s->late_adopted;
-  out["skipped_launches"] = s->skipped_launches;
-  out["update_ms"] = update_ms;
-  out["failures"] = s->failures;
-  return out;
+  // The very object `hapsim run --json` writes (one place builds it), as Python values.
+  return py::module_::import("json").attr("loads")(fem_summary_json(*s).dump());
 }
 
 // Adds a method to the World class bind_world made (what class_::def does, by the class object:

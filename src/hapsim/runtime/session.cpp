@@ -435,6 +435,12 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
   summary.missed_deadlines = st.missed_deadlines;
   const RealtimeSummary rt = realtime_summary(st, client.dropped_records());
   summary.realtime = rt;
+  summary.fem = fem_summary(world);
+  if (summary.fem && fem_thread.failures() > 0) {
+    // The FEM thread stopped at its first failed update; the haptic path kept its last models.
+    summary.fem->failures += fem_thread.failures();
+    summary.fem->error = fem_thread.error();
+  }
   return summary;
 }
 
@@ -505,7 +511,9 @@ SessionSummary run_session(World& world, Device& device, const SessionOptions& o
   SessionSummary summary = options.realtime ? run_realtime(world, device, options, steps)
                                             : run_inline(world, device, options, steps);
   summary.stiffness_clamps = stiffness_clamps(world);
-  summary.fem = fem_summary(world);
+  if (!summary.fem) {
+    summary.fem = fem_summary(world);
+  }
   return summary;
 }
 

@@ -182,6 +182,8 @@ struct FemSummary {
     double final_max_displacement_m = 0.0;
   };
   std::vector<Body> bodies;
+  /// FEM updates that threw (run inside the step, or the FEM thread's, which then stops), and
+  /// the first one's message.
   std::uint64_t failures = 0;
   std::string error;
 };

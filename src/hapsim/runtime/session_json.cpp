@@ -32,6 +32,27 @@ nlohmann::json realtime_json(const RealtimeSummary& rt) {
   return j;
 }
 
+nlohmann::json fem_summary_json(const FemSummary& f) {
+  nlohmann::json bodies = nlohmann::json::array();
+  for (const FemSummary::Body& b : f.bodies) {
+    bodies.push_back({{"name", b.name},
+                      {"tets", b.tets},
+                      {"nodes", b.nodes},
+                      {"elasticity", b.elasticity},
+                      {"final_max_displacement_m", b.final_max_displacement_m}});
+  }
+  return {
+      {"bodies", bodies},
+      {"updates", f.updates},
+      {"period_steps", f.period_steps},
+      {"adopted", f.adopted},
+      {"late_adopted", f.late_adopted},
+      {"skipped_launches", f.skipped_launches},
+      {"update_ms", {{"p50", f.update_ms_p50}, {"p99", f.update_ms_p99}, {"max", f.update_ms_max}}},
+      {"failures", f.failures},
+      {"error", f.error}};
+}
+
 nlohmann::json session_summary_json(const SceneDescription& scene, const World& world,
                                     const SessionSummary& s, const std::string& device_name) {
   nlohmann::json j;
@@ -95,24 +116,7 @@ nlohmann::json session_summary_json(const SceneDescription& scene, const World& 
     }
   }
   if (s.fem) {
-    const FemSummary& f = *s.fem;
-    nlohmann::json bodies = nlohmann::json::array();
-    for (const FemSummary::Body& b : f.bodies) {
-      bodies.push_back({{"name", b.name},
-                        {"tets", b.tets},
-                        {"nodes", b.nodes},
-                        {"elasticity", b.elasticity},
-                        {"final_max_displacement_m", b.final_max_displacement_m}});
-    }
-    j["fem"] = {{"bodies", bodies},
-                {"updates", f.updates},
-                {"period_steps", f.period_steps},
-                {"adopted", f.adopted},
-                {"late_adopted", f.late_adopted},
-                {"skipped_launches", f.skipped_launches},
-                {"update_ms",
-                 {{"p50", f.update_ms_p50}, {"p99", f.update_ms_p99}, {"max", f.update_ms_max}}},
-                {"failures", f.failures}};
+    j["fem"] = fem_summary_json(*s.fem);
   }
   std::vector<std::string> methods;
   for (const BodyDescription& b : world.description().bodies) {
