@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 namespace hapsim::bench {
@@ -24,7 +25,6 @@ namespace {
 constexpr double kHapticDtS = 1e-3;
 // The palpation's geometry: from 1 mm above the first touch, 6 mm beyond it, 20 mm sideways.
 constexpr double kClearanceM = 0.001;
-constexpr double kDepthM = 0.006;
 constexpr double kSlideM = 0.020;
 // The haptic-step run: down at x = −10 mm at 20 mm/s, then to and fro along x, pressed.
 constexpr double kHapticSpeedMPerS = 0.020;
@@ -32,7 +32,11 @@ constexpr double kHapticSpeedMPerS = 0.020;
 constexpr double kPressPeakN = 2.0;
 constexpr double kPressPeriodS = 1.0;
 // The reference's Newton iteration on the contact force.
-constexpr int kReferenceMaxIterations = 50;
+constexpr int kReferenceMaxIterations = 30;
+constexpr double kReferenceForceSlackN = 0.1;
+// A contact that moves this far, or turns this much, in one iteration is running away.
+constexpr double kReferenceRunawayM = 1e-3;
+constexpr double kReferenceRunawayNormal = 0.2;
 constexpr double kReferenceForceTolN = 1e-4;  // the corotational solves' own noise is ~2e-5 N
 // A patch moved by 1 µm changes its weights by under 0.05 %; a normal by 1e-4, the force's
 // direction by 0.01 %.
@@ -221,6 +225,8 @@ struct FemContactReference::Impl {
   Vec3 query_shift = Vec3::Zero();
   std::vector<FemNodeWeight> patch;
   std::vector<FemNodeForce> loads;
+  std::vector<Vec3> saved_x;
+  std::vector<FemNodeForce> saved_loads;
 
   void refresh_surface() {
     const std::vector<Vec3>& x = body->positions();
@@ -254,8 +260,20 @@ FemContactReference::FemContactReference(const FemBlockSpec& spec)
 
 FemContactReference::~FemContactReference() = default;
 
-Vec3 FemContactReference::force_at(const Vec3& p_m) {
+std::optional<Vec3> FemContactReference::force_at(const Vec3& p_m) {
   Impl& m = *impl_;
+  // Where the iteration starts: the last equilibrium, restored when this point has none.
+  m.saved_x = m.body->positions();
+  m.saved_loads = m.loads;
+  const double saved_n = m.applied_n;
+  const Vec3 saved_normal = m.applied_normal;
+  const Vec3 saved_point = m.applied_point;
+  const Vec3 saved_shift = m.query_shift;
+  // No equilibrium pushes harder than the contact spring compressed by the tool's overlap with
+  // the rest surface (the surface only gives way), with a margin for the Poisson bulge.
+  const SurfacePoint rest = m.rest_bvh->closest_point(p_m);
+  const double bound_n =
+      1.5 * m.k_c * std::max(0.0, m.tool_radius_m - rest.signed_distance) + kReferenceForceSlackN;
   // Newton on g(F) = F − k_c·max(0, penetration(F)), slope 1 + k_c·c with c the patch's
   // condensed compliance along the normal (the coupling's own update is this step, one per FEM
   // period); converged when g is below the tolerance and the contact point and normal the load
@@ -265,40 +283,57 @@ Vec3 FemContactReference::force_at(const Vec3& p_m) {
         coupling_contact(*m.rest_bvh, m.rest_surface, m.surface, m.node_of_vertex, *m.body, p_m,
                          m.query_shift, m.tool_radius_m, m.patch_radius_m, m.patch);
     if (!c.found) {
-      throw Error("fem bench reference", "the block's surface answered no closest point");
+      break;
     }
     m.query_shift = c.shift;
     const double g = m.applied_n - m.k_c * std::max(0.0, c.penetration_m);
-    const bool same_contact = m.applied_n == 0.0 ||
-                              ((c.rest_point - m.applied_point).norm() <= kReferencePointTolM &&
-                               (c.normal - m.applied_normal).norm() <= kReferenceNormalTol);
-    if (std::abs(g) <= kReferenceForceTolN && same_contact) {
-      max_iterations = std::max(max_iterations, it);
-      return m.applied_n * m.applied_normal;
+    const double moved_m = (c.rest_point - m.applied_point).norm();
+    const double turned = (c.normal - m.applied_normal).norm();
+    if (m.applied_n == 0.0 || (moved_m <= kReferencePointTolM && turned <= kReferenceNormalTol)) {
+      if (std::abs(g) <= kReferenceForceTolN) {
+        max_iterations = std::max(max_iterations, it);
+        return m.applied_n * m.applied_normal;
+      }
+    }
+    if (it > 2 && m.applied_n > 0.0 &&
+        (moved_m > kReferenceRunawayM || turned > kReferenceRunawayNormal)) {
+      break;  // the contact runs away: a point 0.1 mm on from an equilibrium moves it far less
     }
     const double compliance = m.body->compliance_along(m.patch, c.normal);
     const double slope = 1.0 + m.k_c * std::max(0.0, compliance);
     const double next_n = std::max(0.0, m.applied_n - g / slope);
+    if (std::getenv("FEMDBG")) {
+      std::fprintf(stderr, "it %d pen %.6g g %.3g F %.5g->%.5g moved %.3g turned %.3g c %.4g bound %.3g patch %zu\n", it,
+                   c.penetration_m, g, m.applied_n, next_n, moved_m, turned, compliance, bound_n, m.patch.size());
+    }
+    if (!std::isfinite(next_n) || next_n > bound_n) {
+      break;
+    }
     m.loads.clear();
     for (const FemNodeWeight& w : m.patch) {
       m.loads.push_back({w.node, -next_n * w.weight * c.normal});
     }
     m.body->set_loads(m.loads);
-    const FemStepStats st = m.body->solve_static();
-    if (std::getenv("FEMDBG")) {
-      std::fprintf(stderr, "it %d pen %.6g g %.3g F %.5g->%.5g dpt %.3g dn %.3g c %.4g cg %d conv %d ms %.2f patch %zu\n", it,
-                   c.penetration_m, g, m.applied_n, next_n, (c.rest_point - m.applied_point).norm(),
-                   (c.normal - m.applied_normal).norm(), compliance, st.cg_iterations, st.converged ? 1 : 0, st.solve_ms, m.patch.size());
-    }
+    const FemStepStats stats = m.body->solve_static();
     ++solves;
     m.applied_n = next_n;
     m.applied_normal = c.normal;
     m.applied_point = c.rest_point;
     m.refresh_surface();
+    if (!stats.converged) {
+      break;
+    }
   }
-  max_iterations = std::max(max_iterations, kReferenceMaxIterations);
   ++unconverged;
-  return m.applied_n * m.applied_normal;
+  m.loads = m.saved_loads;
+  m.body->set_loads(m.loads);
+  m.body->set_state(m.saved_x);
+  m.applied_n = saved_n;
+  m.applied_normal = saved_normal;
+  m.applied_point = saved_point;
+  m.query_shift = saved_shift;
+  m.refresh_surface();
+  return std::nullopt;
 }
 
 // --- the palpation -------------------------------------------------------------------------------
@@ -320,13 +355,13 @@ Vec3 FemPalpationPath::at(double s_m) const {
   return end_m;
 }
 
-FemPalpationPath fem_palpation_path(const FemBlockSpec& spec) {
+FemPalpationPath fem_palpation_path(const FemBlockSpec& spec, double depth_m) {
   const double touch_z = spec.size_m.z() + spec.tool_radius_m;
   const double x0 = -0.5 * kSlideM;
   FemPalpationPath p;
   p.start_m = Vec3(x0, 0.0, touch_z + kClearanceM);
-  p.pressed_m = Vec3(x0, 0.0, touch_z - kDepthM);
-  p.slid_m = Vec3(x0 + kSlideM, 0.0, touch_z - kDepthM);
+  p.pressed_m = Vec3(x0, 0.0, touch_z - depth_m);
+  p.slid_m = Vec3(x0 + kSlideM, 0.0, touch_z - depth_m);
   p.end_m = Vec3(x0 + kSlideM, 0.0, touch_z + kClearanceM);
   return p;
 }
@@ -361,22 +396,29 @@ bool fem_error_meets_target(const FemErrorRow& row) {
 
 FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
                                                  const std::vector<double>& speeds_m_per_s,
-                                                 double reference_spacing_m,
+                                                 double depth_m, double reference_spacing_m,
                                                  const ProgressFn& progress) {
   spec.integration = FemIntegration::kQuasiStatic;
-  const FemPalpationPath path = fem_palpation_path(spec);
+  const FemPalpationPath path = fem_palpation_path(spec, depth_m);
   const double length = path.length_m();
   FemLocalModelError out;
   // The full solve along the path (it depends on the position only: quasi-static, elastic,
   // frictionless), once for every speed.
   const auto intervals = static_cast<std::size_t>(std::ceil(length / std::max(reference_spacing_m, 1e-6)));
   const double ds = length / static_cast<double>(intervals);
-  std::vector<Vec3> reference(intervals + 1);
+  std::vector<Vec3> reference(intervals + 1, Vec3::Zero());
+  std::vector<char> defined(intervals + 1, 0);
   {
     const Stopwatch watch;
     FemContactReference full(spec);
     for (std::size_t j = 0; j <= intervals; ++j) {
-      reference[j] = full.force_at(path.at(static_cast<double>(j) * ds));
+      const std::optional<Vec3> f = full.force_at(path.at(static_cast<double>(j) * ds));
+      if (f) {
+        reference[j] = *f;
+        defined[j] = 1;
+      } else if (out.first_unconverged_at_m < 0.0) {
+        out.first_unconverged_at_m = static_cast<double>(j) * ds;
+      }
       if (j % 32 == 0) {
         report_progress(progress, "full solve along the path",
                         0.5 * static_cast<double>(j) / static_cast<double>(intervals));
@@ -388,11 +430,15 @@ FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
     out.reference_unconverged = full.unconverged;
     out.reference_ms = watch.elapsed_ms();
   }
-  const auto reference_at = [&](double s) -> Vec3 {
+  // Linear between reference points; undefined next to a point without an equilibrium.
+  const auto reference_at = [&](double s) -> std::optional<Vec3> {
     const double u = std::clamp(s / ds, 0.0, static_cast<double>(intervals));
     const auto j = std::min(static_cast<std::size_t>(u), intervals - 1);
     const double f = u - static_cast<double>(j);
-    return (1.0 - f) * reference[j] + f * reference[j + 1];
+    if ((!defined[j] && f < 1.0) || (!defined[j + 1] && f > 0.0)) {
+      return std::nullopt;
+    }
+    return Vec3((1.0 - f) * reference[j] + f * reference[j + 1]);
   };
   double peak = 0.0;
   for (const Vec3& f : reference) {
@@ -432,7 +478,18 @@ FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
         }
       }
       world.advance_fem();
-      const Vec3 ref = reference_at(s);
+      row.peak_rendered_n = std::max(row.peak_rendered_n, rendered.norm());
+      const std::optional<Vec3> defined_ref = reference_at(s);
+      if (std::getenv("FEMDBG2") && i % 10 == 0) {
+        const Vec3 r0 = defined_ref ? *defined_ref : Vec3(-9, -9, -9);
+        std::fprintf(stderr, "t %.3f s %.4f p %.4f %.4f  F %.4f %.4f %.4f  ref %.4f %.4f %.4f n %.3f %.3f %.3f\n", t, s, p.x(), p.z(),
+                     rendered.x(), rendered.y(), rendered.z(), r0.x(), r0.y(), r0.z(), model.normal_world.x(), model.normal_world.y(), model.normal_world.z());
+      }
+      if (!defined_ref) {
+        ++row.undefined_steps;
+        continue;
+      }
+      const Vec3 ref = *defined_ref;
       if (rendered.norm() > 0.0 || ref.norm() > 0.0) {
         ++row.contact_steps;
         const double e = (rendered - ref).norm();
@@ -507,12 +564,12 @@ void measure_solver(const FemBlockSpec& spec, int steps, FemBenchRow& row) {
   row.step_ms_mean = s.mean;
 }
 
-void measure_haptic(const FemBlockSpec& spec, double seconds, FemBenchRow& row) {
+void measure_haptic(const FemBlockSpec& spec, double seconds, double depth_m, FemBenchRow& row) {
   FemBlockSpec dynamic = spec;
   dynamic.integration = FemIntegration::kBackwardEuler;
   World world(fem_block_world(dynamic));
   world.set_fem_deferred(true);  // FEM updates between cycles, as `hapsim run` does
-  const FemPalpationPath path = fem_palpation_path(dynamic);
+  const FemPalpationPath path = fem_palpation_path(dynamic, depth_m);
   // Down into the top at the slide's start (untimed).
   const double down_m = (path.pressed_m - path.start_m).norm();
   const auto down_steps = static_cast<std::size_t>(std::lround(down_m / kHapticSpeedMPerS / kHapticDtS));
@@ -529,7 +586,7 @@ void measure_haptic(const FemBlockSpec& spec, double seconds, FemBenchRow& row) 
   us.reserve(steps);
   const double leg_s = kSlideM / kHapticSpeedMPerS;
   for (std::size_t i = 0; i < steps; ++i) {
-    // To and fro along the slide, pressed 6 mm.
+    // To and fro along the slide, pressed.
     const double phase = std::fmod(static_cast<double>(i + 1) * kHapticDtS, 2.0 * leg_s) / leg_s;
     const double f = phase <= 1.0 ? phase : 2.0 - phase;
     const DeviceInput in = probe_at(path.pressed_m + f * (path.slid_m - path.pressed_m), t);
@@ -581,12 +638,12 @@ FemBenchResult run_fem_bench(const FemBenchOptions& options) {
       report_progress(options.progress, name + ": FEM steps", at(0.0));
       measure_solver(spec, options.fem_steps, row);
       report_progress(options.progress, name + ": haptic steps", at(0.2));
-      measure_haptic(spec, options.haptic_s, row);
+      measure_haptic(spec, options.haptic_s, options.depth_m, row);
       if (options.measure_error && !options.speeds_m_per_s.empty()) {
         const ProgressFn inner = [&](std::string_view label, double fraction) {
           report_progress(options.progress, name + ": " + std::string(label), at(0.3 + 0.7 * fraction));
         };
-        row.error = measure_fem_local_model_error(spec, options.speeds_m_per_s,
+        row.error = measure_fem_local_model_error(spec, options.speeds_m_per_s, options.depth_m,
                                                   options.reference_spacing_m, inner);
         row.error_measured = true;
       }
@@ -629,11 +686,17 @@ std::string format_fem_table(const FemBenchResult& result) {
       continue;
     }
     if (!header) {
-      out << "\nLocal model vs the full solve (quasi-static; the contact spring in series at the "
-             "device position), palpation path 6 mm deep, 20 mm sideways:\n";
-      std::snprintf(line, sizeof line, "%6s %-12s %6s %7s %9s %7s %9s %7s %12s %8s %s\n", "tets",
+      std::snprintf(line, sizeof line,
+                    "\nLocal model vs the full solve (quasi-static; the contact spring in series at "
+                    "the device position), palpation %.1f mm deep, 20 mm sideways; undefined: "
+                    "steps next to a path point where the contact law has no equilibrium (left "
+                    "out; from: where along the path, mm):\n",
+                    result.options.depth_m * 1e3);
+      out << line;
+      std::snprintf(line, sizeof line,
+                    "%6s %-12s %6s %7s %9s %7s %9s %7s %12s %8s %4s %15s %9s\n", "tets",
                     "elasticity", "mm/s", "peak_N", "max_err_N", "max_%", "rms_err_N", "rms_%",
-                    "spring_max_N", "target", "met");
+                    "spring_max_N", "target", "met", "undefined/steps", "from_mm");
       out << line;
       header = true;
     }
@@ -644,12 +707,19 @@ std::string format_fem_table(const FemBenchResult& result) {
         std::snprintf(target, sizeof target, fraction <= 0.05 ? "%.0f%%|0.05N" : "%.0f%%",
                       100.0 * fraction);
       }
+      char undefined[40];
+      std::snprintf(undefined, sizeof undefined, "%zu/%zu", e.undefined_steps, e.steps);
+      char from[24] = "-";
+      if (r.error.first_unconverged_at_m >= 0.0) {
+        std::snprintf(from, sizeof from, "%.1f", r.error.first_unconverged_at_m * 1e3);
+      }
       std::snprintf(line, sizeof line,
-                    "%6zu %-12s %6.0f %7.3f %9.4f %7.2f %9.4f %7.2f %12.4f %8s %s\n", r.tets,
-                    elasticity_name(r.elasticity).c_str(), e.speed_m_per_s * 1e3, e.peak_force_n,
-                    e.max_error_n, e.max_error_percent(), e.rms_error_n, e.rms_error_percent(),
-                    e.max_spring_error_n, target,
-                    fraction > 0.0 ? (fem_error_meets_target(e) ? "yes" : "NO") : "-");
+                    "%6zu %-12s %6.0f %7.3f %9.4f %7.2f %9.4f %7.2f %12.4f %8s %4s %15s %9s\n",
+                    r.tets, elasticity_name(r.elasticity).c_str(), e.speed_m_per_s * 1e3,
+                    e.peak_force_n, e.max_error_n, e.max_error_percent(), e.rms_error_n,
+                    e.rms_error_percent(), e.max_spring_error_n, target,
+                    fraction > 0.0 ? (fem_error_meets_target(e) ? "yes" : "NO") : "-", undefined,
+                    from);
       out << line;
     }
   }
@@ -691,7 +761,9 @@ nlohmann::json fem_bench_to_json(const FemBenchResult& result) {
         const double fraction = fem_error_target_fraction(e.speed_m_per_s);
         speeds.push_back({{"speed_mm_per_s", e.speed_m_per_s * 1e3},
                           {"steps", e.steps},
+                          {"undefined_steps", e.undefined_steps},
                           {"contact_steps", e.contact_steps},
+                          {"peak_rendered_n", e.peak_rendered_n},
                           {"peak_force_n", e.peak_force_n},
                           {"max_error_n", e.max_error_n},
                           {"rms_error_n", e.rms_error_n},
@@ -709,13 +781,17 @@ nlohmann::json fem_bench_to_json(const FemBenchResult& result) {
                                     {"solves", r.error.reference_solves},
                                     {"max_iterations", r.error.reference_max_iterations},
                                     {"unconverged", r.error.reference_unconverged},
+                                    {"first_unconverged_at_path_m",
+                                     r.error.first_unconverged_at_m >= 0.0
+                                         ? nlohmann::json(r.error.first_unconverged_at_m)
+                                         : nlohmann::json(nullptr)},
                                     {"ms", r.error.reference_ms}}}};
     } else {
       row["local_model_error"] = nullptr;
     }
     rows.push_back(std::move(row));
   }
-  const FemPalpationPath path = fem_palpation_path(b);
+  const FemPalpationPath path = fem_palpation_path(b, result.options.depth_m);
   return {
       {"block",
        {{"generator", "make_tet_block"},
@@ -743,7 +819,8 @@ nlohmann::json fem_bench_to_json(const FemBenchResult& result) {
        {{"integration", "backward_euler"},
         {"fem_deferred", true},
         {"timed", "World::step only; advance_fem() between cycles, untimed (as hapsim run)"},
-        {"motion", "pressed 6 mm, to and fro 20 mm along x at 20 mm/s"},
+        {"motion", "pressed depth_m beyond the first touch, to and fro 20 mm along x at 20 mm/s"},
+        {"depth_m", result.options.depth_m},
         {"seconds", result.options.haptic_s}}},
       {"local_model_error",
        {{"integration", "quasi_static"},
@@ -766,7 +843,7 @@ nlohmann::json fem_bench_to_json(const FemBenchResult& result) {
           {"pressed_m", {path.pressed_m.x(), path.pressed_m.y(), path.pressed_m.z()}},
           {"slid_m", {path.slid_m.x(), path.slid_m.y(), path.slid_m.z()}},
           {"end_m", {path.end_m.x(), path.end_m.y(), path.end_m.z()}},
-          {"depth_m", kDepthM},
+          {"depth_m", result.options.depth_m},
           {"slide_m", kSlideM},
           {"hold_s", kFemPathHoldS}}},
         {"targets", {{"10_mm_per_s", "5 % of peak or 0.05 N"}, {"50_mm_per_s", "10 % of peak"}}}}},

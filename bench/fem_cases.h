@@ -33,6 +33,7 @@
 #include <array>
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,20 +72,23 @@ class FemContactReference {
   FemContactReference(const FemContactReference&) = delete;
   FemContactReference& operator=(const FemContactReference&) = delete;
 
-  /// The force on the tool (world frame = the block's frame) with its centre at `p_m`.
-  [[nodiscard]] Vec3 force_at(const Vec3& p_m);
+  /// The force on the tool (world frame = the block's frame) with its centre at `p_m`; nullopt
+  /// where the law has no equilibrium the iteration can find (it diverges: the contact point or
+  /// normal runs away, the force passes what the tool's overlap with the rest surface allows, or
+  /// a static solve fails), and then the body is put back as it was at the last equilibrium.
+  [[nodiscard]] std::optional<Vec3> force_at(const Vec3& p_m);
 
-  std::size_t solves = 0;        ///< solve_static calls
-  int max_iterations = 0;        ///< Newton iterations at the worst point
-  std::size_t unconverged = 0;   ///< points where the iteration stopped without converging
+  std::size_t solves = 0;       ///< solve_static calls
+  int max_iterations = 0;       ///< Newton iterations at the worst converged point
+  std::size_t unconverged = 0;  ///< points without an equilibrium
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 
-/// The palpation path: from 1 mm above the top at x = −10 mm down 7 mm (6 mm beyond the first
-/// touch), 20 mm along +x pressed, then up 7 mm; held 50 ms at each end.
+/// The palpation path: from 1 mm above the top at x = −10 mm down to `depth_m` beyond the first
+/// touch, 20 mm along +x pressed, then up again; held 50 ms at each end.
 struct FemPalpationPath {
   Vec3 start_m;
   Vec3 pressed_m;
@@ -93,12 +97,18 @@ struct FemPalpationPath {
   [[nodiscard]] double length_m() const;
   [[nodiscard]] Vec3 at(double s_m) const;
 };
-[[nodiscard]] FemPalpationPath fem_palpation_path(const FemBlockSpec& spec);
+inline constexpr double kFemPalpationDepthM = 0.006;
+[[nodiscard]] FemPalpationPath fem_palpation_path(const FemBlockSpec& spec,
+                                                  double depth_m = kFemPalpationDepthM);
 inline constexpr double kFemPathHoldS = 0.05;
 
 struct FemErrorRow {
   double speed_m_per_s = 0.0;
   std::size_t steps = 0;
+  /// Steps left out: the path there lies between reference points without an equilibrium.
+  std::size_t undefined_steps = 0;
+  /// The largest rendered force over the whole path, N (the undefined stretch included).
+  double peak_rendered_n = 0.0;
   /// Steps where the reference or the rendered force is not zero (the RMS is over these).
   std::size_t contact_steps = 0;
   /// The largest reference force along the path, N (the scale of the percentages).
@@ -126,6 +136,8 @@ struct FemLocalModelError {
   std::size_t reference_solves = 0;
   int reference_max_iterations = 0;
   std::size_t reference_unconverged = 0;
+  /// Where along the path (m) the reference first had no equilibrium; negative: nowhere.
+  double first_unconverged_at_m = -1.0;
   double reference_ms = 0.0;
 };
 
@@ -134,7 +146,8 @@ struct FemLocalModelError {
 /// and interpolated linearly between.
 [[nodiscard]] FemLocalModelError measure_fem_local_model_error(
     FemBlockSpec spec, const std::vector<double>& speeds_m_per_s,
-    double reference_spacing_m = 1e-4, const ProgressFn& progress = {});
+    double depth_m = kFemPalpationDepthM, double reference_spacing_m = 1e-4,
+    const ProgressFn& progress = {});
 
 struct FemBenchOptions {
   /// Approximate tet counts; each becomes a block of cubic cells (fem_block_cells).
@@ -146,6 +159,8 @@ struct FemBenchOptions {
   /// Timed haptic steps per row, s of simulated time in contact.
   double haptic_s = 2.0;
   double reference_spacing_m = 1e-4;
+  /// How deep the palpation (and the haptic-step run) presses beyond the first touch.
+  double depth_m = kFemPalpationDepthM;
   bool measure_error = true;
   ProgressFn progress;
 };

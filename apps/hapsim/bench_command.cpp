@@ -253,6 +253,7 @@ struct FemArgs {
   int steps = 200;
   double haptic_s = 2.0;
   double reference_spacing_mm = 0.1;
+  double depth_mm = 6.0;
   bool no_error = false;
   std::string json_path;
 };
@@ -288,6 +289,7 @@ void run_fem(const FemArgs& args) {
   options.fem_steps = args.steps;
   options.haptic_s = args.haptic_s;
   options.reference_spacing_m = 1e-3 * args.reference_spacing_mm;
+  options.depth_m = 1e-3 * args.depth_mm;
   options.measure_error = !args.no_error;
   std::string sizes;
   for (const std::size_t n : options.tet_counts) {
@@ -308,13 +310,14 @@ void run_fem(const FemArgs& args) {
                 "Block %.0f x %.0f x %.0f mm (make_tet_block), bottom fixed; E %.0f kPa, nu %.2f, "
                 "Rayleigh %.0f 1/s, %.2f s; contact %.0f N/m, %.1f N s/m, tool r %.0f mm, patch r "
                 "%.0f mm\nFEM step: bare FemBody, backward Euler dt %.0f ms, one core, %d steps of a "
-                "0-2-0 N press at 1 Hz; haptic step: World::step pressed 6 mm sliding at 20 mm/s, "
-                "FEM deferred (advance_fem between cycles, untimed), %.1f s\n",
+                "0-2-0 N press at 1 Hz; haptic step: World::step pressed %.1f mm sliding at 20 "
+                "mm/s, FEM deferred (advance_fem between cycles, untimed), %.1f s\n",
                 b.size_m.x() * 1e3, b.size_m.y() * 1e3, b.size_m.z() * 1e3,
                 b.material.youngs_modulus_pa / 1e3, b.material.poisson_ratio,
                 b.material.rayleigh_mass_per_s, b.material.rayleigh_stiffness_s,
                 b.contact_stiffness_n_per_m, b.contact_damping_n_s_per_m, b.tool_radius_m * 1e3,
-                b.patch_radius_m * 1e3, b.dt_s * 1e3, options.fem_steps, options.haptic_s);
+                b.patch_radius_m * 1e3, b.dt_s * 1e3, options.fem_steps, options.depth_m * 1e3,
+                options.haptic_s);
   std::cout << setup << bench::format_fem_table(result);
   std::snprintf(setup, sizeof setup, "%zu rows in %.1f s; load average %.2f before, %.2f after\n",
                 result.rows.size(), watch.elapsed_s(), load_before, load_after);
@@ -710,6 +713,9 @@ void add_bench_command(CLI::App& app) {
   fem->add_option("--reference-spacing", fem_args->reference_spacing_mm,
                   "Path length between full solves, mm (default 0.1; linear in between)")
       ->check(CLI::Range(0.001, 5.0));
+  fem->add_option("--depth", fem_args->depth_mm,
+                  "How deep the palpation presses beyond the first touch, mm (default 6)")
+      ->check(CLI::Range(0.1, 15.0));
   fem->add_flag("--no-error", fem_args->no_error, "Skip the local model's force error");
   fem->add_option("--json", fem_args->json_path, "Write the rows as JSON to FILE");
   fem->callback([fem_args] { run_fem(*fem_args); });
