@@ -16,7 +16,8 @@
 //   on the rest-surface vertices within the patch radius, weights 1 − (r/R)², along the patch's
 //   deformed normal; F = k_c·(tool radius − n·(p − (contact point + patch displacement)))),
 //   solved apart from the world by Newton on F with the patch's condensed compliance as slope,
-//   each iterate a FemBody::solve_static. Not solve_static_sphere_contact: a rigid sphere held by
+//   each iterate a quasi-static FemBody::step (the coupling's update), iterated until the body has
+//   settled. Not solve_static_sphere_contact: a rigid sphere held by
 //   node penalties is another contact law, and its difference would not be the local model's.
 //
 // Shared by `hapsim bench fem` (table and JSON) and, for the block world, the passivity sweep's
@@ -78,7 +79,7 @@ class FemContactReference {
   /// a static solve fails), and then the body is put back as it was at the last equilibrium.
   [[nodiscard]] std::optional<Vec3> force_at(const Vec3& p_m);
 
-  std::size_t solves = 0;       ///< solve_static calls
+  std::size_t solves = 0;       ///< quasi-static steps (FemBody::step) taken
   int max_iterations = 0;       ///< Newton iterations at the worst converged point
   std::size_t unconverged = 0;  ///< points without an equilibrium
 
@@ -200,7 +201,9 @@ struct FemBenchRow {
   bool error_measured = false;
   FemLocalModelError error;
 
-  [[nodiscard]] double rate_hz_median() const { return step_ms_p50 > 0.0 ? 1e3 / step_ms_p50 : 0.0; }
+  [[nodiscard]] double rate_hz_median() const {
+    return step_ms_p50 > 0.0 ? 1e3 / step_ms_p50 : 0.0;
+  }
   [[nodiscard]] double rate_hz_worst() const { return step_ms_max > 0.0 ? 1e3 / step_ms_max : 0.0; }
 };
 

@@ -313,9 +313,9 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
   for (const DeviceProfile* profile : profiles) {
     for (const Surface& surface : surfaces) {
       const auto port_stiffness = [&](double k) {
-        return surface.port_stiffness ? surface.port_stiffness(*surface.build(*profile, k),
-                                                               surface.line, k)
-                                      : k;
+        return surface.port_stiffness
+                   ? surface.port_stiffness(*surface.build(*profile, k), surface.line, k)
+                   : k;
       };
       const auto run_at = [&](double k) {
         const double k_port = port_stiffness(k);
@@ -326,10 +326,9 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
       };
       const double rated = profile->max_stiffness_n_per_m;
       for (const double factor : {1.0, 1.5}) {
-        PassivityRow row{profile->name, surface.name, rated, factor, options.port.device_mass_kg,
-                         run_at(factor * rated)};
-        row.port_stiffness_n_per_m = port_stiffness(factor * rated);
-        result.rows.push_back(row);
+        result.rows.push_back({profile->name, surface.name, rated, factor,
+                               options.port.device_mass_kg, run_at(factor * rated)});
+        result.rows.back().port_stiffness_n_per_m = port_stiffness(factor * rated);
       }
       if (options.bisection_steps > 0) {
         ZWidthRow z{profile->name, surface.name, rated, 0.0, false};

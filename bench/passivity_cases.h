@@ -1,6 +1,6 @@
 // The passivity sweep (issue 14 item 4, `hapsim bench passivity`): each shipped device profile
-// rendering a plane, a sphere, the virtual sheet, the knee and a FEM block at 1.0x and 1.5x its rated
-// stiffness, held by a simulated device and hand; the energy the rendering generated at the
+// rendering a plane, a sphere, the virtual sheet, the knee and a FEM block at 1.0x and 1.5x its
+// rated stiffness, held by a simulated device and hand; the energy the rendering generated at the
 // device port, and the largest stiffness that stays stable (the profile's Z-width) beside its
 // rating.
 //

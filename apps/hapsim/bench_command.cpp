@@ -306,18 +306,18 @@ void run_fem(const FemArgs& args) {
   const double load_after = load_average();
   const bench::FemBlockSpec& b = result.block;
   char setup[600];
-  std::snprintf(setup, sizeof setup,
-                "Block %.0f x %.0f x %.0f mm (make_tet_block), bottom fixed; E %.0f kPa, nu %.2f, "
-                "Rayleigh %.0f 1/s, %.2f s; contact %.0f N/m, %.1f N s/m, tool r %.0f mm, patch r "
-                "%.0f mm\nFEM step: bare FemBody, backward Euler dt %.0f ms, one core, %d steps of a "
-                "0-2-0 N press at 1 Hz; haptic step: World::step pressed %.1f mm sliding at 20 "
-                "mm/s, FEM deferred (advance_fem between cycles, untimed), %.1f s\n",
-                b.size_m.x() * 1e3, b.size_m.y() * 1e3, b.size_m.z() * 1e3,
-                b.material.youngs_modulus_pa / 1e3, b.material.poisson_ratio,
-                b.material.rayleigh_mass_per_s, b.material.rayleigh_stiffness_s,
-                b.contact_stiffness_n_per_m, b.contact_damping_n_s_per_m, b.tool_radius_m * 1e3,
-                b.patch_radius_m * 1e3, b.dt_s * 1e3, options.fem_steps, options.depth_m * 1e3,
-                options.haptic_s);
+  std::snprintf(
+      setup, sizeof setup,
+      "Block %.0f x %.0f x %.0f mm (make_tet_block), bottom fixed; E %.0f kPa, nu %.2f, "
+      "Rayleigh %.0f 1/s, %.2f s; contact %.0f N/m, %.1f N s/m, tool r %.0f mm, patch r "
+      "%.0f mm\nFEM step: bare FemBody, backward Euler dt %.0f ms, one core, %d steps of a "
+      "0-2-0 N press at 1 Hz; haptic step: World::step pressed %.1f mm sliding at 20 "
+      "mm/s, FEM deferred (advance_fem between cycles, untimed), %.1f s\n",
+      b.size_m.x() * 1e3, b.size_m.y() * 1e3, b.size_m.z() * 1e3,
+      b.material.youngs_modulus_pa / 1e3, b.material.poisson_ratio, b.material.rayleigh_mass_per_s,
+      b.material.rayleigh_stiffness_s, b.contact_stiffness_n_per_m, b.contact_damping_n_s_per_m,
+      b.tool_radius_m * 1e3, b.patch_radius_m * 1e3, b.dt_s * 1e3, options.fem_steps,
+      options.depth_m * 1e3, options.haptic_s);
   std::cout << setup << bench::format_fem_table(result);
   std::snprintf(setup, sizeof setup, "%zu rows in %.1f s; load average %.2f before, %.2f after\n",
                 result.rows.size(), watch.elapsed_s(), load_before, load_after);
@@ -693,8 +693,7 @@ void add_bench_command(CLI::App& app) {
       "solver's step rate on one core, factorisation time and memory, the haptic step with the "
       "block in contact, and the 1 kHz local model's force error against a full solve along a "
       "palpation");
-  fem->add_option("--sizes", fem_args->sizes,
-                  "Approximate tet counts (default 1000,5000,20000)")
+  fem->add_option("--sizes", fem_args->sizes, "Approximate tet counts (default 1000,5000,20000)")
       ->delimiter(',')
       ->check(CLI::Range(std::size_t{6}, std::size_t{2000000}));
   fem->add_flag("--large", fem_args->large, "Add the 80k-tet block (its factorisation takes long)");
