@@ -61,6 +61,7 @@ struct DeviceArgs {
   std::string driver_config;
   std::string profile = "touch";
   std::string link_shim;
+  double say_force_above_n = std::numeric_limits<double>::quiet_NaN();  // NaN: say nothing
 };
 
 // A simulation host with no model for this long is silent (its models come every millisecond).
@@ -283,6 +284,7 @@ void run_device(const DeviceArgs& args) {
   std::uint64_t joins = 0;
   std::optional<Silence> pending_silence;  // silent, force not yet reported at zero
   std::vector<Silence> silences;
+  bool above_said = false;  // --say-force-above: said once per rise, again after a fall below
   while (loop.running() && !stop.load(std::memory_order_relaxed)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
     if (auto fresh = take_said(info_in); fresh && fresh->serve_id != serve_id) {
@@ -306,6 +308,15 @@ void run_device(const DeviceArgs& args) {
       pending_silence = Silence{host_s(s.last_model_ns), s.force_at_last_model_n, 0.0};
     }
     sim_alive = alive;
+    if (!std::isnan(args.say_force_above_n)) {
+      const bool above = s.force_n > args.say_force_above_n;
+      if (above && !above_said) {
+        std::printf("force        above %.2f N at %.3f s (%.3f N)\n", args.say_force_above_n,
+                    host_s(now_ns), s.force_n);
+        std::fflush(stdout);
+      }
+      above_said = above;
+    }
     if (pending_silence && s.force_n == 0.0) {
       // The force reached zero: how long after the last model arrived.
       pending_silence->zero_after_ms =
@@ -409,6 +420,10 @@ void add_device_command(CLI::App& app) {
                   "Pass the local models received through a simulated link: "
                   "delay_ms=D,jitter_ms=J,loss=L,outage_at_s=T,outage_s=S,seed=N (no root, no "
                   "netem)");
+  cmd->add_option("--say-force-above", args->say_force_above_n,
+                  "Print a line each time the rendered force rises above this many newtons "
+                  "(for an operator or a script watching the device host)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--json", args->json_path, "Write the summary as JSON");
   add_dds_options(cmd, args->dds);
   cmd->callback([args] {

@@ -173,11 +173,13 @@ TEST(ThreeProcesses, KillingServeFadesTheForceAndTheDeviceRendersAgainWhenItRetu
   ASSERT_TRUE(serve->wait_for("dds ", 20s)) << serve->output();
   // The device runs until stopped (120 s bounds a hang): a slow build's second serve may take
   // longer than the palpation's 9 s to load and join.
-  BackgroundHapsim device("device --duration 120" + net + " --json " + device_json.string(),
-                          hapsim::test::temp_path("device-kill.log"));
+  // It says when its force rises above 2 N: serve is killed then, mid-contact, however late a
+  // loaded machine starts the palpation (a fixed 3.3 s sleep once killed it at 0.19 N).
+  BackgroundHapsim device(
+      "device --duration 120 --say-force-above 2" + net + " --json " + device_json.string(),
+      hapsim::test::temp_path("device-kill.log"));
   ASSERT_TRUE(device.wait_for("host answering", 60s)) << device.output();
-  // The palpation presses the patella hardest around 3.3 s into the device's script.
-  std::this_thread::sleep_for(3300ms);
+  ASSERT_TRUE(device.wait_for("force        above 2.00 N", 60s)) << device.output();
   serve->signal(SIGKILL);
   serve->wait();
   ASSERT_TRUE(device.wait_for("host silent", 30s)) << device.output();
