@@ -81,7 +81,7 @@ FemOptions block_options(const FemBlockSpec& spec) {
 // material point of the tissue, the rest surface's closest point to the tool less the patch's
 // displacement; the patch is the rest surface's vertices within the patch radius of it, weighted
 // 1 − (r/R)² (or the closest triangle's corners when none is that close), weights summing to one;
-// the normal is the patch's weighted deformed vertex normal; the penetration is measured along it
+// the normal is the patch's weighted rest vertex normal; the penetration is measured along it
 // from where the patch is now. F = k_c·penetration is the series law the local model linearises.
 struct CouplingContact {
   bool found = false;
@@ -92,7 +92,6 @@ struct CouplingContact {
 };
 
 CouplingContact coupling_contact(const MeshBvh& rest_bvh, const TriangleMesh& rest_surface,
-                                 const TriangleMesh& surface,
                                  const std::vector<std::uint32_t>& node_of_vertex,
                                  const FemBody& body, const Vec3& p, const Vec3& query_shift,
                                  double tool_radius_m, double patch_radius_m,
@@ -101,7 +100,7 @@ CouplingContact coupling_contact(const MeshBvh& rest_bvh, const TriangleMesh& re
   patch.clear();
   const SurfacePoint sp = rest_bvh.closest_point(p - query_shift);
   if (!sp.found() || !std::isfinite(sp.signed_distance) ||
-      sp.triangle >= surface.triangles.size()) {
+      sp.triangle >= rest_surface.triangles.size()) {
     return c;
   }
   const double r2 = patch_radius_m * patch_radius_m;
@@ -112,7 +111,7 @@ CouplingContact coupling_contact(const MeshBvh& rest_bvh, const TriangleMesh& re
     if (d2 < r2) {
       const double w = 1.0 - d2 / r2;
       patch.push_back({node_of_vertex[v], w});
-      normal += w * surface.vertex_normals[v];
+      normal += w * rest_surface.vertex_normals[v];
       sum += w;
     }
   }
@@ -128,8 +127,8 @@ CouplingContact coupling_contact(const MeshBvh& rest_bvh, const TriangleMesh& re
     w.weight /= sum;
     c.shift += w.weight * (x[w.node] - rest.nodes[w.node]);
   }
-  normal =
-      normal.squaredNorm() > 0.0 ? Vec3(normal.normalized()) : surface.face_normal(sp.triangle);
+  normal = normal.squaredNorm() > 0.0 ? Vec3(normal.normalized())
+                                      : rest_surface.face_normal(sp.triangle);
   if (!(normal.squaredNorm() > 0.0)) {
     normal = sp.normal;
   }
@@ -222,8 +221,7 @@ struct FemContactReference::Impl {
   double tool_radius_m = 0.0;
   double patch_radius_m = 0.0;
   std::unique_ptr<FemBody> body;
-  TriangleMesh rest_surface;
-  TriangleMesh surface;  // deformed, with its vertex normals
+  TriangleMesh rest_surface;  // with its vertex normals: the load's direction
   std::vector<std::uint32_t> node_of_vertex;
   std::unique_ptr<MeshBvh> rest_bvh;
   // The load on the body now (solved): its force along its normal on its patch, and the patch's
@@ -239,14 +237,6 @@ struct FemContactReference::Impl {
   std::vector<FemNodeForce> saved_loads;
   double settled_m = 0.0;    // the largest node move of the last step
   bool last_failed = false;  // the previous point had no equilibrium: fail this one fast
-
-  void refresh_surface() {
-    const std::vector<Vec3>& x = body->positions();
-    for (std::size_t v = 0; v < surface.vertices.size(); ++v) {
-      surface.vertices[v] = x[node_of_vertex[v]];
-    }
-    surface.compute_vertex_normals();
-  }
 };
 
 FemContactReference::FemContactReference(const FemBlockSpec& spec)
@@ -260,8 +250,7 @@ FemContactReference::FemContactReference(const FemBlockSpec& spec)
   TetMesh tets = block_tets(spec);
   const TetBoundary boundary = tet_boundary(tets);
   m.rest_surface = boundary.surface;
-  m.surface = boundary.surface;
-  m.surface.compute_vertex_normals();
+  m.rest_surface.compute_vertex_normals();
   m.node_of_vertex = boundary.node_of_vertex;
   const std::vector<std::uint32_t> fixed = bottom_nodes(tets);
   m.body = std::make_unique<FemBody>(
@@ -293,8 +282,8 @@ std::optional<Vec3> FemContactReference::force_at(const Vec3& p_m) {
   const int iterations = m.last_failed ? kReferenceIterationsAfterFailure : kReferenceMaxIterations;
   for (int it = 1; it <= iterations; ++it) {
     const CouplingContact c =
-        coupling_contact(*m.rest_bvh, m.rest_surface, m.surface, m.node_of_vertex, *m.body, p_m,
-                         m.query_shift, m.tool_radius_m, m.patch_radius_m, m.patch);
+        coupling_contact(*m.rest_bvh, m.rest_surface, m.node_of_vertex, *m.body, p_m, m.query_shift,
+                         m.tool_radius_m, m.patch_radius_m, m.patch);
     if (!c.found) {
       break;
     }
@@ -346,7 +335,6 @@ std::optional<Vec3> FemContactReference::force_at(const Vec3& p_m) {
     m.applied_n = next_n;
     m.applied_normal = normal;
     m.applied_point = c.rest_point;
-    m.refresh_surface();
     if (!stats.converged) {
       break;
     }
@@ -361,7 +349,6 @@ std::optional<Vec3> FemContactReference::force_at(const Vec3& p_m) {
   m.applied_normal = saved_normal;
   m.applied_point = saved_point;
   m.query_shift = saved_shift;
-  m.refresh_surface();
   return std::nullopt;
 }
 
@@ -884,7 +871,7 @@ nlohmann::json fem_bench_to_json(const FemBenchResult& result) {
          "the rest surface's closest point to the tool less the patch's displacement, the load is "
          "spread on the rest-surface vertices within the patch radius (weights 1-(r/R)^2) along "
          "the "
-         "patch's deformed normal, F = k_c * (tool radius - n.(p - (contact point + patch "
+         "patch's rest normal, F = k_c * (tool radius - n.(p - (contact point + patch "
          "displacement))); solved independently of the world by Newton on F (slope 1 + k_c * the "
          "patch's condensed compliance), each iterate a quasi-static FemBody::step (as the "
          "coupling's "

@@ -14,7 +14,7 @@
 //   under the coupling's own contact law (world/fem_coupling.cpp, restated here: the contact is
 //   the rest surface's closest point to the tool less its patch's displacement, the load spread
 //   on the rest-surface vertices within the patch radius, weights 1 − (r/R)², along the patch's
-//   deformed normal; F = k_c·(tool radius − n·(p − (contact point + patch displacement)))),
+//   rest normal; F = k_c·(tool radius − n·(p − (contact point + patch displacement)))),
 //   solved apart from the world by Newton on F with the patch's condensed compliance as slope,
 //   each iterate a quasi-static FemBody::step (the coupling's update), iterated until the body has
 //   settled. Not solve_static_sphere_contact: a rigid sphere held by

@@ -8,6 +8,7 @@
 #include "hapsim/geometry/tet_mesh.h"
 #include "hapsim/world/fem_coupling.h"
 #include "hapsim/world/world.h"
+#include "hapsim/world/world_step.h"
 
 #include "support/allocation_counter.h"
 #include "support/body_fixtures.h"
@@ -16,6 +17,7 @@
 
 #include <cmath>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace hapsim {
@@ -117,6 +119,70 @@ TEST(FemWorld, AHeldProbeSettlesWhereTheContactSpringMeetsTheTissue) {
       << "sink " << sink_m * 1e3 << " mm";
   // And softer than the contact spring alone: the tissue gave way.
   EXPECT_LT(force_n, 0.9 * kContactStiffness_n_per_m * depth_m);
+}
+
+// Held still 7 mm deep (the tissue gives ~6 mm), off the top's centre, on the flat top: the force
+// settles along the top's normal, steady. Taking the load's direction from the dent's own
+// deformed normal once fed the dent's slope back into the load: the probe then rang or wandered
+// sideways (±1 N at 6 mm, quasi-static; 0.4 N drifting at 8 mm, backward Euler).
+TEST(FemWorld, AProbeHeldDeepInTheDentFeelsASteadyForceAlongTheNormal) {
+  for (const FemElasticity elasticity : {FemElasticity::kLinear, FemElasticity::kCorotational}) {
+    for (const FemIntegration integration :
+         {FemIntegration::kQuasiStatic, FemIntegration::kBackwardEuler}) {
+      World world(block_world(elasticity, integration));
+      world.set_fem_deferred(true);
+      const Vec3 above(-0.006, 0.004, kTopZ_m + kToolRadius_m);
+      const double depth_m = 0.007;
+      double min_z = 1e9;
+      double max_z = 0.0;
+      double max_lateral = 0.0;
+      for (int k = 0; k < 3000; ++k) {  // down over 0.4 s, then held 2.6 s
+        DeviceInput in =
+            test::probe_at(above - Vec3::UnitZ() * depth_m * std::min(1.0, (k + 1) / 400.0));
+        in.time_s = k * 1e-3;
+        const Vec3 f = world.step(in, 1e-3).command.force_world_n;
+        world.advance_fem();
+        ASSERT_TRUE(f.allFinite());
+        if (k >= 2000) {  // the last second
+          min_z = std::min(min_z, f.z());
+          max_z = std::max(max_z, f.z());
+          max_lateral = std::max(max_lateral, f.head<2>().norm());
+        }
+      }
+      const std::string what =
+          std::string(to_string(elasticity)) + ", " + std::string(to_string(integration));
+      EXPECT_GT(min_z, 0.5) << what;  // pressed: k_series · 7 mm
+      EXPECT_LT(max_z - min_z, 1e-3 * max_z) << what;
+      EXPECT_LT(max_lateral, 1e-6) << what;
+    }
+  }
+}
+
+// The damping a FEM contact is rendered with: Colgate's floor factor·k·T on the stiffness it
+// renders (the contact spring in series with the tissue, ~10x softer here than the spring
+// alone), with T the haptic period for a quasi-static tissue (the model's spring is its
+// equilibrium) and the FEM's period for a dynamic one (its motion reaches the hand sampled then).
+TEST(FemWorld, AContactIsDampedForTheStiffnessItRendersAndTheFemsSampling) {
+  for (const FemIntegration integration :
+       {FemIntegration::kQuasiStatic, FemIntegration::kBackwardEuler}) {
+    World world(block_world(FemElasticity::kLinear, integration));
+    for (int k = 0; k < 200; ++k) {
+      world.step(pressed(0.004 * std::min(1.0, (k + 1) / 100.0)), 1e-3);
+    }
+    const LocalContactModel& m = world.state().fem_contacts[0].model;
+    ASSERT_TRUE(m.valid);
+    const double k_series = m.normal_world.dot(m.stiffness_n_per_m * m.normal_world);
+    ASSERT_LT(k_series, 0.5 * kContactStiffness_n_per_m);  // the tissue gives
+    const ContactMaterial& material = world.state().material_contact[0];
+    ASSERT_EQ(material.damping_n_s_per_m, 0.0);
+    const double b = fem_contact_damping_n_s_per_m(world.model(), material, m, 1e-3);
+    const double fem_period_s = integration == FemIntegration::kQuasiStatic ? 1e-3 : 0.01;
+    EXPECT_NEAR(b, k_series * fem_period_s, 1e-9 * b) << to_string(integration);
+    // A material damped more than the floor keeps its own.
+    ContactMaterial damped = material;
+    damped.damping_n_s_per_m = 50.0;
+    EXPECT_EQ(fem_contact_damping_n_s_per_m(world.model(), damped, m, 1e-3), 50.0);
+  }
 }
 
 TEST(FemWorld, TheSurfaceDentsUnderTheProbeAndNotFarAway) {

@@ -109,6 +109,7 @@ std::vector<std::uint32_t> fem_fixed_nodes(const WorldModel& model, const BodyDe
 
 FemCoupling::FemCoupling(const WorldModel& model) {
   const WorldDescription& d = model.description();
+  passivity_damping_factor_ = d.passivity_damping_factor;
   tool_count_ = std::min<std::size_t>(d.tools.size(), kMaxTools);
   for (std::size_t t = 0; t < tool_count_; ++t) {
     tool_radius_m_[t] = d.tools[t].radius_m;
@@ -159,6 +160,7 @@ FemCoupling::FemCoupling(const WorldModel& model) {
       body->node_of_vertex = boundary.node_of_vertex;
     }
     body->rest_surface = body->surface;
+    body->rest_surface.compute_vertex_normals();
     body->rest_bvh = std::make_unique<MeshBvh>(body->rest_surface);
     body->patch_radius_m = fd.contact_patch_radius_m;
     body->margin_m = fd.contact_margin_m;
@@ -396,8 +398,8 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     const Vec3 p_body = body.X_body_world * launch.p_world[t];
     // The contact is a material point of the tissue: the rest surface's closest point to the tool
     // less the displacement its patch had (a tool that pushed the surface in finds the same
-    // point, not the rim of its own dent). Its gap is measured along the deformed surface's
-    // normal there from where the patch is now: exactly the series law the model linearises,
+    // point, not the rim of its own dent). Its gap is measured along the patch's normal from
+    // where the patch is now: exactly the series law the model linearises,
     // F = k_c·(d − n·H·u), whatever the dent's shape.
     const SurfacePoint sp =
         body.rest_bvh->closest_point(p_body - body.patch_shift[t], &body.hints[t]);
@@ -410,13 +412,17 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     // rest), weighted by a smooth bump (their sum is one).
     const double r_patch = std::max(body.patch_radius_m, radius);
     double sum = 0.0;
-    Vec3 normal = Vec3::Zero();  // the patch's deformed normal: turns with the tissue
+    // The load's direction: the patch's rest normal (in the body's frame, so it turns with the
+    // body), as small-strain contact theory (Hertz, Boussinesq) takes it. Not the dent's deformed
+    // normal: that fed the dent's own slope back into the load, and a probe held still 6-8 mm
+    // deep then wandered or rang sideways (0.4 N drifting, ±1 N ringing on the bench block).
+    Vec3 normal = Vec3::Zero();
     for (std::size_t v = 0; v < body.rest_surface.vertices.size(); ++v) {
       const double d2 = (body.rest_surface.vertices[v] - sp.point).squaredNorm();
       if (d2 < r_patch * r_patch) {
         const double w = 1.0 - d2 / (r_patch * r_patch);
         sum += w;
-        normal += w * body.surface.vertex_normals[v];
+        normal += w * body.rest_surface.vertex_normals[v];
         if (body.embedding.empty()) {
           patch.push_back({body.node_of_vertex[v], w});
         } else {
@@ -448,7 +454,7 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
       shift += w.weight * (x[w.node] - tets.nodes[w.node]);
     }
     normal = normal.squaredNorm() > 0.0 ? Vec3(normal.normalized())
-                                        : body.surface.face_normal(sp.triangle);
+                                        : body.rest_surface.face_normal(sp.triangle);
     if (!(normal.squaredNorm() > 0.0)) {
       normal = sp.normal;
     }
@@ -472,7 +478,15 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     m.v0_world_m_per_s = launch.v_world[t];
     m.f0_world_n = tissue_coupled_force_n(rendered_n, penetration_m, k_contact, k_series) * n_world;
     m.stiffness_n_per_m = k_series * n_world * n_world.transpose();
-    m.damping_n_s_per_m.setZero();  // the step adds the passivity floor with the material's
+    // A dynamic tissue's motion reaches the hand sampled at the FEM's period T (f0 is refreshed
+    // once a period): Colgate's floor for that sampling, factor·k·T, which the stage honours
+    // with the material's and its own factor·k·dt. Quasi-static, f0 is the equilibrium and the
+    // spring between updates exact: no floor of its own (the passivity sweep's rows: omega3 at
+    // 1.5x its rating generated 0.24 J with backward Euler below it, none quasi-static).
+    const double b_sample = fem.options().integration == FemIntegration::kBackwardEuler
+                                ? passivity_damping_factor_ * k_series * fem.options().dt_s
+                                : 0.0;
+    m.damping_n_s_per_m = b_sample * n_world * n_world.transpose();
     m.normal_world = n_world;
     m.validity_radius_m = body.margin_m + radius;
     m.max_normal_force_n = launch.max_force_n[b];

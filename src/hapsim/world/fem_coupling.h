@@ -163,6 +163,7 @@ class FemCoupling {
   std::vector<std::unique_ptr<TripleBuffer<FemSurfaceFrame>>> published_surfaces_;
   std::size_t tool_count_ = 0;
   std::array<double, kMaxTools> tool_radius_m_{};
+  double passivity_damping_factor_ = 1.0;  // WorldDescription's: the floor a model asks for
   std::atomic<std::uint64_t> period_steps_{0};
   TripleBuffer<FemLaunch> launches_{FemLaunch{}};
   TripleBuffer<FemUpdate> updates_{FemUpdate{}};

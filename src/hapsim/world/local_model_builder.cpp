@@ -3,6 +3,7 @@
 #include "hapsim/deform/sheet_profile.h"
 #include "hapsim/force/penalty_force.h"
 #include "hapsim/world/fem_coupling.h"
+#include "hapsim/world/world_step.h"
 
 #include <algorithm>
 #include <array>
@@ -69,7 +70,11 @@ void LocalModelBuilder::build(const WorldState& state, std::uint64_t sequence,
       if (c.force_n < cap * (1.0 - 1e-9)) {
         m.stiffness_n_per_m += fm.stiffness_n_per_m;
       }
-      m.damping_n_s_per_m += std::max(material.damping_n_s_per_m, 0.0) * nn;
+      // The damping the world's stage renders it with.
+      m.damping_n_s_per_m += fem_contact_damping_n_s_per_m(
+                                 *model_, state.material_contact[model_->segments()[flat].material],
+                                 fm, state.materials_dt_s) *
+                             nn;
       m.max_normal_force_n += cap;
       if (m.normal_world.isZero()) {
         m.normal_world = c.normal_world;

@@ -2,13 +2,15 @@
 // Each cycle the model is evaluated at the tool's fresh position, as a device host renders a
 // served model: the push along the model's normal from f0 at x0 and the series stiffness
 // (contact spring and tissue), plus the contact's damping (never below the passivity floor
-// factor·k·dt), held to the contact's force cap, push-only, zero beyond the validity radius.
-// The force rendered is the FEM's load at its next update (SPEC §8: the tissue yields to what the
-// hand felt); with World::set_rendered_push (a served world) the device's own push replaces it.
+// factor·k·dt, nor the floor the FEM side asks for: fem_contact_damping_n_s_per_m), held to the
+// contact's force cap, push-only, zero beyond the validity radius. The force rendered is the FEM's
+// load at its next update (SPEC §8: the tissue yields to what the hand felt); with
+// World::set_rendered_push (a served world) the device's own push replaces it.
 #include "hapsim/world/fem_coupling.h"
 #include "hapsim/world/world_model.h"
 #include "hapsim/world/world_stages.h"
 #include "hapsim/world/world_state.h"
+#include "hapsim/world/world_step.h"
 
 #include <algorithm>
 #include <cmath>
@@ -22,7 +24,6 @@ void fem_contacts(const WorldModel& model, WorldState& state, double dt_s) noexc
     return;
   }
   const WorldDescription& d = model.description();
-  const double floor_factor = d.passivity_damping_factor * (dt_s > 0.0 ? dt_s : 0.0);
   for (std::size_t t = 0; t < state.tools.size() && t < kMaxTools; ++t) {
     ToolRuntime& tool = state.tools[t];
     ToolState& out = state.tool_states[t];
@@ -45,7 +46,8 @@ void fem_contacts(const WorldModel& model, WorldState& state, double dt_s) noexc
       }
       const SegmentModel& seg = model.segments()[model.flat_segment(fem_bodies[b], 0)];
       const ContactMaterial& material = state.materials[seg.material];
-      const double damping = std::max(material.damping_n_s_per_m, floor_factor * k_n);
+      const double damping =
+          fem_contact_damping_n_s_per_m(model, state.material_contact[seg.material], m, dt_s);
       const double push_n =
           std::clamp(spring_n - damping * tool.v_world.dot(n), 0.0,
                      std::min(m.max_normal_force_n, std::max(material.max_force_n, 0.0)));

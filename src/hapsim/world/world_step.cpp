@@ -19,6 +19,22 @@ ContactMaterial effective_material(const WorldModel& model, const ContactMateria
   return m;
 }
 
+double fem_contact_damping_n_s_per_m(const WorldModel& model, const ContactMaterial& contact,
+                                     const LocalContactModel& fem_model, double dt_s) noexcept {
+  const double dt = std::isfinite(dt_s) && dt_s > 0.0 ? dt_s : 0.0;
+  const Vec3& n = fem_model.normal_world;
+  const double k_n = n.dot(fem_model.stiffness_n_per_m * n);
+  const double b_fem = n.dot(fem_model.damping_n_s_per_m * n);
+  double b = std::max(contact.damping_n_s_per_m, 0.0);
+  if (std::isfinite(k_n) && k_n > 0.0) {
+    b = std::max(b, model.description().passivity_damping_factor * k_n * dt);
+  }
+  if (std::isfinite(b_fem) && b_fem > 0.0) {
+    b = std::max(b, b_fem);
+  }
+  return b;
+}
+
 namespace {
 
 // The effective materials for this dt (recomputed only when dt or a material changed).

@@ -6,6 +6,7 @@
 
 #include "hapsim/core/device_io.h"
 #include "hapsim/force/contact_material.h"
+#include "hapsim/force/local_contact_model.h"
 #include "hapsim/world/world_model.h"
 #include "hapsim/world/world_state.h"
 
@@ -24,5 +25,16 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
 [[nodiscard]] ContactMaterial effective_material(const WorldModel& model,
                                                  const ContactMaterial& contact,
                                                  double dt_s) noexcept;
+
+/// The normal damping of a FEM body's contact rendered from `fem_model` (its normal and series
+/// stiffness k): the material's own (as edited), raised to the passivity floor factor·k·dt of the
+/// stiffness the contact renders (the contact spring in series with the tissue, not the contact
+/// spring alone: that floor was ten times the series one on a 20 kPa block, a drag of 0.15 N at
+/// 50 mm/s), and to the floor the FEM side asks for in the model's damping (its tissue's motion
+/// sampled at the FEM's period: FemCoupling). haptic path
+[[nodiscard]] double fem_contact_damping_n_s_per_m(const WorldModel& model,
+                                                   const ContactMaterial& contact,
+                                                   const LocalContactModel& fem_model,
+                                                   double dt_s) noexcept;
 
 }  // namespace hapsim
