@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <optional>
@@ -246,11 +247,12 @@ FemContactReference::FemContactReference(const FemBlockSpec& spec)
   quasi_static.integration = FemIntegration::kQuasiStatic;
   m.k_c = spec.contact_stiffness_n_per_m;
   m.tool_radius_m = spec.tool_radius_m;
-  m.patch_radius_m = std::max(spec.patch_radius_m, spec.tool_radius_m);
   TetMesh tets = block_tets(spec);
   const TetBoundary boundary = tet_boundary(tets);
   m.rest_surface = boundary.surface;
   m.rest_surface.compute_vertex_normals();
+  m.patch_radius_m =
+      std::max(fem_patch_radius_m(spec.patch_radius_m, m.rest_surface), spec.tool_radius_m);
   m.node_of_vertex = boundary.node_of_vertex;
   const std::vector<std::uint32_t> fixed = bottom_nodes(tets);
   m.body = std::make_unique<FemBody>(
@@ -461,6 +463,27 @@ FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
   for (const Vec3& f : reference) {
     peak = std::max(peak, f.norm());
   }
+  {
+    const double slide_from_m = (path.pressed_m - path.start_m).norm();
+    const double slide_to_m = slide_from_m + (path.slid_m - path.pressed_m).norm();
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = 0.0;
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (std::size_t j = 0; j <= intervals; ++j) {
+      const double s = static_cast<double>(j) * ds;
+      if (defined[j] && s >= slide_from_m && s <= slide_to_m) {
+        const double f = reference[j].norm();
+        lo = std::min(lo, f);
+        hi = std::max(hi, f);
+        sum += f;
+        ++n;
+      }
+    }
+    if (n > 0 && sum > 0.0) {
+      out.slide_ripple_percent = 100.0 * (hi - lo) / (sum / static_cast<double>(n));
+    }
+  }
 
   for (std::size_t k = 0; k < speeds_m_per_s.size(); ++k) {
     const double v = speeds_m_per_s[k];
@@ -548,8 +571,10 @@ void measure_solver(const FemBlockSpec& spec, int steps, FemBenchRow& row) {
   row.factor_nonzeros = body.factor_nonzeros();
   // The press: on the top's centre, over the coupling's patch about it.
   std::vector<FemNodeWeight> patch;
-  rest_patch(boundary.surface, boundary.node_of_vertex, Vec3(0.0, 0.0, spec.size_m.z()),
-             std::max(spec.patch_radius_m, spec.tool_radius_m), patch);
+  rest_patch(
+      boundary.surface, boundary.node_of_vertex, Vec3(0.0, 0.0, spec.size_m.z()),
+      std::max(fem_patch_radius_m(spec.patch_radius_m, boundary.surface), spec.tool_radius_m),
+      patch);
   std::vector<FemNodeForce> loads;
   std::vector<double> ms;
   ms.reserve(static_cast<std::size_t>(steps));
@@ -713,9 +738,10 @@ std::string format_fem_table(const FemBenchResult& result) {
           "only); spring: the model's f0 + K(x - x0) without the stage's damping:\n",
           result.options.depth_m * 1e3);
       out << line;
-      std::snprintf(line, sizeof line, "%6s %-12s %6s %7s %9s %7s %9s %7s %12s %8s %4s %15s %9s\n",
-                    "tets", "elasticity", "mm/s", "peak_N", "max_err_N", "max_%", "rms_err_N",
-                    "rms_%", "spring_max_N", "target", "met", "undefined/steps", "from_mm");
+      std::snprintf(line, sizeof line,
+                    "%6s %-12s %6s %7s %9s %7s %9s %7s %12s %8s %4s %15s %9s %8s\n", "tets",
+                    "elasticity", "mm/s", "peak_N", "max_err_N", "max_%", "rms_err_N", "rms_%",
+                    "spring_max_N", "target", "met", "undefined/steps", "from_mm", "ripple_%");
       out << line;
       header = true;
     }
@@ -732,16 +758,16 @@ std::string format_fem_table(const FemBenchResult& result) {
       if (r.error.first_unconverged_at_m >= 0.0) {
         std::snprintf(from, sizeof from, "%.1f", r.error.first_unconverged_at_m * 1e3);
       }
-      std::snprintf(line, sizeof line,
-                    "%6zu %-12s %6.0f %7.3f %9.4f %7.2f %9.4f %7.2f %12.4f %8s %4s %15s %9s\n",
-                    r.tets, elasticity_name(r.elasticity).c_str(), e.speed_m_per_s * 1e3,
-                    e.peak_force_n, e.max_error_n, e.max_error_percent(), e.rms_error_n,
-                    e.rms_error_percent(), e.max_spring_error_n, target,
-                    fraction > 0.0
-                        ? (fem_error_meets_target(e) ? (e.undefined_steps > 0 ? "yes*" : "yes")
-                                                     : (e.undefined_steps > 0 ? "NO*" : "NO"))
-                        : "-",
-                    undefined, from);
+      std::snprintf(
+          line, sizeof line,
+          "%6zu %-12s %6.0f %7.3f %9.4f %7.2f %9.4f %7.2f %12.4f %8s %4s %15s %9s %8.1f\n", r.tets,
+          elasticity_name(r.elasticity).c_str(), e.speed_m_per_s * 1e3, e.peak_force_n,
+          e.max_error_n, e.max_error_percent(), e.rms_error_n, e.rms_error_percent(),
+          e.max_spring_error_n, target,
+          fraction > 0.0 ? (fem_error_meets_target(e) ? (e.undefined_steps > 0 ? "yes*" : "yes")
+                                                      : (e.undefined_steps > 0 ? "NO*" : "NO"))
+                         : "-",
+          undefined, from, r.error.slide_ripple_percent);
       out << line;
     }
   }
@@ -824,7 +850,8 @@ nlohmann::json fem_bench_to_json(const FemBenchResult& result) {
             {"first_unconverged_at_path_m", r.error.first_unconverged_at_m >= 0.0
                                                 ? nlohmann::json(r.error.first_unconverged_at_m)
                                                 : nlohmann::json(nullptr)},
-            {"ms", r.error.reference_ms}}}};
+            {"ms", r.error.reference_ms},
+            {"slide_ripple_percent", r.error.slide_ripple_percent}}}};
     } else {
       row["local_model_error"] = nullptr;
     }

@@ -140,6 +140,10 @@ struct FemLocalModelError {
   /// Where along the path (m) the reference first had no equilibrium; negative: nowhere.
   double first_unconverged_at_m = -1.0;
   double reference_ms = 0.0;
+  /// The full solve's own ripple along the pressed slide, (max − min)/mean of |F| in %: the
+  /// force a uniform block gives depends on where the tool is against the mesh's vertices (the
+  /// patch's nodes), more as the mesh is coarse beside the patch; the local model lags it.
+  double slide_ripple_percent = 0.0;
 };
 
 /// The local model against the full solve along the palpation path at each speed (m/s), with

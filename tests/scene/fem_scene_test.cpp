@@ -8,6 +8,7 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/deform/fem_body_description.h"
+#include "hapsim/world/fem_coupling.h"
 #include "hapsim/world/world.h"
 
 #include "support/temp_dir_test.h"
@@ -155,7 +156,7 @@ TEST_F(FemSceneTest, FemBlockSceneDescribesOneCorotationalBlockAttachedToTheTabl
   EXPECT_EQ(fem.options.elasticity, FemElasticity::kCorotational);
   EXPECT_EQ(fem.options.integration, FemIntegration::kBackwardEuler);
   EXPECT_EQ(fem.options.dt_s, 0.01);
-  EXPECT_EQ(fem.contact_patch_radius_m, 0.006);
+  EXPECT_EQ(fem.contact_patch_radius_m, 0.009);
 
   ASSERT_EQ(fem.materials.size(), 1u);
   EXPECT_EQ(fem.materials[0].region, 0);
@@ -207,6 +208,30 @@ TEST_F(FemSceneTest, FemSettingsLeftOutTakeTheDocumentedDefaults) {
   EXPECT_EQ(fem.materials[0].material.rayleigh_stiffness_s, 0.0);
   ASSERT_TRUE(fem.fixed_below_z_m.has_value());
   EXPECT_EQ(*fem.fixed_below_z_m, 0.001);
+}
+
+// A patch smaller than the mesh can carry is raised, and the loader says so once (the block's
+// 4 x 3 x 2 cells are 20 x 20 x 15 mm: its boundary's edges average about 22 mm, the patch
+// becomes 1.5 times that); a patch the mesh carries is left alone, silently.
+TEST_F(FemSceneTest, APatchTooSmallForTheMeshIsRaisedAndSaidOnce) {
+  const SceneDescription coarse = load_scene(write("coarse.json", small_fem_scene().dump()));
+  std::size_t said = 0;
+  for (const std::string& w : coarse.warnings) {
+    if (w.find("body 'block': contact patch radius 4.0 mm raised to") != std::string::npos) {
+      ++said;
+    }
+  }
+  EXPECT_EQ(said, 1u);
+  const TriangleMesh& surface = coarse.world.bodies[1].segments[0].mesh;
+  const double raised_m = fem_patch_radius_m(0.004, surface);
+  EXPECT_GT(raised_m, 1.5 * 0.020);  // longer than the cells' shortest edge
+  EXPECT_LT(raised_m, 1.5 * 0.030);  // shorter than their face diagonals
+  Json fine = small_fem_scene();
+  fine["bodies"][1]["fem"]["contact_patch_radius_m"] = 0.05;
+  const SceneDescription kept = load_scene(write("fine.json", fine.dump()));
+  for (const std::string& w : kept.warnings) {
+    EXPECT_EQ(w.find("contact patch radius"), std::string::npos) << w;
+  }
 }
 
 TEST_F(FemSceneTest, TetMeshRegionsGetTheirOwnMaterials) {

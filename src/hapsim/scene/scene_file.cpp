@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -133,6 +134,23 @@ SceneDescription Parser::parse(const Json& root) {
   }
   check_fem_attachments(scene.world);
   scene.warnings = geometry_.warnings();
+  for (const BodyDescription& body : scene.world.bodies) {
+    if (!body.fem || body.segments.empty()) {
+      continue;
+    }
+    // The coupling raises a patch too small for the surface's mesh (world/fem_coupling.h): say so.
+    const double given_m = body.fem->contact_patch_radius_m;
+    const double used_m = fem_patch_radius_m(given_m, body.segments[0].mesh);
+    if (used_m > given_m) {
+      char w[320];
+      std::snprintf(w, sizeof w,
+                    "body '%s': contact patch radius %.1f mm raised to %.1f mm (%.1fx the "
+                    "surface's mean edge): a smaller patch holds one to three nodes and the force "
+                    "ripples as the tool slides over them; a finer mesh keeps the smaller patch",
+                    body.name.c_str(), given_m * 1e3, used_m * 1e3, kFemPatchEdges);
+      scene.warnings.emplace_back(w);
+    }
+  }
 
   const Json& tools = array(required(root, "", "tools"), "/tools", "a list of tools");
   if (tools.empty()) {

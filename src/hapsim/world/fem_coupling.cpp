@@ -40,6 +40,16 @@ struct FemCoupling::Body {
   /// Per tool: its patch's weighted displacement at the last update (body frame), to find the
   /// same material point again when the tool has pushed the surface in.
   std::array<Vec3, kMaxTools> patch_shift;
+  /// Per tool, quasi-static only: the last update's load and its patch's displacement along the
+  /// normal, and how much softer than compliance_along the tissue answered a change of load
+  /// (see update_body).
+  struct Secant {
+    bool valid = false;
+    double load_n = 0.0;
+    double normal_shift_m = 0.0;
+    double softening = 1.0;
+  };
+  std::array<Secant, kMaxTools> secant{};
   std::vector<FemNodeForce> loads;
   /// Stress for display: per tet, and per surface vertex; a boundary vertex's tets (CSR).
   std::vector<double> tet_von_mises_pa;
@@ -107,6 +117,27 @@ std::vector<std::uint32_t> fem_fixed_nodes(const WorldModel& model, const BodyDe
 
 }  // namespace
 
+namespace {
+// The secant softening of a quasi-static contact (update_body): measured from a load change of at
+// least 1 mN and 2 % of the load, at most ten times softer than compliance_along.
+constexpr double kFemSecantMinLoadStepN = 1e-3;
+constexpr double kFemSecantMinLoadFraction = 0.02;
+constexpr double kFemMaxSoftening = 10.0;
+}  // namespace
+
+double fem_patch_radius_m(double configured_m, const TriangleMesh& rest_surface) {
+  double sum_m = 0.0;
+  std::size_t edges = 0;
+  for (const auto& tri : rest_surface.triangles) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      sum_m += (rest_surface.vertices[tri[k]] - rest_surface.vertices[tri[(k + 1) % 3]]).norm();
+      ++edges;
+    }
+  }
+  const double mean_edge_m = edges > 0 ? sum_m / static_cast<double>(edges) : 0.0;
+  return std::max(configured_m, kFemPatchEdges * mean_edge_m);
+}
+
 FemCoupling::FemCoupling(const WorldModel& model) {
   const WorldDescription& d = model.description();
   passivity_damping_factor_ = d.passivity_damping_factor;
@@ -162,7 +193,7 @@ FemCoupling::FemCoupling(const WorldModel& model) {
     body->rest_surface = body->surface;
     body->rest_surface.compute_vertex_normals();
     body->rest_bvh = std::make_unique<MeshBvh>(body->rest_surface);
-    body->patch_radius_m = fd.contact_patch_radius_m;
+    body->patch_radius_m = fem_patch_radius_m(fd.contact_patch_radius_m, body->rest_surface);
     body->margin_m = fd.contact_margin_m;
     for (auto& p : body->patch) {
       p.reserve(256);
@@ -391,6 +422,8 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     m = LocalContactModel{};
     std::vector<FemNodeWeight>& patch = body.patch[t];
     patch.clear();
+    Body::Secant secant = body.secant[t];  // kept only while the tool stays in contact
+    body.secant[t] = Body::Secant{};
     if (!launch.usable[t]) {
       continue;
     }
@@ -464,16 +497,45 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
       continue;
     }
     body.patch_shift[t] = shift;
+    const Vec3 n_world = body.X_world_body.linear() * normal;
+    const double rendered_n =
+        std::max(0.0, launch.push_world_n[t * kMaxFemBodies + b].dot(n_world));
     // The tissue's own compliance at the patch along the normal, in series with the contact.
-    const double compliance_m_per_n = fem.compliance_along(patch, normal);
+    // compliance_along is the rest stiffness turned into the nodes' frames; a corotational body
+    // squeezed by a third of its depth answers a change of load up to several times softer than
+    // that. Quasi-static, each update is an equilibrium, and f0's correction is a Newton step on
+    // the contact's force with that compliance as slope: at more than twice too stiff a slope
+    // the held force flipped between two values every update (1.4 and 2.5 N, 7 mm into the
+    // bench's block). The secant of the last two updates (load and patch displacement along the
+    // normal) measures the softening; it is kept between 1 and kFemMaxSoftening and taken only
+    // from a load change large enough to measure it. Backward Euler: its lagging surface would
+    // make the secant measure inertia, and it damps the loop itself.
+    double compliance_m_per_n = fem.compliance_along(patch, normal);
+    if (fem.options().integration == FemIntegration::kQuasiStatic && compliance_m_per_n > 0.0 &&
+        std::isfinite(compliance_m_per_n)) {
+      Body::Secant& sc = secant;
+      const double normal_shift_m = normal.dot(shift);
+      const double d_load_n = rendered_n - sc.load_n;
+      if (sc.valid && std::abs(d_load_n) >
+                          std::max(kFemSecantMinLoadStepN,
+                                   kFemSecantMinLoadFraction * std::max(rendered_n, sc.load_n))) {
+        const double measured_m_per_n = -(normal_shift_m - sc.normal_shift_m) / d_load_n;
+        sc.softening =
+            std::isfinite(measured_m_per_n)
+                ? std::clamp(measured_m_per_n / compliance_m_per_n, 1.0, kFemMaxSoftening)
+                : sc.softening;
+      }
+      sc.valid = true;
+      sc.load_n = rendered_n;
+      sc.normal_shift_m = normal_shift_m;
+      compliance_m_per_n *= sc.softening;
+      body.secant[t] = sc;
+    }
     const double k_tissue = compliance_m_per_n > 0.0 && std::isfinite(compliance_m_per_n)
                                 ? 1.0 / compliance_m_per_n
                                 : kInf;
     const double k_contact = launch.contact_stiffness_n_per_m[b];
     const double k_series = series_stiffness_n_per_m(k_contact, k_tissue);
-    const Vec3 n_world = body.X_world_body.linear() * normal;
-    const double rendered_n =
-        std::max(0.0, launch.push_world_n[t * kMaxFemBodies + b].dot(n_world));
     m.x0_world_m = launch.p_world[t];
     m.v0_world_m_per_s = launch.v_world[t];
     m.f0_world_n = tissue_coupled_force_n(rendered_n, penetration_m, k_contact, k_series) * n_world;
@@ -508,6 +570,7 @@ void FemCoupling::reset() {
     for (Vec3& shift : body->patch_shift) {
       shift.setZero();
     }
+    body->secant = {};
   }
   // The rest surfaces again.
   for (auto& body : bodies_) {
