@@ -311,7 +311,7 @@ void run_fem(const FemArgs& args) {
       "Block %.0f x %.0f x %.0f mm (make_tet_block), bottom fixed; E %.0f kPa, nu %.2f, "
       "Rayleigh %.0f 1/s, %.2f s; contact %.0f N/m, %.1f N s/m, tool r %.0f mm, patch r "
       "%.0f mm\nFEM step: bare FemBody, backward Euler dt %.0f ms, one core, %d steps of a "
-      "0-2-0 N press at 1 Hz; haptic step: World::step pressed %.1f mm sliding at 20 "
+      "0-1-0 N press at 1 Hz; haptic step: World::step pressed %.1f mm sliding at 20 "
       "mm/s, FEM deferred (advance_fem between cycles, untimed), %.1f s\n",
       b.size_m.x() * 1e3, b.size_m.y() * 1e3, b.size_m.z() * 1e3,
       b.material.youngs_modulus_pa / 1e3, b.material.poisson_ratio, b.material.rayleigh_mass_per_s,

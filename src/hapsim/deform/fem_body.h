@@ -71,7 +71,9 @@ struct FemOptions {
   /// ask for ever more accuracy). solve_static (corotational) stops its rotation updates when
   /// one moves the nodes by less than 100 times this fraction of their displacement.
   int max_cg_iterations = 200;
-  double cg_relative_tolerance = 1e-8;
+  /// 1e-5: a fingertip's 6 mm dent in a 20k-tet block moves 30 nm from where 1e-8 puts it, in
+  /// half the CG iterations (12 against 22 a step).
+  double cg_relative_tolerance = 1e-5;
   /// Quasi-static corotational: rotation updates per step (each one CG solve).
   int quasi_static_iterations = 4;
 };
