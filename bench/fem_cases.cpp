@@ -47,6 +47,9 @@ constexpr double kReferenceForceTolN = 1e-4;  // the corotational solves' own no
 // direction by 0.01 %.
 constexpr double kReferencePointTolM = 1e-6;
 constexpr double kReferenceNormalTol = 1e-4;
+// The secant softening: from a load step of at least 1 mN, at most ten times softer.
+constexpr double kReferenceSecantMinLoadStepN = 1e-3;
+constexpr double kReferenceMaxSoftening = 10.0;
 
 std::uint32_t as_node(std::size_t i) {
   return static_cast<std::uint32_t>(i);
@@ -237,6 +240,12 @@ struct FemContactReference::Impl {
   std::vector<Vec3> saved_x;
   std::vector<Vec3> before_x;
   std::vector<FemNodeForce> saved_loads;
+  // The secant softening (see force_at): the last iterate's load and displacement along the
+  // normal, and how much softer than compliance_along the body answered.
+  bool secant_valid = false;
+  double secant_load_n = 0.0;
+  double secant_shift_m = 0.0;
+  double softening = 1.0;
   double settled_m = 0.0;    // the largest node move of the last step
   bool last_failed = false;  // the previous point had no equilibrium: fail this one fast
 };
@@ -313,7 +322,23 @@ std::optional<Vec3> FemContactReference::force_at(const Vec3& p_m) {
         loaded ? Vec3((m.applied_normal + kReferenceRelaxation * (c.normal - m.applied_normal))
                           .normalized())
                : c.normal;
-    const double compliance = m.body->compliance_along(m.patch, normal);
+    double compliance = m.body->compliance_along(m.patch, normal);
+    // A corotational body squeezed deep answers softer than compliance_along: the secant of the
+    // last two iterates (load against the patch's displacement along the normal), as the
+    // coupling measures it, kept at least as soft as compliance_along. Without it the iteration
+    // overshot and found no equilibrium beyond 4-5 mm of the palpation.
+    const double normal_shift_m = normal.dot(c.shift);
+    const double d_load_n = m.applied_n - m.secant_load_n;
+    if (m.secant_valid && std::abs(d_load_n) > kReferenceSecantMinLoadStepN && compliance > 0.0) {
+      const double measured = -(normal_shift_m - m.secant_shift_m) / d_load_n;
+      if (std::isfinite(measured)) {
+        m.softening = std::clamp(measured / compliance, 1.0, kReferenceMaxSoftening);
+      }
+    }
+    m.secant_valid = true;
+    m.secant_load_n = m.applied_n;
+    m.secant_shift_m = normal_shift_m;
+    compliance *= m.softening;
     // Out of contact g = F: its slope is 1 (the next iterate lets go); in contact 1 + k_c·c.
     const double slope = c.penetration_m > 0.0 ? 1.0 + m.k_c * std::max(0.0, compliance) : 1.0;
     const double next_n = std::max(0.0, m.applied_n - g / slope);
@@ -352,6 +377,7 @@ std::optional<Vec3> FemContactReference::force_at(const Vec3& p_m) {
   m.applied_normal = saved_normal;
   m.applied_point = saved_point;
   m.query_shift = saved_shift;
+  m.secant_valid = false;  // its last pair was of the state just undone
   return std::nullopt;
 }
 
@@ -527,7 +553,7 @@ FemLocalModelError measure_fem_local_model_error(FemBlockSpec spec,
         ++row.undefined_steps;
         continue;
       }
-      const Vec3 ref = *defined_ref;
+      const Vec3& ref = *defined_ref;
       if (rendered.norm() > 0.0 || ref.norm() > 0.0) {
         ++row.contact_steps;
         const double e = (rendered - ref).norm();

@@ -385,7 +385,7 @@ std::int32_t fem_factorize(const FemSymbolic& sym, const FemBlockPattern& pat,
   for (std::int32_t s = 0; s < sn; ++s) {
     const std::int32_t f = sym.first[fem_sz(s)];
     const std::int32_t l = sym.first[fem_sz(s) + 1] - 1;
-    const Eigen::Index w = 3 * (l - f + 1);
+    const Eigen::Index w = Eigen::Index{3} * (l - f + 1);
     const std::size_t r0 = sym.row_start[fem_sz(s)];
     const std::size_t r1 = sym.row_start[fem_sz(s) + 1];
     const Eigen::Index m = w + static_cast<Eigen::Index>(r1 - r0);
@@ -399,14 +399,14 @@ std::int32_t fem_factorize(const FemSymbolic& sym, const FemBlockPattern& pat,
     }
     // Column node j of the lower triangle is row j of the upper pattern, transposed.
     for (std::int32_t j = f; j <= l; ++j) {
-      const Eigen::Index c0 = 3 * (j - f);
+      const Eigen::Index c0 = Eigen::Index{3} * (j - f);
       for (std::int32_t p = pat.start[fem_sz(j)]; p < pat.start[fem_sz(j) + 1]; ++p) {
         const std::int32_t k = pat.col[fem_sz(p)];
         const double* b = a.data() + 9 * fem_sz(p);  // A(j, k), column-major
         for (std::int32_t r = 0; r < 3; ++r) {
           const Eigen::Index row = work.relpos[fem_sz(3 * k + r)];
           for (Eigen::Index c = 0; c < 3; ++c) {
-            block(row, c0 + c) += b[3 * r + c];  // A(k, j)(r, c) = A(j, k)(c, r)
+            block(row, c0 + c) += b[Eigen::Index{3} * r + c];  // A(k, j)(r, c) = A(j, k)(c, r)
           }
         }
       }
@@ -419,7 +419,7 @@ std::int32_t fem_factorize(const FemSymbolic& sym, const FemBlockPattern& pat,
     // CHOLMOD: d waits in the list of the supernode owning its next unconsumed row).
     for (std::int32_t d = work.head[fem_sz(s)]; d != -1;) {
       const std::int32_t d_next = work.next[fem_sz(d)];
-      const Eigen::Index wd = 3 * (sym.first[fem_sz(d) + 1] - sym.first[fem_sz(d)]);
+      const Eigen::Index wd = Eigen::Index{3} * (sym.first[fem_sz(d) + 1] - sym.first[fem_sz(d)]);
       const std::size_t dr0 = sym.row_start[fem_sz(d)];
       const std::size_t dr1 = sym.row_start[fem_sz(d) + 1];
       const Eigen::Index md = wd + static_cast<Eigen::Index>(dr1 - dr0);
@@ -488,7 +488,7 @@ void fem_solve_in_place(const FemSymbolic& sym, const Scalar* lv, Scalar* y, Sca
   const std::int32_t sn = sym.supernodes();
   for (std::int32_t s = 0; s < sn; ++s) {
     const std::int32_t f = sym.first[fem_sz(s)];
-    const Eigen::Index w = 3 * (sym.first[fem_sz(s) + 1] - f);
+    const Eigen::Index w = Eigen::Index{3} * (sym.first[fem_sz(s) + 1] - f);
     const std::size_t r0 = sym.row_start[fem_sz(s)];
     const Eigen::Index nr = static_cast<Eigen::Index>(sym.row_start[fem_sz(s) + 1] - r0);
     const Eigen::Map<const Mat> block(lv + sym.value_start[fem_sz(s)], w + nr, w);
@@ -505,7 +505,7 @@ void fem_solve_in_place(const FemSymbolic& sym, const Scalar* lv, Scalar* y, Sca
   }
   for (std::int32_t s = sn; s-- > 0;) {
     const std::int32_t f = sym.first[fem_sz(s)];
-    const Eigen::Index w = 3 * (sym.first[fem_sz(s) + 1] - f);
+    const Eigen::Index w = Eigen::Index{3} * (sym.first[fem_sz(s) + 1] - f);
     const std::size_t r0 = sym.row_start[fem_sz(s)];
     const Eigen::Index nr = static_cast<Eigen::Index>(sym.row_start[fem_sz(s) + 1] - r0);
     const Eigen::Map<const Mat> block(lv + sym.value_start[fem_sz(s)], w + nr, w);
@@ -528,16 +528,16 @@ void fem_spmv(const FemBlockPattern& pat, const std::vector<double>& values, con
   y.setZero();
   const std::int32_t n = pat.rows();
   for (std::int32_t i = 0; i < n; ++i) {
-    const Vec3 xi = x.segment<3>(3 * i);
+    const Vec3 xi = x.segment<3>(Eigen::Index{3} * i);
     std::int32_t p = pat.start[fem_sz(i)];
     Vec3 yi = Eigen::Map<const Mat3>(values.data() + 9 * fem_sz(p)) * xi;  // diagonal block
     for (++p; p < pat.start[fem_sz(i) + 1]; ++p) {
       const std::int32_t j = pat.col[fem_sz(p)];
       const Eigen::Map<const Mat3> b(values.data() + 9 * fem_sz(p));
-      yi.noalias() += b * x.segment<3>(3 * j);
-      y.segment<3>(3 * j).noalias() += b.transpose() * xi;
+      yi.noalias() += b * x.segment<3>(Eigen::Index{3} * j);
+      y.segment<3>(Eigen::Index{3} * j).noalias() += b.transpose() * xi;
     }
-    y.segment<3>(3 * i) += yi;
+    y.segment<3>(Eigen::Index{3} * i) += yi;
   }
 }
 
@@ -666,8 +666,8 @@ struct FemBody::Impl {
   std::vector<Vec3> scratch_x;
 
   // --- construction -------------------------------------------------------------------------
-  Impl(TetMesh mesh_in, std::vector<FemRegionMaterial> region_materials,
-       std::vector<std::uint32_t> fixed_nodes, FemOptions opts, std::string_view src)
+  Impl(TetMesh mesh_in, const std::vector<FemRegionMaterial>& region_materials,
+       std::vector<std::uint32_t> fixed_nodes, const FemOptions& opts, std::string_view src)
       : mesh(std::move(mesh_in)), options(opts), source(src) {
     corotational = options.elasticity == FemElasticity::kCorotational;
     dynamic = options.integration == FemIntegration::kBackwardEuler;
@@ -1193,7 +1193,7 @@ struct FemBody::Impl {
       for (std::size_t a = 0; a < 4; ++a) {
         const std::int32_t fi = free_index[el.node[a]];
         if (fi >= 0) {
-          coupling.segment<3>(3 * fi) += fn[a];
+          coupling.segment<3>(Eigen::Index{3} * fi) += fn[a];
         }
       }
     }
@@ -1541,7 +1541,7 @@ struct FemBody::Impl {
         Eigen::Map<Mat3>(work_values.data() + 9 * fem_sz(pattern.start[fem_sz(fi)])) +=
             penalty * n * n.transpose();
         const Vec3 spring = penalty * (radius - n.dot(d)) * n;
-        rhs.segment<3>(3 * fi) += spring;
+        rhs.segment<3>(Eigen::Index{3} * fi) += spring;
         scale += spring.norm();
       }
       // Preconditioner: K + the springs (in the node frames), factored for the first active set
@@ -1577,7 +1577,7 @@ struct FemBody::Impl {
       for (std::size_t b = 0; b < nb; ++b) {
         if (active[b]) {
           const std::int32_t fi = free_index[boundary_free[b]];
-          const double dn = normal[b].dot(sol.segment<3>(3 * fi));
+          const double dn = normal[b].dot(sol.segment<3>(Eigen::Index{3} * fi));
           curvature -= penalty * dn * dn;
         }
       }
@@ -1586,7 +1586,7 @@ struct FemBody::Impl {
         double g = slope0 + alpha * curvature;
         for (std::size_t b = 0; b < nb; ++b) {
           const std::int32_t fi = free_index[boundary_free[b]];
-          const Vec3 dx = sol.segment<3>(3 * fi);
+          const Vec3 dx = sol.segment<3>(Eigen::Index{3} * fi);
           const Vec3 d = x[boundary_free[b]] + alpha * dx - center;
           const double dist = d.norm();
           if (dist < radius && dist > 0.0) {
@@ -1658,7 +1658,7 @@ struct FemBody::Impl {
         n = fem_extract_rotation(sum, q, kFemQueryPolarIterations, kFemPolarTolerance).transpose() *
             n_in;
       }
-      sol.segment<3>(3 * fi) += w.weight * n;
+      sol.segment<3>(Eigen::Index{3} * fi) += w.weight * n;
       any = true;
     }
     if (!any) {
@@ -1681,11 +1681,11 @@ struct FemBody::Impl {
 
 // ---------------------------------------------------------------------------------------------
 
-FemBody::FemBody(TetMesh mesh, std::vector<FemRegionMaterial> materials,
-                 std::vector<std::uint32_t> fixed_nodes, FemOptions options,
+FemBody::FemBody(TetMesh mesh, const std::vector<FemRegionMaterial>& materials,
+                 std::vector<std::uint32_t> fixed_nodes, const FemOptions& options,
                  std::string_view source)
-    : impl_(std::make_unique<Impl>(std::move(mesh), std::move(materials), std::move(fixed_nodes),
-                                   options, source)) {}
+    : impl_(std::make_unique<Impl>(std::move(mesh), materials, std::move(fixed_nodes), options,
+                                   source)) {}
 
 FemBody::~FemBody() = default;
 FemBody::FemBody(FemBody&&) noexcept = default;

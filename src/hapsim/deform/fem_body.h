@@ -117,8 +117,8 @@ class FemBody {
   /// (naming a node: K is singular when the fixed nodes do not hold every piece, e.g. a single
   /// fixed node). Also refused: two materials for one region, dt ≤ 0, a CG tolerance outside
   /// (0, 1), fewer than one CG or quasi-static iteration. A node in no tet stays where it is.
-  FemBody(TetMesh mesh, std::vector<FemRegionMaterial> materials,
-          std::vector<std::uint32_t> fixed_nodes, FemOptions options,
+  FemBody(TetMesh mesh, const std::vector<FemRegionMaterial>& materials,
+          std::vector<std::uint32_t> fixed_nodes, const FemOptions& options,
           std::string_view source = "fem body");
   ~FemBody();
   FemBody(const FemBody&) = delete;

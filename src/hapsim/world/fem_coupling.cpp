@@ -201,7 +201,7 @@ FemCoupling::FemCoupling(const WorldModel& model) {
     for (Vec3& shift : body->patch_shift) {
       shift.setZero();
     }
-    body->loads.reserve(256 * kMaxTools);
+    body->loads.reserve(std::size_t{256} * static_cast<std::size_t>(kMaxTools));
     // Which tets touch each boundary vertex (its stress is their mean), as a flat list.
     const std::size_t nv = body->surface.vertices.size();
     if (body->embedding.empty()) {
