@@ -20,11 +20,11 @@ namespace hapsim {
 /// The `realtime` block (knee and teleop scenes alike).
 [[nodiscard]] nlohmann::json realtime_json(const RealtimeSummary& rt);
 
-/// Everything a session summary says, plus the scene, world and device it ran.
 /// The "fem" object of a run's JSON (FEM bodies' updates, costs and displacements); the Python
 /// module's World.fem_stats() returns the same.
 [[nodiscard]] nlohmann::json fem_summary_json(const FemSummary& fem);
 
+/// Everything a session summary says, plus the scene, world and device it ran.
 [[nodiscard]] nlohmann::json session_summary_json(const SceneDescription& scene, const World& world,
                                                   const SessionSummary& s,
                                                   const std::string& device_name);

@@ -115,9 +115,6 @@ std::vector<std::uint32_t> fem_fixed_nodes(const WorldModel& model, const BodyDe
   return {fixed.begin(), fixed.end()};
 }
 
-}  // namespace
-
-namespace {
 // The secant softening of a quasi-static contact (update_body): measured from a load change of at
 // least 1 mN and 2 % of the load, at most ten times softer than compliance_along.
 constexpr double kFemSecantMinLoadStepN = 1e-3;
