@@ -45,6 +45,9 @@ HAPSIM_PACKAGES=(
   # CalculiX (find_program(ccx)): the FEM body's oracle, a separate GPL program the deform oracle
   # tests run on the same tet mesh (never linked)
   calculix-ccx
+  # TetGen (a separate GPL program, never linked): scripts/derive-knee-fem.sh meshes the FEM knee
+  # with it, and a test re-runs that script to check the committed mesh is what it derives
+  tetgen
   # the Python module (python/): Python's headers and find_package(pybind11) build it; NumPy for
   # its arrays; pytest runs its tests under ctest; the examples' plots use the matplotlib above
   python3-dev python3-numpy pybind11-dev python3-pytest

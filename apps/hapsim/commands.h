@@ -47,6 +47,7 @@ void add_watch_command(CLI::App& app);
 void add_control_command(CLI::App& app);
 void add_simplify_command(CLI::App& app);
 void add_polygonize_command(CLI::App& app);
+void add_tetrahedralize_command(CLI::App& app);
 void add_sheet_profile_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 

@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   add_control_command(app);
   add_simplify_command(app);
   add_polygonize_command(app);
+  add_tetrahedralize_command(app);
   add_sheet_profile_command(app);
   add_calibrate_command(app);
 #ifdef HAPSIM_WITH_BENCH

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <optional>
@@ -1063,6 +1064,37 @@ TetMesh parse_vtk_unstructured(std::string_view text, std::string_view source) {
   }
   tet_io_finish(mesh, in.where(), line_of_tet);
   return mesh;
+}
+
+void write_tetgen(const TetMesh& mesh, const std::filesystem::path& path_without_extension) {
+  const auto write = [](const std::filesystem::path& path, const std::string& text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+    out.flush();
+    if (!out) {
+      throw Error(path.string(), "cannot write the file");
+    }
+  };
+  std::string node = std::to_string(mesh.node_count()) + " 3 0 0\n";
+  char line[128];
+  for (std::size_t i = 0; i < mesh.node_count(); ++i) {
+    const Vec3& p = mesh.nodes[i];
+    std::snprintf(line, sizeof line, "%zu %.17g %.17g %.17g\n", i, p.x(), p.y(), p.z());
+    node += line;
+  }
+  std::string ele = std::to_string(mesh.tet_count()) + " 4 1\n";
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    const TetIndices& k = mesh.tets[t];
+    std::snprintf(line, sizeof line, "%zu %u %u %u %u %d\n", t, k[0], k[1], k[2], k[3],
+                  mesh.region(t));
+    ele += line;
+  }
+  std::filesystem::path node_path = path_without_extension;
+  node_path += ".node";
+  std::filesystem::path ele_path = path_without_extension;
+  ele_path += ".ele";
+  write(node_path, node);
+  write(ele_path, ele);
 }
 
 TetMesh read_vtk_unstructured(const std::filesystem::path& path) {

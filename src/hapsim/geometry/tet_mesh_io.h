@@ -33,6 +33,12 @@ namespace hapsim {
 [[nodiscard]] TetMesh parse_tetgen(std::string_view node_text, std::string_view ele_text,
                                    std::string_view source);
 
+/// Writes `mesh` as TetGen's `PATH.node` and `PATH.ele` (PATH without the extension): nodes
+/// numbered from 0, coordinates with 17 significant digits (read back bit for bit), the region as
+/// the .ele's one attribute, tets as stored. The same mesh gives the same bytes. Throws
+/// hapsim::Error naming the file when it cannot be written (a full disk included).
+void write_tetgen(const TetMesh& mesh, const std::filesystem::path& path_without_extension);
+
 /// Legacy VTK ASCII, DATASET UNSTRUCTURED_GRID (POINTS, CELLS, CELL_TYPES: 10 = tetra; an
 /// integer CELL_DATA scalar named region, gmsh:physical or CellEntityIds, when present, is the
 /// region). CELLS in the 5.1 layout (OFFSETS, CONNECTIVITY: meshio's default) are read too, and

@@ -108,12 +108,17 @@ void read_palpation(const SceneReader& r, const Json& j, const std::string& pp,
   for (std::size_t i = 0; i < targets.size(); ++i) {
     const std::string ip = JsonReader::at(tp, i);
     const Json& t = r.object(targets[i], ip, "a palpation target");
-    r.allow_keys(t, ip, {"body", "segment", "from", "depth_m", "hold_s"});
+    r.allow_keys(t, ip, {"body", "segment", "toward_m", "from", "depth_m", "hold_s"});
     PalpationTargetDescription target;
     target.body =
         r.nonempty_string(r.required(t, ip, "body"), JsonReader::at(ip, "body"), "a body name");
-    target.segment = r.nonempty_string(r.required(t, ip, "segment"), JsonReader::at(ip, "segment"),
-                                       "a segment name");
+    if (t.contains("toward_m")) {
+      target.toward_world = r.vec3(t["toward_m"], JsonReader::at(ip, "toward_m"), "m");
+    }
+    if (t.contains("segment") || !target.toward_world) {
+      target.segment = r.nonempty_string(r.required(t, ip, "segment"),
+                                         JsonReader::at(ip, "segment"), "a segment name");
+    }
     target.from_world = r.vec3(r.required(t, ip, "from"), JsonReader::at(ip, "from"), "");
     if (!(target.from_world.norm() > 1e-9)) {
       r.fail(JsonReader::at(ip, "from"),
@@ -290,7 +295,8 @@ void check_palpation_targets(const SceneReader& r, const SceneDescription& scene
       r.fail(JsonReader::at(p, "body"),
              "expected the name of a body in /bodies, got '" + t.body + "'");
     }
-    if (std::none_of(body->segments.begin(), body->segments.end(),
+    if ((!t.segment.empty() || !t.toward_world) &&
+        std::none_of(body->segments.begin(), body->segments.end(),
                      [&](const SegmentDescription& s) { return s.name == t.segment; })) {
       std::string names;
       for (std::size_t s = 0; s < body->segments.size() && s < 40; ++s) {

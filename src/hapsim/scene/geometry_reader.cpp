@@ -296,12 +296,15 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
       if (m.contains("pattern")) {
         pattern = r_.nonempty_string(m["pattern"], JsonReader::at(kp, "pattern"),
                                      "a file pattern like *.stl");
-        if (pattern.rfind('*', 0) != 0 || pattern.find('*', 1) != std::string::npos) {
+        if (std::count(pattern.begin(), pattern.end(), '*') != 1) {
           r_.fail(JsonReader::at(kp, "pattern"),
-                  "expected '*' followed by a file-name ending, e.g. '*.stl'");
+                  "expected a file-name beginning, one '*' and an ending, e.g. '*.stl' or "
+                  "'Bone_*.stl'");
         }
       }
-      const std::string ending = ascii_lower(pattern.substr(1));
+      const std::size_t star = pattern.find('*');
+      const std::string beginning = ascii_lower(pattern.substr(0, star));
+      const std::string ending = ascii_lower(pattern.substr(star + 1));
       const std::string prefix =
           m.contains("strip_prefix")
               ? r_.string(m["strip_prefix"], JsonReader::at(kp, "strip_prefix"), "text")
@@ -316,7 +319,8 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
         const std::filesystem::directory_entry& entry = *it;
         const std::string name = ascii_lower(entry.path().filename().string());
         std::error_code entry_ec;
-        if (entry.is_regular_file(entry_ec) && name.size() >= ending.size() &&
+        if (entry.is_regular_file(entry_ec) && name.size() >= beginning.size() + ending.size() &&
+            name.compare(0, beginning.size(), beginning) == 0 &&
             name.compare(name.size() - ending.size(), ending.size(), ending) == 0) {
           files.push_back(entry.path());
         }

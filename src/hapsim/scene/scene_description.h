@@ -20,6 +20,10 @@ namespace hapsim {
 struct PalpationTargetDescription {
   std::string body;     // body name
   std::string segment;  // segment name within the body
+  /// Aim at this point (world frame) instead of the segment's centroid: a landmark inside a body
+  /// that is no segment of it (the MCL inside a FEM knee's tissue). The surface met is still the
+  /// body's first, coming from `from_world`.
+  std::optional<Vec3> toward_world;
   Vec3 from_world = Vec3::UnitY();
   double depth_m = 0.006;
   double hold_s = 0.5;

@@ -64,15 +64,24 @@ class ExactBodies {
 
 PalpationAim aim(const World& world, const PalpationTargetDescription& target, ExactBodies& exact) {
   const std::size_t body = find_body(world, target.body);
-  const std::size_t segment = find_segment(world, body, target.segment);
   const BodyDescription& bd = world.description().bodies[body];
-  const TriangleMesh& mesh = bd.segments[segment].mesh;
-  Vec3 centroid_body = Vec3::Zero();
-  for (const Vec3& v : mesh.vertices) {
-    centroid_body += v;
+  std::size_t segment = 0;
+  Vec3 centroid_world;
+  if (target.toward_world) {
+    centroid_world = *target.toward_world;
+    if (!target.segment.empty()) {
+      segment = find_segment(world, body, target.segment);
+    }
+  } else {
+    segment = find_segment(world, body, target.segment);
+    const TriangleMesh& mesh = bd.segments[segment].mesh;
+    Vec3 centroid_body = Vec3::Zero();
+    for (const Vec3& v : mesh.vertices) {
+      centroid_body += v;
+    }
+    centroid_body /= static_cast<double>(mesh.vertex_count());
+    centroid_world = bd.X_world_body * centroid_body;
   }
-  centroid_body /= static_cast<double>(mesh.vertex_count());
-  const Vec3 centroid_world = bd.X_world_body * centroid_body;
   const double norm = target.from_world.norm();
   if (!(norm > 0.0) || !target.from_world.allFinite()) {
     throw Error("palpation target '" + target.segment + "'", "needs a non-zero 'from' direction");
@@ -87,7 +96,8 @@ PalpationAim aim(const World& world, const PalpationTargetDescription& target, E
   const double reach = 2.0 * all.diagonal().norm() + 0.1;
   Vec3 p = centroid_world + from * reach;
   const Iso3 X_body_world = bd.X_world_body.inverse();
-  const std::string where = "palpation target '" + target.segment + "'";
+  const std::string where =
+      "palpation target '" + (target.segment.empty() ? target.body : target.segment) + "'";
   for (int iteration = 0; iteration < 10000; ++iteration) {
     double nearest = kInf;
     std::size_t nearest_segment = segment;
