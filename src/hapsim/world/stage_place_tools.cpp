@@ -265,6 +265,7 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
                              : Vec3(input.p_world + q * d.tools[t].offset_device);
     if (!state.tools_placed) {
       tool.proxy.reset(p_world);
+      tool.proxy_surface_last_step = -1;
     }
     tool.v_world = tool.has_previous && dt_s > 0.0 ? Vec3((p_world - tool.p_previous_world) / dt_s)
                                                    : Vec3::Zero();

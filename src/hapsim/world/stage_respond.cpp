@@ -106,6 +106,30 @@ void drive_sheets_with_rendered_push(double rendered_push_n, double step_push_n,
   }
 }
 
+// A proxy never passes through a closed surface, but a defect (a query's wrong side, a
+// friction step off a curved surface) could let it go while the device is still inside the body:
+// the hand would feel the bone vanish with nothing said. Such a loss is counted as a
+// pop-through. One closest-point query, only on the cycle a contact ends. haptic path
+void count_proxy_loss(WorldState& state, ToolRuntime& tool) noexcept {
+  const int last = tool.proxy_surface_last_step;
+  tool.proxy_surface_last_step =
+      tool.proxy.in_contact() ? tool.proxy.contacts().front().surface : -1;
+  if (last < 0 || tool.proxy.in_contact() ||
+      static_cast<std::size_t>(last) >= tool.surfaces.size()) {
+    return;
+  }
+  const ProxySurface& s = tool.surfaces[static_cast<std::size_t>(last)];
+  if (s.query == nullptr || s.two_sided) {
+    return;  // an open sheet has no inside
+  }
+  // A free proxy reaches the device within the cycle: the tool sphere overlapping the body
+  // (beyond 0.1 mm, clear of rounding) with no proxy contact is a proxy that went astray.
+  const SurfacePoint sp = s.query->closest_point(s.X_world_body.inverse() * tool.p_world);
+  if (sp.signed_distance < tool.proxy.params().radius_m - 1e-4) {
+    ++state.pop_throughs;
+  }
+}
+
 }  // namespace
 
 // haptic path
@@ -128,6 +152,7 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
 
     // Proxy segments: the god-object's proxy never enters them; the spring pulls the tool to it.
     tool.proxy.update(tool.p_world, tool.surfaces);
+    count_proxy_loss(state, tool);
     const Vec3 proxy_force_world =
         proxy_force(tool.proxy, tool.surfaces, tool.p_world, tool.v_world);
     Vec3 total = proxy_force_world;

@@ -159,7 +159,8 @@ struct StepResult {
   /// Contacts found but not reported because the per-step buffer was full.
   std::int32_t dropped_contacts = 0;
   /// Tools that left a penalty segment through its far side this step (pulled through a thin
-  /// segment: must stay 0).
+  /// segment), and proxies that let go of a surface with the device inside that body (a lost
+  /// bone): must stay 0.
   std::int32_t penalty_pop_throughs = 0;
   /// Contacts of dynamic bodies with other bodies this step.
   std::span<const BodyContact> body_contacts;
@@ -245,7 +246,10 @@ struct ToolRuntime {
   GodObject proxy;                           ///< respond stage
   std::vector<ProxySurface> surfaces;        ///< one per proxy segment
   std::vector<std::size_t> surface_segment;  ///< flat segment of each surface
-  std::vector<QueryHint> hints;              ///< per flat segment (temporal coherence)
+  /// The surface (index into `surfaces`) the proxy touched last step, -1 for none: a proxy that
+  /// lets go of it while the device is inside that body has lost it (counted as a pop-through).
+  int proxy_surface_last_step = -1;
+  std::vector<QueryHint> hints;  ///< per flat segment (temporal coherence)
   /// Per flat segment: the tool was within reach of, or inside, it last step. Only then can it be
   /// deeper than the reach now (it moves far less than a reach per cycle), so only then is the
   /// costly deep-inside query needed (detect stage).
