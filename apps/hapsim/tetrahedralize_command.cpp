@@ -27,10 +27,10 @@
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <cerrno>
-#include <cstring>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -139,10 +139,12 @@ void run_tetgen(const std::string& program, const std::string& switches,
       text = "..." + text.substr(text.size() - 600);
     }
     throw CommandError(program + " " + sw + " failed (" +
-                       (WIFEXITED(status) ? "exit " + std::to_string(WEXITSTATUS(status))
-                                          : "killed by signal " + std::to_string(WTERMSIG(status))) +
+                       (WIFEXITED(status)
+                            ? "exit " + std::to_string(WEXITSTATUS(status))
+                            : "killed by signal " + std::to_string(WTERMSIG(status))) +
                        "); a self-intersecting --outer is the usual cause (check it with "
-                       "'tetgen -d'). Its output:\n" + text);
+                       "'tetgen -d'). Its output:\n" +
+                       text);
   }
 }
 
@@ -238,10 +240,9 @@ std::size_t keep_largest_piece(TetMesh& mesh) {
   if (count.size() <= 1) {
     return 0;
   }
-  const std::uint32_t largest =
-      std::max_element(count.begin(), count.end(), [](auto& a, auto& b) {
-        return a.second < b.second;
-      })->first;
+  const std::uint32_t largest = std::max_element(count.begin(), count.end(), [](auto& a, auto& b) {
+                                  return a.second < b.second;
+                                })->first;
   std::vector<TetIndices> tets;
   std::vector<std::int32_t> regions;
   for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
@@ -471,11 +472,13 @@ void run_tetrahedralize(const TetrahedralizeOptions& opt) {
 
   const TetMeshQuality q = tet_mesh_quality(mesh);
   const double unit3_to_ml = opt.scale * opt.scale * opt.scale * 1e6;
-  std::printf("meshed       %zu tets; removed %zu inside --drop surfaces, %zu flat, %zu in islands\n",
-              meshed, dropped_inside, dropped_flat, islands);
-  std::printf("volume       %zu tets, %zu nodes, %.1f mL; dihedral %.1f..%.1f deg, worst aspect %.1f\n",
-              q.tets, q.nodes, q.total_volume_m3 * unit3_to_ml, q.min_dihedral_deg,
-              q.max_dihedral_deg, q.max_aspect_ratio);
+  std::printf(
+      "meshed       %zu tets; removed %zu inside --drop surfaces, %zu flat, %zu in islands\n",
+      meshed, dropped_inside, dropped_flat, islands);
+  std::printf(
+      "volume       %zu tets, %zu nodes, %.1f mL; dihedral %.1f..%.1f deg, worst aspect %.1f\n",
+      q.tets, q.nodes, q.total_volume_m3 * unit3_to_ml, q.min_dihedral_deg, q.max_dihedral_deg,
+      q.max_aspect_ratio);
   nlohmann::json region_json = nlohmann::json::object();
   for (const auto& [id, n] : per_region) {
     double volume = 0.0;

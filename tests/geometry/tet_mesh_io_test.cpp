@@ -270,7 +270,9 @@ std::string write_msh(const TetMesh& m) {
   return s.str();
 }
 
-void write_tetgen(const TetMesh& m, const fs::path& stem) {
+// TetGen's files as TetGen numbers them (from 1), written here apart from the library's own
+// writer (from 0), so the reader is checked against both numberings.
+void write_tetgen_one_based(const TetMesh& m, const fs::path& stem) {
   std::ofstream node(fs::path(stem).concat(".node"));
   node << m.node_count() << " 3 0 0\n";
   for (std::size_t i = 0; i < m.node_count(); ++i) {
@@ -329,11 +331,30 @@ TEST_F(TetMeshIo, ABlockWrittenInEachFormatReadsBackIdentical) {
   EXPECT_EQ(by_region(msh, 1), by_region(block, 1));
   EXPECT_EQ(by_region(msh, 2), by_region(block, 2));
 
-  write_tetgen(block, dir_ / "block");
+  write_tetgen_one_based(block, dir_ / "block");
   const TetMesh tetgen = read_tet_mesh(dir_ / "block.ele");
   EXPECT_EQ(tetgen.nodes, block.nodes);
   EXPECT_EQ(tetgen.tets, block.tets);
   EXPECT_EQ(tetgen.regions, block.regions);
+
+  // The library's writer (hapsim tetrahedralize's output): bit for bit back, the same bytes twice.
+  TetMesh odd = block;
+  for (Vec3& p : odd.nodes) {
+    p += Vec3(1.0 / 3.0, -2.0 / 7.0, 1e-17);  // digits a short format would round away
+  }
+  hapsim::write_tetgen(odd, dir_ / "ours");
+  const TetMesh ours = read_tet_mesh(dir_ / "ours.node");
+  EXPECT_EQ(ours.nodes, odd.nodes);
+  EXPECT_EQ(ours.tets, odd.tets);
+  EXPECT_EQ(ours.regions, odd.regions);
+  hapsim::write_tetgen(ours, dir_ / "again");
+  const auto bytes = [](const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  EXPECT_EQ(bytes(dir_ / "again.node"), bytes(dir_ / "ours.node"));
+  EXPECT_EQ(bytes(dir_ / "again.ele"), bytes(dir_ / "ours.ele"));
+  EXPECT_THROW(hapsim::write_tetgen(odd, dir_ / "no_such_folder" / "x"), Error);
 
   const TetMesh vtk = read_tet_mesh(write("block.vtk", write_vtk(block)));
   EXPECT_EQ(vtk.nodes, block.nodes);

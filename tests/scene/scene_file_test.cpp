@@ -427,7 +427,13 @@ TEST_F(SceneFileTest, BadMeshFilesAreNamedWithTheirJsonPath) {
        "no file matching '*.stl'"},
       {{{"mesh_folder", {{"folder", "meshes"}, {"pattern", "stl"}}}},
        "/bodies/0/geometry/mesh_folder/pattern",
-       "expected '*' followed by"},
+       "expected a file-name beginning, one '*' and an ending"},
+      {{{"mesh_folder", {{"folder", "meshes"}, {"pattern", "*_*.stl"}}}},
+       "/bodies/0/geometry/mesh_folder/pattern",
+       "one '*'"},
+      {{{"mesh_folder", {{"folder", "meshes"}, {"pattern", "Bone_*.stl"}}}},
+       "/bodies/0/geometry/mesh_folder/folder",
+       "no file matching 'Bone_*.stl'"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.geometry.dump());

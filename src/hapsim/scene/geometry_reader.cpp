@@ -108,8 +108,8 @@ void GeometryReader::read_tets(const Json& j, const std::string& kp, const std::
       if (!(n >= 1.0 && n <= 200.0) || n != std::floor(n)) {
         r_.fail(JsonReader::at(cp, i), "expected a whole number of cells in 1..200");
       }
-      cells[i] = static_cast<int>(capped(n, r_.options().detail_caps.tet_block_cells,
-                                         JsonReader::at(cp, i)));
+      cells[i] = static_cast<int>(
+          capped(n, r_.options().detail_caps.tet_block_cells, JsonReader::at(cp, i)));
       total *= cells[i];
     }
     if (6.0 * total > 2e6) {
