@@ -13,6 +13,7 @@
 #include "progress_printer.h"
 
 #include "bench/collision_cases.h"
+#include "bench/contact_cases.h"
 #include "bench/fem_cases.h"
 #include "bench/passivity_cases.h"
 #include "bench/soak_cases.h"
@@ -194,6 +195,63 @@ void run_step(const StepArgs& args) {
       throw CommandError("--json " + args.json_path + ": write failed");
     }
     std::cout << "wrote " << args.json_path << '\n';
+  }
+}
+
+double load_average();
+
+struct ContactArgs {
+  std::vector<std::string> scenes;
+  std::vector<std::string> methods;
+  std::vector<double> speeds_mm_per_s;
+  std::vector<std::string> landmarks;
+  double press_n = 4.0;
+  double max_depth_mm = 15.0;
+  std::string json_path;
+};
+
+void run_contact(const ContactArgs& args) {
+  JsonOutput json_out(args.json_path);
+  bench::ContactBenchOptions options;
+  for (const std::string& s : args.scenes) {
+    options.scenes.emplace_back(s);
+  }
+  options.methods = args.methods;
+  if (!args.speeds_mm_per_s.empty()) {
+    options.speeds_mm_per_s = args.speeds_mm_per_s;
+  }
+  options.landmarks = args.landmarks;
+  options.press_n = args.press_n;
+  options.max_depth_mm = args.max_depth_mm;
+  ProgressPrinter printer;
+  options.progress = [&printer](std::string_view label, double fraction) {
+    printer(label, fraction);
+  };
+  const Stopwatch watch;
+  const std::vector<bench::ContactRow> rows = bench::run_contact_bench(options);
+  std::printf(
+      "A fingertip pressed over each landmark until it pushes back %.1f N (at most %.0f mm past "
+      "the skin), dragged 30 mm each way "
+      "across it and back, then held 0.3 s; pops: pop-throughs (a proxy lost with the tool "
+      "inside its body counts); jump: the largest force change between two cycles while "
+      "dragging; peak and held: the force; step: World::step only (FEM updates between cycles, "
+      "untimed)\n",
+      args.press_n, args.max_depth_mm);
+  std::cout << bench::format_contact_table(rows);
+  std::size_t pops = 0;
+  double worst_p99_us = 0.0;
+  for (const bench::ContactRow& r : rows) {
+    pops += r.pop_throughs;
+    worst_p99_us = std::max(worst_p99_us, r.step_p99_us);
+  }
+  std::printf("%zu rows in %.1f s: %zu pop-throughs in all, worst step p99 %.1f us, load %.2f\n",
+              rows.size(), watch.elapsed_s(), pops, worst_p99_us, load_average());
+  if (json_out) {
+    std::cout << std::flush;
+    json_out.write({{"rows", bench::contact_rows_to_json(rows)},
+                    {"press_n", args.press_n},
+                    {"max_depth_mm", args.max_depth_mm},
+                    {"load_average", load_average()}});
   }
 }
 
@@ -685,6 +743,39 @@ void add_bench_command(CLI::App& app) {
   passivity->callback([passivity_args] { run_passivity(*passivity_args); });
 
   add_snapshot_bench(*bench);
+
+  auto contact_args = std::make_shared<ContactArgs>();
+  CLI::App* contact = bench->add_subcommand(
+      "contact",
+      "Contact at hand speed: a fingertip pressed over the knee's landmarks (patella, tibial "
+      "tuberosity, patellar tendon, MCL, LCL) dragged across them at 10-500 mm/s, per scene and "
+      "contact method: pop-throughs, force continuity and the step's cost");
+  contact
+      ->add_option("--scenes", contact_args->scenes,
+                   "Scene files (default: scenes/knee.json and scenes/knee_fem.json)")
+      ->delimiter(',');
+  contact->add_option("--methods", contact_args->methods, "exact, spheretree, knee (default: all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"exact", "spheretree", "knee"}));
+  contact
+      ->add_option("--speeds", contact_args->speeds_mm_per_s,
+                   "Drag speeds, mm/s (default 10,50,200,500)")
+      ->delimiter(',')
+      ->check(CLI::Range(0.1, 5000.0));
+  contact
+      ->add_option("--landmarks", contact_args->landmarks,
+                   "Landmarks (default: all): " + join(bench::contact_landmark_names()))
+      ->delimiter(',');
+  contact
+      ->add_option("--press", contact_args->press_n,
+                   "Press in until the fingertip pushes back this much, N (default 4)")
+      ->check(CLI::Range(0.1, 50.0));
+  contact
+      ->add_option("--max-depth-mm", contact_args->max_depth_mm,
+                   "... or this far past the first touch of the skin, mm (default 15)")
+      ->check(CLI::Range(0.0, 50.0));
+  contact->add_option("--json", contact_args->json_path, "Write the rows as JSON to FILE");
+  contact->callback([contact_args] { run_contact(*contact_args); });
 
   auto fem_args = std::make_shared<FemArgs>();
   CLI::App* fem = bench->add_subcommand(

@@ -99,9 +99,35 @@ TEST(GodObject, StaticFrictionHoldsAndDynamicFrictionTrails) {
   proxy.update(Vec3(0.0008, 0, -0.002), surfaces);  // inside the cone: stick
   EXPECT_NEAR(proxy.proxy_world().x(), 0.0, 1e-9);
   const Vec3 fx = proxy_force(proxy, surfaces, Vec3(0.0008, 0, -0.002), Vec3::Zero());
-  EXPECT_LT(fx.x(), -0.5);                         // friction force resists the sideways push
-  proxy.update(Vec3(0.005, 0, -0.002), surfaces);  // outside: slip, trail by 0.3 * 2 mm
+  EXPECT_LT(fx.x(), -0.5);  // friction force resists the sideways push
+  // Outside the cone: slip, trail by 0.3 * 2 mm. In two cycles: the sliding loop traces at most
+  // 16 x 0.25 mm a cycle, and friction never moves the proxy farther than the loop did (that
+  // motion would be untraced: it crossed a tendon's edge in one cycle).
+  proxy.update(Vec3(0.0029, 0, -0.002), surfaces);
+  proxy.update(Vec3(0.005, 0, -0.002), surfaces);
   EXPECT_NEAR(proxy.proxy_world().x(), 0.005 - 0.3 * 0.002, 2e-5);
+}
+
+// Friction only holds a proxy back: with the device far ahead and deep (a saturated spring), the
+// proxy moves no farther along the surface in a cycle than the sliding loop traced (16 steps of
+// 0.25 mm). It used to jump the rest of the way to the dynamic cone's edge in one untraced move,
+// which carried it across the patellar tendon's edge and left it 2 mm off every surface.
+TEST(GodObject, FrictionNeverMovesTheProxyFartherThanTheSlideTraced) {
+  test::HalfSpace floor;
+  ContactMaterial m = wall_material(1000.0, 0.0);
+  m.static_friction = 0.2;
+  m.dynamic_friction = 0.15;
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&floor, Iso3::Identity(), &m, false, &hint}}};
+  GodObject proxy;
+  proxy.reset(Vec3(0, 0, 0.001));
+  proxy.update(Vec3(0, 0, -0.010), surfaces);
+  ASSERT_TRUE(proxy.in_contact());
+  proxy.update(Vec3(0.020, 0, -0.010), surfaces);  // 20 mm ahead, 10 mm deep, in one cycle
+  const GodObjectParams p = proxy.params();
+  EXPECT_LE(proxy.proxy_world().x(), p.max_iterations * p.max_substep_m + 1e-9);
+  EXPECT_GT(proxy.proxy_world().x(), 0.0);
+  EXPECT_TRUE(proxy.in_contact());
 }
 
 // A fingertip pressed 2.5 mm into a convex bone (the patella's curvature: 25 mm) and dragged

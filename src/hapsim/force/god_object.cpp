@@ -51,6 +51,8 @@ GodObject::Probe GodObject::probe(const ProxySurface& surface, int index, const 
 // haptic path
 double GodObject::scan(std::span<const ProxySurface> surfaces, double margin_m) {
   contact_count_ = 0;
+  nearest_clearance_m_ = margin_m;
+  nearest_normal_world_ = Vec3::Zero();
   double least = margin_m;
   const int n = static_cast<int>(std::min<std::size_t>(surfaces.size(), kMaxSurfaces));
   for (int i = 0; i < n; ++i) {
@@ -58,6 +60,10 @@ double GodObject::scan(std::span<const ProxySurface> surfaces, double margin_m) 
       continue;  // out of this update's reach (see update()): clearance >= margin_m
     }
     const Probe pr = probe(surfaces[static_cast<std::size_t>(i)], i, proxy_world_, margin_m);
+    if (pr.clearance_m < nearest_clearance_m_) {
+      nearest_clearance_m_ = pr.clearance_m;
+      nearest_normal_world_ = pr.normal_world;
+    }
     least = std::min(least, pr.clearance_m);
     if (!(pr.clearance_m < params_.contact_tolerance_m)) {
       continue;
@@ -174,8 +180,26 @@ void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface>
     proxy_world_ += motion * (step / length);
     least = resolve_penetration(surfaces, margin);
   }
+  settle_onto_nearest(device_p_world, surfaces, margin);
   apply_friction(previous, device_p_world, surfaces, margin);
   cull_ = false;
+}
+
+// haptic path
+void GodObject::settle_onto_nearest(const Vec3& device_p_world,
+                                    std::span<const ProxySurface> surfaces, double margin_m) {
+  for (int pass = 0; pass < 3 && contact_count_ == 0; ++pass) {
+    const double clearance = nearest_clearance_m_;
+    const Vec3 n = nearest_normal_world_;
+    // Only just off a surface (within a contact step), and only when the device is beyond it:
+    // a proxy in free space with the device beside it is where it should be.
+    if (!(clearance < params_.max_substep_m) || n.isZero() ||
+        (proxy_world_ - device_p_world).dot(n) <= clearance) {
+      return;
+    }
+    proxy_world_ -= n * clearance;
+    (void)resolve_penetration(surfaces, margin_m);
+  }
 }
 
 // haptic path
@@ -223,23 +247,21 @@ void GodObject::apply_friction(const Vec3& previous_proxy_world, const Vec3& dev
   if (t_len <= material->static_friction * depth) {
     proxy_world_ -= moved_t;  // stick: inside the friction cone the proxy keeps its place
   } else {
-    // Slip: the proxy trails the device by the dynamic friction cone's radius.
+    // Slip: the proxy trails the device by the dynamic friction cone's radius. Friction only
+    // holds the proxy back: when the sliding loop has not yet come that far (the device deep in
+    // and far ahead), moving it the rest of the way here would be a jump nobody traced, through
+    // whatever lies between (it crossed the patellar tendon's edge and left the proxy 2 mm off
+    // every surface, the device 15 mm deep).
     const Vec3 goal_t = tangential - tangential * (material->dynamic_friction * depth / t_len);
-    proxy_world_ += goal_t - moved_t;
+    if (goal_t.squaredNorm() < moved_t.squaredNorm()) {
+      proxy_world_ += goal_t - moved_t;
+    }
   }
   resolve_penetration(surfaces, margin_m);
   // Friction moves the proxy in the contact's tangent plane: over a convex surface that lifts
-  // it off (10-40 um a cycle sliding over a patella at 50 mm/s), the contact falls outside the
-  // tolerance and the force vanishes for that cycle with the device still inside the bone.
-  // Settle it back along the normal (the device is beneath the surface: depth > 0 above).
-  for (int pass = 0; pass < 3 && contact_count_ == 0; ++pass) {
-    const double clearance = scan(surfaces, margin_m);
-    if (contact_count_ > 0 || !(clearance < params_.max_substep_m)) {
-      break;
-    }
-    proxy_world_ -= n * clearance;
-    resolve_penetration(surfaces, margin_m);
-  }
+  // it off (10-40 um a cycle sliding over a patella at 50 mm/s), and the force would vanish for
+  // that cycle with the device still inside the bone.
+  settle_onto_nearest(device_p_world, surfaces, margin_m);
 }
 
 // haptic path

@@ -90,11 +90,20 @@ class GodObject {
                             std::span<const ProxySurface> surfaces) const;
   void apply_friction(const Vec3& previous_proxy_world, const Vec3& device_p_world,
                       std::span<const ProxySurface> surfaces, double margin_m);
+  /// A proxy left out of contact just off a surface the device is beyond (a friction step in a
+  /// convex surface's tangent plane, or the iterations spent between leaving one surface and
+  /// meeting the next) is moved back onto it along its normal: otherwise that cycle renders no
+  /// force with the device inside the body.
+  void settle_onto_nearest(const Vec3& device_p_world, std::span<const ProxySurface> surfaces,
+                           double margin_m);
 
   GodObjectParams params_;
   Vec3 proxy_world_ = Vec3::Zero();
   std::array<ProxyContact, kMaxContacts> contacts_{};
   int contact_count_ = 0;
+  /// The nearest surface at the last scan (also when farther than the contact tolerance).
+  double nearest_clearance_m_ = 0.0;
+  Vec3 nearest_normal_world_ = Vec3::Zero();
   int iterations_used_ = 0;
   /// Side of each two-sided surface the proxy is on (+1 front, −1 back, 0 unknown yet).
   std::array<std::int8_t, kMaxSurfaces> side_{};
