@@ -301,9 +301,29 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
       s.line = find_touch(*probe, Vec3(0.0, 0.0, passivity_fem_block().size_m.z() + 0.02),
                           Vec3::UnitZ());
       surfaces.push_back(std::move(s));
+    } else if (name == "fem_knee") {
+      // The FEM knee (scenes/knee_fem.json) over the patella: 5 mm of FEM tissue on a rigid
+      // bone, every material's spring at the swept stiffness and the device's force limit.
+      auto knee =
+          std::make_shared<SceneDescription>(load_scene(options.scenes_dir / "knee_fem.json"));
+      Surface s{name,
+                [knee](const DeviceProfile& profile, double k) {
+                  WorldDescription world = knee->world;
+                  for (MaterialDescription& m : world.materials) {
+                    m.contact.stiffness_n_per_m = k;
+                    m.contact.max_force_n = limit_n(profile);
+                  }
+                  return std::make_unique<World>(std::move(world));
+                },
+                {},
+                fem_port_stiffness};
+      const DeviceProfile& any = builtin_device_profiles().front();
+      std::unique_ptr<World> probe = s.build(any, any.max_stiffness_n_per_m);
+      s.line = find_touch(*probe, Vec3(-0.01, 0.09, 0.028), Vec3::UnitY());
+      surfaces.push_back(std::move(s));
     } else {
-      throw Error("--surfaces",
-                  "unknown surface '" + name + "', expected plane, sphere, sheet, knee or fem");
+      throw Error("--surfaces", "unknown surface '" + name +
+                                    "', expected plane, sphere, sheet, knee, fem or fem_knee");
     }
   }
 
