@@ -209,6 +209,18 @@ double limit_n(const DeviceProfile& profile) {
   return profile.max_force_n > 0.0 ? profile.max_force_n : profile.max_finger_force_n;
 }
 
+// A scene's world with every material's spring at the swept stiffness and the device's limit.
+auto scene_at_stiffness(std::shared_ptr<const SceneDescription> scene) {
+  return [scene](const DeviceProfile& profile, double k) {
+    WorldDescription world = scene->world;
+    for (MaterialDescription& m : world.materials) {
+      m.contact.stiffness_n_per_m = k;
+      m.contact.max_force_n = limit_n(profile);
+    }
+    return std::make_unique<World>(std::move(world));
+  };
+}
+
 // The port's environment: the world at the handle's pose, its force clamped to the device's
 // rating (and rate), along the port's normal.
 PortEnvironment world_port(World& world, const PortLine& line, const DeviceProfile& profile,
@@ -258,17 +270,7 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
     if (name == "knee") {
       auto knee = std::make_shared<SceneDescription>(
           load_scene(options.scenes_dir / "knee_procedural.json"));
-      Surface s{name,
-                [knee](const DeviceProfile& profile, double k) {
-                  WorldDescription world = knee->world;
-                  for (MaterialDescription& m : world.materials) {
-                    m.contact.stiffness_n_per_m = k;
-                    m.contact.max_force_n = limit_n(profile);
-                  }
-                  return std::make_unique<World>(std::move(world));
-                },
-                knee_touch(*knee),
-                {}};
+      Surface s{name, scene_at_stiffness(knee), knee_touch(*knee), {}};
       surfaces.push_back(std::move(s));
     } else if (name == "plane" || name == "sphere" || name == "sheet") {
       Surface s{name,
@@ -306,17 +308,7 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
       // bone, every material's spring at the swept stiffness and the device's force limit.
       auto knee =
           std::make_shared<SceneDescription>(load_scene(options.scenes_dir / "knee_fem.json"));
-      Surface s{name,
-                [knee](const DeviceProfile& profile, double k) {
-                  WorldDescription world = knee->world;
-                  for (MaterialDescription& m : world.materials) {
-                    m.contact.stiffness_n_per_m = k;
-                    m.contact.max_force_n = limit_n(profile);
-                  }
-                  return std::make_unique<World>(std::move(world));
-                },
-                {},
-                fem_port_stiffness};
+      Surface s{name, scene_at_stiffness(knee), {}, fem_port_stiffness};
       const DeviceProfile& any = builtin_device_profiles().front();
       std::unique_ptr<World> probe = s.build(any, any.max_stiffness_n_per_m);
       s.line = find_touch(*probe, Vec3(-0.01, 0.09, 0.028), Vec3::UnitY());

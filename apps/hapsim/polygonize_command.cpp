@@ -8,6 +8,7 @@
 #include "json_output.h"
 
 #include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/core/disjoint_sets.h"
 #include "hapsim/geometry/mesh_argument.h"
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/mesh_simplify.h"
@@ -100,20 +101,11 @@ SdfSample box_sdf(const Box3& box, const Vec3& p) {
 // Splits by shared vertices (union-find) and keeps the component of largest signed volume;
 // returns how many components were dropped.
 std::size_t keep_largest_component(TriangleMesh& mesh) {
-  std::vector<std::uint32_t> parent(mesh.vertex_count());
-  for (std::uint32_t i = 0; i < parent.size(); ++i) {
-    parent[i] = i;
-  }
-  const auto find = [&](std::uint32_t v) {
-    while (parent[v] != v) {
-      parent[v] = parent[parent[v]];
-      v = parent[v];
-    }
-    return v;
-  };
+  DisjointSets pieces(mesh.vertex_count());
+  const auto find = [&](std::uint32_t v) { return pieces.find(v); };
   for (const TriangleIndices& t : mesh.triangles) {
-    parent[find(t[1])] = find(t[0]);
-    parent[find(t[2])] = find(t[0]);
+    pieces.unite(t[0], t[1]);
+    pieces.unite(t[0], t[2]);
   }
   std::unordered_map<std::uint32_t, double> volume;
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {

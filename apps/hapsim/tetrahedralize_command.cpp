@@ -13,6 +13,7 @@
 #include "json_output.h"
 
 #include "hapsim/collision/mesh_bvh.h"
+#include "hapsim/core/disjoint_sets.h"
 #include "hapsim/core/error.h"
 #include "hapsim/geometry/mesh_argument.h"
 #include "hapsim/geometry/mesh_validation.h"
@@ -217,20 +218,11 @@ TetMesh read_mesher_output(const std::filesystem::path& prefix) {
 // Keeps the tets connected (through shared nodes) to the piece with the most tets; returns how
 // many were dropped. Pockets between dropped parts can leave tiny islands nothing holds.
 std::size_t keep_largest_piece(TetMesh& mesh) {
-  std::vector<std::uint32_t> parent(mesh.node_count());
-  for (std::uint32_t i = 0; i < parent.size(); ++i) {
-    parent[i] = i;
-  }
-  const auto find = [&](std::uint32_t v) {
-    while (parent[v] != v) {
-      parent[v] = parent[parent[v]];
-      v = parent[v];
-    }
-    return v;
-  };
+  DisjointSets pieces(mesh.node_count());
+  const auto find = [&](std::uint32_t v) { return pieces.find(v); };
   for (const TetIndices& t : mesh.tets) {
     for (int k = 1; k < 4; ++k) {
-      parent[find(t[k])] = find(t[0]);
+      pieces.unite(t[0], t[k]);
     }
   }
   std::map<std::uint32_t, std::size_t> count;
