@@ -210,7 +210,7 @@ double limit_n(const DeviceProfile& profile) {
 }
 
 // A scene's world with every material's spring at the swept stiffness and the device's limit.
-auto scene_at_stiffness(std::shared_ptr<const SceneDescription> scene) {
+auto scene_at_stiffness(const std::shared_ptr<const SceneDescription>& scene) {
   return [scene](const DeviceProfile& profile, double k) {
     WorldDescription world = scene->world;
     for (MaterialDescription& m : world.materials) {

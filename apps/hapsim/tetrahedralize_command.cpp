@@ -24,7 +24,7 @@
 #include <glob.h>
 #include <spawn.h>
 #include <sys/wait.h>
-#include <unistd.h>
+#include <unistd.h>  // environ
 
 #include <algorithm>
 #include <array>
@@ -37,8 +37,6 @@
 #include <map>
 #include <memory>
 #include <sstream>
-
-extern char** environ;
 
 namespace hapsim::app {
 namespace {
@@ -115,6 +113,7 @@ void run_tetgen(const std::string& program, const std::string& switches,
   const std::string sw = "-" + switches + "iQ";
   std::vector<std::string> args{program, sw, poly.string()};
   std::vector<char*> argv;
+  argv.reserve(args.size() + 1);
   for (std::string& a : args) {
     argv.push_back(a.data());
   }

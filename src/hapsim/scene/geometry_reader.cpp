@@ -64,10 +64,10 @@ void GeometryReader::check_sizes(const std::string& ptr, const std::vector<Loade
     if (files.size() > 3) {
       names += " and " + std::to_string(files.size() - 3) + " more";
     }
-    warnings_.push_back(where + std::to_string(files.size()) + " of " +
-                        std::to_string(meshes.size()) + " mesh files in " + folder.string() + " (" +
-                        names + "); " + worst.file.filename().string() + " " +
-                        describe(worst.advice));
+    std::ostringstream w;
+    w << where << files.size() << " of " << meshes.size() << " mesh files in " << folder.string()
+      << " (" << names << "); " << worst.file.filename().string() << " " << describe(worst.advice);
+    warnings_.push_back(w.str());
   }
 }
 

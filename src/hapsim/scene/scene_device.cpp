@@ -209,7 +209,8 @@ DeviceInput glove_input(double time_s, const Vec3& p_world, const Mat3& R,
   in.joint_count = kHandFingers * kGloveAnglesPerFinger;
   for (int f = 0; f < kHandFingers; ++f) {
     for (int k = 0; k < kGloveAnglesPerFinger; ++k) {
-      in.joint_rad[static_cast<std::size_t>(f * kGloveAnglesPerFinger + k)] =
+      in.joint_rad[static_cast<std::size_t>(f) * kGloveAnglesPerFinger +
+                   static_cast<std::size_t>(k)] =
           angles[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)];
     }
   }
@@ -331,7 +332,7 @@ Trajectory make_scene_glove_palpation(const World& world, const GlovePalpationDe
   }
   // 2. Hand orientation: back of the hand towards `from`, spread along the first two targets
   // (the finger nearer the thumb on the hand's +y side).
-  const Vec3 z = from;
+  const Vec3& z = from;
   Vec3 y = z.unitOrthogonal();
   if (goals.size() >= 2) {
     const bool first_is_thumbward = g.fingers[0].finger < g.fingers[1].finger;
