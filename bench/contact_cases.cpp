@@ -16,19 +16,22 @@ namespace hapsim::bench {
 namespace {
 
 struct Landmark {
+  const char* scene;  ///< the scene file's stem it belongs to, or a prefix of it ("knee")
   const char* name;
   Vec3 point_world;  ///< the anatomy, scene frame (x medial, y anterior, z proximal)
   Vec3 from;         ///< where the fingertip comes from
   Vec3 across;       ///< the drag's direction: across the structure
 };
 
-// The knee scenes' landmarks (scenes/knee_fem.json's palpation targets).
+// The knee scenes' landmarks (scenes/knee_fem.json's palpation targets), and the middle of
+// scenes/thin_plate.json's 2 mm plate.
 const Landmark kLandmarks[] = {
-    {"patella", {-0.01, 0.054, 0.028}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}},
-    {"tibial tuberosity", {-0.005, 0.014, -0.047}, {0.0, 1.0, -0.35}, {1.0, 0.0, 0.0}},
-    {"patellar tendon", {-0.0157, 0.0327, -0.0162}, {0.0, 1.0, 0.0}, {1.0, 0.0, 0.0}},
-    {"MCL", {0.0364, -0.0022, -0.0061}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}},
-    {"LCL", {-0.0428, -0.027, -0.0065}, {-1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}},
+    {"knee", "patella", {-0.01, 0.054, 0.028}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}},
+    {"knee", "tibial tuberosity", {-0.005, 0.014, -0.047}, {0.0, 1.0, -0.35}, {1.0, 0.0, 0.0}},
+    {"knee", "patellar tendon", {-0.0157, 0.0327, -0.0162}, {0.0, 1.0, 0.0}, {1.0, 0.0, 0.0}},
+    {"knee", "MCL", {0.0364, -0.0022, -0.0061}, {1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}},
+    {"knee", "LCL", {-0.0428, -0.027, -0.0065}, {-1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}},
+    {"thin_plate", "2 mm plate", {0.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, {1.0, 0.0, 0.0}},
 };
 
 ContactMethod method_named(const std::string& name) {
@@ -152,26 +155,42 @@ std::vector<std::string> contact_landmark_names() {
 std::vector<ContactRow> run_contact_bench(const ContactBenchOptions& options) {
   std::vector<std::filesystem::path> scenes = options.scenes;
   if (scenes.empty()) {
-    scenes = {default_scenes_dir() / "knee.json", default_scenes_dir() / "knee_fem.json"};
+    scenes = {default_scenes_dir() / "knee.json", default_scenes_dir() / "knee_fem.json",
+              default_scenes_dir() / "thin_plate.json"};
   }
   std::vector<std::string> methods = options.methods;
   if (methods.empty()) {
     methods = {"exact", "spheretree", "knee"};
   }
-  std::vector<const Landmark*> landmarks;
-  for (const Landmark& l : kLandmarks) {
-    if (options.landmarks.empty() || std::find(options.landmarks.begin(), options.landmarks.end(),
-                                               l.name) != options.landmarks.end()) {
-      landmarks.push_back(&l);
+  // The landmarks of a scene: those named (all by default) that belong to it.
+  const auto landmarks_of = [&](const std::string& stem) {
+    std::vector<const Landmark*> out;
+    for (const Landmark& l : kLandmarks) {
+      const bool named = options.landmarks.empty() ||
+                         std::find(options.landmarks.begin(), options.landmarks.end(), l.name) !=
+                             options.landmarks.end();
+      if (named && stem.rfind(l.scene, 0) == 0) {
+        out.push_back(&l);
+      }
     }
+    return out;
+  };
+  std::size_t cases = 0;
+  for (const std::filesystem::path& file : scenes) {
+    cases += landmarks_of(file.stem().string()).size();
   }
-  if (landmarks.empty()) {
-    throw Error("--landmarks", "none of the landmarks given is known");
+  if (cases == 0) {
+    throw Error("--landmarks",
+                "no landmark given belongs to the scenes given (the knee's: "
+                "knee*.json; the plate's: thin_plate.json)");
   }
   std::vector<ContactRow> rows;
-  const double total = static_cast<double>(scenes.size() * methods.size() * landmarks.size() *
-                                           options.speeds_mm_per_s.size());
+  const double total = static_cast<double>(cases * methods.size() * options.speeds_mm_per_s.size());
   for (const std::filesystem::path& file : scenes) {
+    const std::vector<const Landmark*> landmarks = landmarks_of(file.stem().string());
+    if (landmarks.empty()) {
+      continue;
+    }
     const SceneDescription scene = load_scene(file);
     for (const std::string& method : methods) {
       for (const Landmark* lm : landmarks) {
@@ -192,17 +211,18 @@ std::vector<ContactRow> run_contact_bench(const ContactBenchOptions& options) {
 std::string format_contact_table(const std::vector<ContactRow>& rows) {
   std::ostringstream out;
   char line[400];
-  std::snprintf(line, sizeof line, "%-9s %-18s %-10s %6s %6s %6s %5s %9s %9s %7s %7s %8s %8s %8s\n",
-                "scene", "landmark", "method", "mm/s", "depth", "steps", "pops", "jump max",
-                "jump p99", "peak", "held", "p50 us", "p99 us", "max us");
+  std::snprintf(line, sizeof line,
+                "%-10s %-18s %-10s %6s %6s %6s %5s %9s %9s %7s %7s %8s %8s %8s\n", "scene",
+                "landmark", "method", "mm/s", "depth", "steps", "pops", "jump max", "jump p99",
+                "peak", "held", "p50 us", "p99 us", "max us");
   out << line;
   for (const ContactRow& r : rows) {
     if (!r.error.empty()) {
-      std::snprintf(line, sizeof line, "%-9s %-18s %-10s %6.0f  %s\n", r.scene.c_str(),
+      std::snprintf(line, sizeof line, "%-10s %-18s %-10s %6.0f  %s\n", r.scene.c_str(),
                     r.landmark.c_str(), r.method.c_str(), r.speed_mm_per_s, r.error.c_str());
     } else {
       std::snprintf(line, sizeof line,
-                    "%-9s %-18s %-10s %6.0f %3.1f mm %6zu %5zu %7.2f N %7.2f N %5.2f N %5.2f N "
+                    "%-10s %-18s %-10s %6.0f %3.1f mm %6zu %5zu %7.2f N %7.2f N %5.2f N %5.2f N "
                     "%8.2f %8.2f %8.1f\n",
                     r.scene.c_str(), r.landmark.c_str(), r.method.c_str(), r.speed_mm_per_s,
                     r.depth_mm, r.steps, r.pop_throughs, r.max_force_jump_n, r.p99_force_jump_n,

@@ -1,5 +1,6 @@
 // `hapsim bench contact` (issue 30): contact that holds at hand speed. A fingertip pressed into
-// the skin over each knee landmark until it pushes back firmly (4 N) (patella, tibial tuberosity,
+// the skin over each knee landmark (and the middle of a 2 mm plate) until it pushes back firmly
+// (4 N) (patella, tibial tuberosity,
 // patellar tendon, MCL, LCL: thin or curved parts over bone, ligament and tendon) is dragged 30 mm
 // to each side across it and back, at 10 to 500 mm/s, then held over it; per scene, landmark,
 // contact method and speed: pop-throughs (a proxy lost with the tool inside its body counts as
@@ -19,12 +20,13 @@
 namespace hapsim::bench {
 
 struct ContactBenchOptions {
-  /// Scene files (default: the paper's knee and the FEM knee in the checkout's scenes/).
+  /// Scene files (default: the paper's knee, the FEM knee and the 2 mm plate in the checkout's
+  /// scenes/); each runs the landmarks that belong to it.
   std::vector<std::filesystem::path> scenes;
   /// exact, spheretree, knee (default: all three; a method a scene cannot use is reported).
   std::vector<std::string> methods;
   std::vector<double> speeds_mm_per_s{10.0, 50.0, 200.0, 500.0};
-  /// Landmark names (default: all five).
+  /// Landmark names (default: all: the knee's five, the plate's one).
   std::vector<std::string> landmarks;
   /// The fingertip is pressed in until the force reaches this (a firm palpation), or
   /// `max_depth_mm` past the first touch of the skin, before the drag.

@@ -753,7 +753,7 @@ void add_bench_command(CLI::App& app) {
       "contact method: pop-throughs, force continuity and the step's cost");
   contact
       ->add_option("--scenes", contact_args->scenes,
-                   "Scene files (default: scenes/knee.json and scenes/knee_fem.json)")
+                   "Scene files (default: scenes/knee.json, knee_fem.json and thin_plate.json)")
       ->delimiter(',');
   contact->add_option("--methods", contact_args->methods, "exact, spheretree, knee (default: all)")
       ->delimiter(',')
