@@ -243,7 +243,8 @@ nlohmann::json contact_rows_to_json(const std::vector<ContactRow>& rows) {
     if (!r.error.empty()) {
       j["error"] = r.error;
     } else {
-      j.update({{"steps", r.steps},
+      j.update({{"depth_mm", r.depth_mm},
+                {"steps", r.steps},
                 {"pop_throughs", r.pop_throughs},
                 {"max_force_jump_n", r.max_force_jump_n},
                 {"p99_force_jump_n", r.p99_force_jump_n},

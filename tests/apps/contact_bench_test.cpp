@@ -1,0 +1,70 @@
+// `hapsim bench contact` (bench/contact_cases.h): the binary on the 2 mm plate writes JSON with
+// every key and holds the plate with the device pushed through it; in-process, the paper knee's
+// patella dragged at hand speed keeps the bone (0 pop-throughs) and the landmark filter refuses
+// a name no scene has. Physics and counts only: never a time.
+#ifdef HAPSIM_HAVE_BENCH_CASES
+
+#include "bench/contact_cases.h"
+#include "bench/step_cases.h"
+#include "hapsim/core/error.h"
+
+#include "hapsim_process.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace hapsim::bench {
+namespace {
+
+TEST(ContactBench, ThePlatePushedThroughAtHandSpeedHoldsAndTheJsonHasEveryKey) {
+  const std::filesystem::path json_path = test::temp_path("contact_bench.json");
+  const test::RunResult r = test::run_hapsim(
+      "bench contact --scenes " + (default_scenes_dir() / "thin_plate.json").string() +
+      " --methods exact --speeds 50,500 --press 40 --json " + json_path.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j.at("rows").size(), 2u) << j.dump(2);
+  for (const auto& row : j.at("rows")) {
+    for (const char* key : {"scene", "landmark", "method", "speed_mm_per_s", "depth_mm", "steps",
+                            "pop_throughs", "max_force_jump_n", "p99_force_jump_n", "peak_force_n",
+                            "held_force_n", "step_p50_us", "step_p99_us", "step_max_us"}) {
+      EXPECT_TRUE(row.contains(key)) << key;
+    }
+    EXPECT_EQ(row.at("pop_throughs").get<int>(), 0);
+    // Pushed 8 mm into 5000 N/m (past the plate's 2 mm), held there: the wall's 40 N.
+    EXPECT_GT(row.at("depth_mm").get<double>(), 2.0);
+    EXPECT_GT(row.at("held_force_n").get<double>(), 38.0);
+  }
+}
+
+TEST(ContactBench, ThePaperKneesPatellaDraggedAtHandSpeedKeepsTheBone) {
+  ContactBenchOptions options;
+  options.scenes = {default_scenes_dir() / "knee.json"};
+  options.methods = {"exact"};
+  options.landmarks = {"patella"};
+  options.speeds_mm_per_s = {50.0, 500.0};
+  const std::vector<ContactRow> rows = run_contact_bench(options);
+  ASSERT_EQ(rows.size(), 2u);
+  for (const ContactRow& row : rows) {
+    EXPECT_TRUE(row.error.empty()) << row.error;
+    EXPECT_EQ(row.pop_throughs, 0u) << row.speed_mm_per_s;
+    EXPECT_NEAR(row.held_force_n, 4.0, 0.5) << row.speed_mm_per_s;
+  }
+}
+
+TEST(ContactBench, ALandmarkNoSceneHasIsRefused) {
+  ContactBenchOptions options;
+  options.scenes = {default_scenes_dir() / "thin_plate.json"};
+  options.landmarks = {"patella"};
+  EXPECT_THROW((void)run_contact_bench(options), Error);
+}
+
+}  // namespace
+}  // namespace hapsim::bench
+
+#endif  // HAPSIM_HAVE_BENCH_CASES
