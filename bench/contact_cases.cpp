@@ -162,6 +162,12 @@ std::vector<ContactRow> run_contact_bench(const ContactBenchOptions& options) {
   if (methods.empty()) {
     methods = {"exact", "spheretree", "knee"};
   }
+  for (const std::string& name : options.landmarks) {
+    if (std::none_of(std::begin(kLandmarks), std::end(kLandmarks),
+                     [&](const Landmark& l) { return name == l.name; })) {
+      throw Error("--landmarks", "unknown landmark '" + name + "'");
+    }
+  }
   // The landmarks of a scene: those named (all by default) that belong to it.
   const auto landmarks_of = [&](const std::string& stem) {
     std::vector<const Landmark*> out;
@@ -218,8 +224,10 @@ std::string format_contact_table(const std::vector<ContactRow>& rows) {
   out << line;
   for (const ContactRow& r : rows) {
     if (!r.error.empty()) {
-      std::snprintf(line, sizeof line, "%-10s %-18s %-10s %6.0f  %s\n", r.scene.c_str(),
-                    r.landmark.c_str(), r.method.c_str(), r.speed_mm_per_s, r.error.c_str());
+      std::snprintf(line, sizeof line, "%-10s %-18s %-10s %6.0f  ", r.scene.c_str(),
+                    r.landmark.c_str(), r.method.c_str(), r.speed_mm_per_s);
+      out << line << r.error << '\n';
+      continue;
     } else {
       std::snprintf(line, sizeof line,
                     "%-10s %-18s %-10s %6.0f %3.1f mm %6zu %5zu %7.2f N %7.2f N %5.2f N %5.2f N "

@@ -199,6 +199,9 @@ double fem_port_stiffness(World& world, const PortLine& line, double k) {
     input.time_s = i * 1e-3;
     (void)world.step(input, 1e-3);
   }
+  if (world.state().fem_contacts.empty()) {
+    return k;
+  }
   const LocalContactModel& m = world.state().fem_contacts[0].model;
   const double k_n = m.normal_world.dot(m.stiffness_n_per_m * m.normal_world);
   return m.valid && std::isfinite(k_n) && k_n > 0.0 ? std::min(k_n, k) : k;

@@ -119,18 +119,32 @@ void run_tetgen(const std::string& program, const std::string& switches,
   }
   argv.push_back(nullptr);
   posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  if (posix_spawn_file_actions_init(&actions) != 0) {
+    throw CommandError("cannot prepare to run " + program + " (out of memory)");
+  }
+  const int open_rc = posix_spawn_file_actions_addopen(&actions, 1, log.c_str(),
+                                                       O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const int dup_rc = posix_spawn_file_actions_adddup2(&actions, 1, 2);
   pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+  const int rc = open_rc != 0 || dup_rc != 0
+                     ? (open_rc != 0 ? open_rc : dup_rc)
+                     : posix_spawnp(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
+  if (open_rc != 0 || dup_rc != 0) {
+    throw CommandError("cannot send " + program + "'s output to " + log.string() + " (" +
+                       std::strerror(rc) + ")");
+  }
   if (rc != 0) {
     throw CommandError("--tetgen " + program + ": cannot run it (" + std::strerror(rc) +
-                       "); on Debian: apt-get install tetgen");
+                       (rc == ENOENT ? "); on Debian: apt-get install tetgen" : ")"));
   }
   int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  pid_t waited = 0;
+  while ((waited = ::waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
+  }
+  if (waited < 0) {
+    throw CommandError("lost track of " + program + " (waitpid: " + std::strerror(errno) +
+                       "): its output cannot be trusted");
   }
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     std::ifstream in(log);
@@ -284,8 +298,8 @@ void run_tetrahedralize(const TetrahedralizeOptions& opt) {
   if (opt.switches.find_first_not_of("0123456789.pqaAYTVOSe/") != std::string::npos ||
       opt.switches.find('p') == std::string::npos) {
     throw CommandError("--switches " + opt.switches +
-                       ": expected TetGen switches with p (a PLC) and only p q a A Y T O S / and "
-                       "numbers; hapsim adds i (the points) and Q");
+                       ": expected TetGen switches with p (a PLC) and only p q a A Y T V O S e / "
+                       "and numbers; hapsim adds i (the points) and Q");
   }
   JsonOutput json(opt.json_path);
   const TriangleMesh outer = load_closed(opt.outer, "--outer");
@@ -512,7 +526,8 @@ void add_tetrahedralize_command(CLI::App& app) {
   cmd->add_option("--points", opt->points,
                   "A closed mesh whose vertices become nodes (repeatable; * patterns expand)");
   cmd->add_option("--drop", opt->drop,
-                  "Remove the tets whose centre is inside this closed mesh (repeatable)");
+                  "Remove the tets whose centre is inside this closed mesh (repeatable; * "
+                  "patterns expand)");
   cmd->add_option("--region", opt->regions,
                   "ID=FILE: tets whose centre is inside FILE get region ID; the first match wins "
                   "(repeatable; * patterns expand)");
@@ -524,7 +539,7 @@ void add_tetrahedralize_command(CLI::App& app) {
   cmd->add_option("--min-spacing", opt->min_spacing_fraction,
                   "Leave out a --points vertex this near one kept, as a fraction of the outer "
                   "surface's bounding diagonal")
-      ->check(CLI::Range(0.0, 0.1));
+      ->check(CLI::Range(1e-6, 0.1));
   cmd->add_option("--scale", opt->scale,
                   "File units to metres, for the volumes printed (0.001 for millimetres); the "
                   "output stays in file units")

@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -39,6 +40,11 @@ std::string bytes(const fs::path& p) {
 TEST(FemKnee, TheMeshingScriptReproducesTheCommittedMeshes) {
   if (std::system("command -v tetgen >/dev/null 2>&1") != 0) {
     GTEST_SKIP() << "tetgen is not installed (apt-get install tetgen; scripts/setup.sh does)";
+  }
+  // The committed bytes are TetGen 1.5.0's (Debian 12's 1.5.0-5): another version may mesh
+  // differently, which is not a defect of the script.
+  if (std::system("dpkg-query -W -f='${Version}' tetgen 2>/dev/null | grep -q '^1[.]5[.]0'") != 0) {
+    GTEST_SKIP() << "the committed meshes are TetGen 1.5.0's; this tetgen is another version";
   }
   const fs::path out = temp_path("knee_fem_derived");
   fs::remove_all(out);
@@ -134,7 +140,8 @@ TEST(FemKnee, APressTooHardOnThePatellaBreachesTheTissuesAndTheBonesLimit) {
   const nlohmann::json a = assess(rec, "knee_fem_press_hard");
   std::map<std::string, double> worst_over_n;
   for (const auto& b : a.at("breaches")) {
-    worst_over_n[b.at("tissue").get<std::string>()] = b.at("excess_n").get<double>();
+    double& worst = worst_over_n[b.at("tissue").get<std::string>()];
+    worst = std::max(worst, b.at("excess_n").get<double>());
   }
   ASSERT_TRUE(worst_over_n.count("bone")) << a.dump(2);
   ASSERT_TRUE(worst_over_n.count("soft_tissue")) << a.dump(2);

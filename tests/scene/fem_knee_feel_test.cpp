@@ -58,6 +58,9 @@ TEST(FemKneeFeel, TheQuadricepsModulusIsInThePublishedInVivoRange) {
   const double e_pa = 3.0 * (1.0 - nu * nu) * (num / den) / (4.0 * std::sqrt(radius_m));
   EXPECT_GE(e_pa, 220.0);
   EXPECT_LE(e_pa, 58.4e3 * 1.093);
+  // And a regression band around what it measured when recorded (41.8 kPa, 2026-11-27): the
+  // published range alone is 290x wide.
+  EXPECT_NEAR(e_pa, 41.8e3, 0.1 * 41.8e3);
   // Stiffening: the secant stiffness from 6 to 8 mm above that from 2 to 4 mm.
   const auto force_at = [&](double d) {
     for (const auto& [dd, f] : depth_force) {

@@ -53,6 +53,7 @@ double GodObject::scan(std::span<const ProxySurface> surfaces, double margin_m) 
   contact_count_ = 0;
   nearest_clearance_m_ = margin_m;
   nearest_normal_world_ = Vec3::Zero();
+  nearest_surface_ = -1;
   double least = margin_m;
   const int n = static_cast<int>(std::min<std::size_t>(surfaces.size(), kMaxSurfaces));
   for (int i = 0; i < n; ++i) {
@@ -63,6 +64,7 @@ double GodObject::scan(std::span<const ProxySurface> surfaces, double margin_m) 
     if (pr.clearance_m < nearest_clearance_m_) {
       nearest_clearance_m_ = pr.clearance_m;
       nearest_normal_world_ = pr.normal_world;
+      nearest_surface_ = i;
     }
     least = std::min(least, pr.clearance_m);
     if (!(pr.clearance_m < params_.contact_tolerance_m)) {
@@ -191,10 +193,15 @@ void GodObject::settle_onto_nearest(const Vec3& device_p_world,
   for (int pass = 0; pass < 3 && contact_count_ == 0; ++pass) {
     const double clearance = nearest_clearance_m_;
     const Vec3 n = nearest_normal_world_;
+    const int s = nearest_surface_;
     // Only just off a surface (within a contact step), and only when the device is beyond it:
-    // a proxy in free space with the device beside it is where it should be.
-    if (!(clearance < params_.max_substep_m) || n.isZero() ||
-        (proxy_world_ - device_p_world).dot(n) <= clearance) {
+    // behind its tangent plane and inside that body (near a convex edge the plane alone would
+    // snap a proxy onto a body the device is not in). A proxy in free space with the device
+    // beside it is where it should be.
+    if (!(clearance < params_.max_substep_m) || n.isZero() || s < 0 ||
+        (proxy_world_ - device_p_world).dot(n) <= clearance ||
+        !(probe(surfaces[static_cast<std::size_t>(s)], s, device_p_world, params_.max_substep_m)
+              .clearance_m < 0.0)) {
       return;
     }
     proxy_world_ -= n * clearance;
@@ -253,8 +260,11 @@ void GodObject::apply_friction(const Vec3& previous_proxy_world, const Vec3& dev
     // whatever lies between (it crossed the patellar tendon's edge and left the proxy 2 mm off
     // every surface, the device 15 mm deep).
     const Vec3 goal_t = tangential - tangential * (material->dynamic_friction * depth / t_len);
-    if (goal_t.squaredNorm() < moved_t.squaredNorm()) {
-      proxy_world_ += goal_t - moved_t;
+    const double moved_len = moved_t.norm();
+    const double goal_len = goal_t.norm();
+    if (goal_len < moved_len) {
+      // Back along the way it came (the chord of the traced slide), not to a point off it.
+      proxy_world_ -= moved_t * (1.0 - goal_len / moved_len);
     }
   }
   resolve_penetration(surfaces, margin_m);

@@ -104,6 +104,7 @@ class GodObject {
   /// The nearest surface at the last scan (also when farther than the contact tolerance).
   double nearest_clearance_m_ = 0.0;
   Vec3 nearest_normal_world_ = Vec3::Zero();
+  int nearest_surface_ = -1;
   int iterations_used_ = 0;
   /// Side of each two-sided surface the proxy is on (+1 front, −1 back, 0 unknown yet).
   std::array<std::int8_t, kMaxSurfaces> side_{};

@@ -1089,12 +1089,23 @@ void write_tetgen(const TetMesh& mesh, const std::filesystem::path& path_without
                   mesh.region(t));
     ele += line;
   }
-  std::filesystem::path node_path = path_without_extension;
-  node_path += ".node";
-  std::filesystem::path ele_path = path_without_extension;
-  ele_path += ".ele";
-  write(node_path, node);
-  write(ele_path, ele);
+  // Both to temporary names first, then renamed: a failed write never leaves a new .node
+  // beside an old .ele (a pair that could load as a wrong mesh).
+  const auto with = [&](const char* ext) {
+    std::filesystem::path p = path_without_extension;
+    p += ext;
+    return p;
+  };
+  write(with(".node.tmp"), node);
+  write(with(".ele.tmp"), ele);
+  std::error_code ec;
+  std::filesystem::rename(with(".node.tmp"), with(".node"), ec);
+  if (!ec) {
+    std::filesystem::rename(with(".ele.tmp"), with(".ele"), ec);
+  }
+  if (ec) {
+    throw Error(with(".node").string(), "cannot move the written file into place: " + ec.message());
+  }
 }
 
 TetMesh read_vtk_unstructured(const std::filesystem::path& path) {

@@ -84,7 +84,9 @@ PalpationAim aim(const World& world, const PalpationTargetDescription& target, E
   }
   const double norm = target.from_world.norm();
   if (!(norm > 0.0) || !target.from_world.allFinite()) {
-    throw Error("palpation target '" + target.segment + "'", "needs a non-zero 'from' direction");
+    throw Error(
+        "palpation target '" + (target.segment.empty() ? target.body : target.segment) + "'",
+        "needs a non-zero 'from' direction");
   }
   const Vec3 from = target.from_world / norm;
   // Start outside everything of the body, then trace towards the centroid: each step moves by
@@ -117,7 +119,8 @@ PalpationAim aim(const World& world, const PalpationTargetDescription& target, E
     }
   }
   throw Error(where, "no surface of body '" + bd.name + "' lies between the direction " +
-                         "given and the segment's centroid");
+                         "given and " +
+                         (target.toward_world ? "the point toward_m" : "the segment's centroid"));
 }
 
 }  // namespace
