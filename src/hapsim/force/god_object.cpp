@@ -200,7 +200,8 @@ void GodObject::settle_onto_nearest(const Vec3& device_p_world,
     // beside it is where it should be.
     if (!(clearance < params_.max_substep_m) || n.isZero() || s < 0 ||
         (proxy_world_ - device_p_world).dot(n) <= clearance ||
-        !(probe(surfaces[static_cast<std::size_t>(s)], s, device_p_world, params_.max_substep_m)
+        !(probe(surfaces[static_cast<std::size_t>(s)], s, device_p_world,
+                (device_p_world - proxy_world_).norm() + params_.max_substep_m)
               .clearance_m < 0.0)) {
       return;
     }
