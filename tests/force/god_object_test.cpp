@@ -130,6 +130,34 @@ TEST(GodObject, FrictionNeverMovesTheProxyFartherThanTheSlideTraced) {
   EXPECT_TRUE(proxy.in_contact());
 }
 
+// A curved open surface (two-sided: a dome of sheet) pushed far through from outside, the device
+// dragged over it with friction: friction lifts the proxy off the curve and the settle step puts
+// it back, but must never probe a two-sided surface at the device, which would teach it the
+// device's side (8 mm beyond, inside) and push the proxy through to there.
+TEST(GodObject, ACurvedSheetPushedThroughKeepsTheProxyOnItsSideWhileDragged) {
+  test::SolidSphere dome(0.025);
+  ContactMaterial m = wall_material(1000.0, 0.0);
+  m.static_friction = 0.3;
+  m.dynamic_friction = 0.2;
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&dome, Iso3::Identity(), &m, true, &hint}}};
+  GodObjectParams params;
+  params.radius_m = 0.005;
+  GodObject proxy(params);
+  const double r = 0.025 - 0.008;  // the device's centre 8 mm beyond the sheet
+  proxy.reset(Vec3(0.0, 0.0, 0.05));
+  for (int i = 1; i <= 200; ++i) {
+    proxy.update(Vec3(0.0, 0.0, 0.05 + (r - 0.05) * i / 200.0), surfaces);
+  }
+  ASSERT_TRUE(proxy.in_contact());
+  const int cycles = static_cast<int>(1.2 * r / 0.05 / 1e-3);  // over 1.2 rad at 50 mm/s
+  for (int i = 1; i <= cycles; ++i) {
+    const double a = 1.2 * i / cycles;
+    proxy.update(Vec3(r * std::sin(a), 0.0, r * std::cos(a)), surfaces);
+    ASSERT_GE(proxy.proxy_world().norm(), 0.025 + params.radius_m - 2e-5) << "cycle " << i;
+  }
+}
+
 // A fingertip pressed 2.5 mm into a convex bone (the patella's curvature: 25 mm) and dragged
 // over it with friction, at 50 to 500 mm/s: friction moves the proxy in the tangent plane, which
 // lifts it off a convex surface; before the proxy was settled back, it ended 10-40 um off the

@@ -198,7 +198,10 @@ void GodObject::settle_onto_nearest(const Vec3& device_p_world,
     // behind its tangent plane and inside that body (near a convex edge the plane alone would
     // snap a proxy onto a body the device is not in). A proxy in free space with the device
     // beside it is where it should be.
+    // An open (two-sided) surface has no inside, and probing it at the device would teach it
+    // the device's side: never for those.
     if (!(clearance < params_.max_substep_m) || n.isZero() || s < 0 ||
+        surfaces[static_cast<std::size_t>(s)].two_sided ||
         (proxy_world_ - device_p_world).dot(n) <= clearance ||
         !(probe(surfaces[static_cast<std::size_t>(s)], s, device_p_world,
                 (device_p_world - proxy_world_).norm() + params_.max_substep_m)
