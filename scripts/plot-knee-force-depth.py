@@ -53,11 +53,15 @@ def main(csv_path, png_path):
         ax.grid(alpha=0.3)
     for ax in axes[len(landmarks):]:
         ax.axis("off")
-    axes[0].set_ylabel("force along the press (N)")
-    axes[0].legend(loc="upper left", fontsize=8)
+    for row in range(nrows):
+        axes[row * cols].set_ylabel("force along the press (N)")
+    # One legend for all, under the title: inside a panel it covers a curve.
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", ncol=len(labels), fontsize=10,
+               bbox_to_anchor=(0.5, 0.955), frameon=False)
     fig.suptitle("Pressing a 7 mm fingertip into the knee at 5 mm/s: the paper's model and the "
                  "FEM knee against the published in-vivo range", fontsize=13)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.92))
     fig.savefig(png_path)
 
 

@@ -82,11 +82,11 @@ PalpationAim aim(const World& world, const PalpationTargetDescription& target, E
     centroid_body /= static_cast<double>(mesh.vertex_count());
     centroid_world = bd.X_world_body * centroid_body;
   }
+  const std::string where =
+      "palpation target '" + (target.segment.empty() ? target.body : target.segment) + "'";
   const double norm = target.from_world.norm();
   if (!(norm > 0.0) || !target.from_world.allFinite()) {
-    throw Error(
-        "palpation target '" + (target.segment.empty() ? target.body : target.segment) + "'",
-        "needs a non-zero 'from' direction");
+    throw Error(where, "needs a non-zero 'from' direction");
   }
   const Vec3 from = target.from_world / norm;
   // Start outside everything of the body, then trace towards the centroid: each step moves by
@@ -98,8 +98,6 @@ PalpationAim aim(const World& world, const PalpationTargetDescription& target, E
   const double reach = 2.0 * all.diagonal().norm() + 0.1;
   Vec3 p = centroid_world + from * reach;
   const Iso3 X_body_world = bd.X_world_body.inverse();
-  const std::string where =
-      "palpation target '" + (target.segment.empty() ? target.body : target.segment) + "'";
   for (int iteration = 0; iteration < 10000; ++iteration) {
     double nearest = kInf;
     std::size_t nearest_segment = segment;
