@@ -23,7 +23,7 @@ struct Landmark {
   Vec3 across;       ///< the drag's direction: across the structure
 };
 
-// The knee scenes' landmarks (scenes/knee_fem.json's palpation targets), and the middle of
+// The knee scenes' landmarks (scenes/knee.json's palpation targets), and the middle of
 // scenes/thin_plate.json's 2 mm plate.
 const Landmark kLandmarks[] = {
     {"knee", "patella", {-0.01, 0.054, 0.028}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}},
@@ -155,7 +155,7 @@ std::vector<std::string> contact_landmark_names() {
 std::vector<ContactRow> run_contact_bench(const ContactBenchOptions& options) {
   std::vector<std::filesystem::path> scenes = options.scenes;
   if (scenes.empty()) {
-    scenes = {default_scenes_dir() / "knee.json", default_scenes_dir() / "knee_fem.json",
+    scenes = {default_scenes_dir() / "knee_paper.json", default_scenes_dir() / "knee.json",
               default_scenes_dir() / "thin_plate.json"};
   }
   std::vector<std::string> methods = options.methods;

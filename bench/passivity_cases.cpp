@@ -307,10 +307,9 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
                           Vec3::UnitZ());
       surfaces.push_back(std::move(s));
     } else if (name == "fem_knee") {
-      // The FEM knee (scenes/knee_fem.json) over the patella: 5 mm of FEM tissue on a rigid
+      // The FEM knee (scenes/knee.json) over the patella: 5 mm of FEM tissue on a rigid
       // bone, every material's spring at the swept stiffness and the device's force limit.
-      auto knee =
-          std::make_shared<SceneDescription>(load_scene(options.scenes_dir / "knee_fem.json"));
+      auto knee = std::make_shared<SceneDescription>(load_scene(options.scenes_dir / "knee.json"));
       Surface s{name, scene_at_stiffness(knee), {}, fem_port_stiffness};
       const DeviceProfile& any = builtin_device_profiles().front();
       std::unique_ptr<World> probe = s.build(any, any.max_stiffness_n_per_m);

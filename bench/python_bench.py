@@ -81,7 +81,7 @@ def closest_throughput(hapsim_bin, mesh_spec, n, repeats):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--hapsim", default=str(ROOT / "build" / "release" / "apps" / "hapsim"))
-    parser.add_argument("--scene", default=str(ROOT / "scenes" / "knee.json"))
+    parser.add_argument("--scene", default=str(ROOT / "scenes" / "knee_paper.json"))
     parser.add_argument("--seconds", type=float, default=5.0)
     parser.add_argument("--repeats", type=int, default=3)
     args = parser.parse_args()

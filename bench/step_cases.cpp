@@ -32,6 +32,8 @@ std::vector<StepBenchCase> default_step_cases(
     const std::filesystem::path& scenes_dir, const std::optional<std::filesystem::path>& data_dir) {
   std::vector<StepBenchCase> cases;
   cases.push_back({"knee-1-finger", scenes_dir / "knee_procedural.json", std::nullopt});
+  // The FEM knee (the default scene) under five fingertips: five contacts on one FEM body.
+  cases.push_back({"fem-knee-5-fingers", scenes_dir / "knee_fem_five_fingers.json", std::nullopt});
   if (data_dir && std::filesystem::is_directory(*data_dir / "knee_vhf_left")) {
     cases.push_back({"vhf-5-fingers", scenes_dir / "knee_vhf.json", *data_dir / "knee_vhf_left"});
   }

@@ -30,8 +30,8 @@ struct StepBenchCase {
 /// The checkout's scenes/ folder (compiled in).
 [[nodiscard]] std::filesystem::path default_scenes_dir();
 
-/// The shipped cases: the procedural knee with one fingertip, and (when the data exists) the real
-/// VHF knee with five fingertips.
+/// The shipped cases: the procedural knee with one fingertip, the FEM knee with five, and (when
+/// the data exists) the real VHF knee with five fingertips.
 [[nodiscard]] std::vector<StepBenchCase> default_step_cases(
     const std::filesystem::path& scenes_dir, const std::optional<std::filesystem::path>& data_dir);
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Derives scenes/knee_fem/ (the FEM knee, scenes/knee_fem.json): the soft tissue between the skin
+# Derives scenes/knee_fem/ (the FEM knee, scenes/knee.json): the soft tissue between the skin
 # and the bones of the default knee (scenes/knee_vhf_small, itself derived from the Visible Human
 # Female, CC BY 4.0: see its ATTRIBUTION.md) as linear tetrahedra at two resolutions, meshed by
 # TetGen run as a program (`hapsim tetrahedralize`; apt-get install tetgen). Regions by the

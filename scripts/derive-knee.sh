@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Derives scenes/knee_vhf_small/ (the default knee, scenes/knee.json) from the Visible Human Female
+# Derives scenes/knee_vhf_small/ (the default knee, scenes/knee_paper.json) from the Visible Human Female
 # left knee in ../shared/data/knee_vhf_left/stl (CC BY 4.0, Andreassen et al., Scientific Data 10
 # (2023)): the parts a surgeon palpates, cut to the knee region, simplified to the knee paper's
 # budget (~13.5k vertices over all parts), a modelled femur and patellar tendon (CSG, the data has

@@ -17,7 +17,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "build", "relea
 import hapsim  # noqa: E402
 
 # The knee's landmarks in the scene frame (x medial, y anterior, z proximal; joint line near z = 0):
-# where the press aims and where it comes from, as scenes/knee_fem.json's palpation targets.
+# where the press aims and where it comes from, as scenes/knee.json's palpation targets.
 LANDMARKS = {
     "LCL": ([-0.0428, -0.0270, -0.0065], [-1.0, 0.0, 0.0]),
     "lateral joint line": ([-0.037, 0.001, -0.003], [-0.7, 0.7, 0.0]),

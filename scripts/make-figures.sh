@@ -40,9 +40,9 @@ rm -f "$OUT/000-fig3-gaussian-profile.csv"
 # Cut short mid-carry, the run reports the pick-and-place unfinished (exit status 1): expected.
 run "$S/teleop.json" --duration 6.5 --snapshot "$OUT/000-teleop-scene.png" || [ $? -eq 1 ]
 
-# --- Paper 001 (knee palpation) on the real knee, the glove's index pressing the vastus medialis
-# (scenes/knee_hand.json: the finger reaches the skin at ~1.15 s, holds pressed 1.4-2.0 s) ---
-KNEE_HAND="$S/knee_hand.json"
+# --- Paper 001 (knee palpation) on the paper's model of the real knee, the glove's index pressing the vastus medialis
+# (scenes/knee_hand_paper.json: the finger reaches the skin at ~1.15 s, holds pressed 1.4-2.0 s) ---
+KNEE_HAND="$S/knee_hand_paper.json"
 MUSCLE=Muscle_VastusMedialis
 CLOSE=0.26,0.14,0.14,0.025,0.04,0.095,30
 # Fig. 3: the muscle's vertex groups coloured, their spheres of influence, and the three vertices

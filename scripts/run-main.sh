@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The main job: install what is missing, build, then run the knee palpation scene on the simulated
-# device (scenes/knee.json: the real Visible Human knee at ~13.5k vertices, one fingertip, a scripted
+# device (scenes/knee.json: the FEM knee, the real Visible Human knee's tissue as ~26k tetrahedra over rigid bones, one fingertip, a scripted
 # palpation of the landmarks a surgeon feels) and report what
 # happened, with a picture of the final state. Extra arguments go to `hapsim run` (e.g. --method
 # knee, --realtime, --record FILE, --snapshot FILE.png --snapshot-every 500).

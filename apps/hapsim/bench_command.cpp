@@ -172,7 +172,7 @@ void run_step(const StepArgs& args) {
                             : std::optional<std::filesystem::path>(args.data_dir);
   if (args.scenes.empty()) {
     options.cases = bench::default_step_cases(bench::default_scenes_dir(), data_dir);
-    if (options.cases.size() < 2) {
+    if (options.cases.size() < 3) {
       std::cerr << "hapsim bench step: no knee_vhf_left in the data folder: the 5-finger VHF "
                    "case is skipped (give --data)\n";
     }
@@ -401,7 +401,7 @@ void run_soak(const SoakArgs& args) {
   JsonOutput json_out(args.json_path);
   std::vector<std::string> scenes = args.scenes;
   if (scenes.empty()) {
-    scenes = {(bench::default_scenes_dir() / "knee.json").string(),
+    scenes = {(bench::default_scenes_dir() / "knee_paper.json").string(),
               (bench::default_scenes_dir() / "teleop.json").string()};
   }
   nlohmann::json rows = nlohmann::json::array();
@@ -686,10 +686,10 @@ void add_bench_command(CLI::App& app) {
   collision->callback([args] { run_collision(*args); });
 
   auto step_args = std::make_shared<StepArgs>();
-  CLI::App* step = bench->add_subcommand(
-      "step",
-      "Haptic step cost on the knee scenes (one fingertip; five on the real knee) per contact "
-      "method, beside the exact-query baseline");
+  CLI::App* step = bench->add_subcommand("step",
+                                         "Haptic step cost on the knee scenes (one fingertip; five "
+                                         "on the FEM knee and the real knee) per contact "
+                                         "method, beside the exact-query baseline");
   step->add_option("--methods", step_args->methods, "exact, spheretree, knee (default: all)")
       ->delimiter(',')
       ->check(CLI::IsMember({"exact", "spheretree", "knee"}));
@@ -753,7 +753,7 @@ void add_bench_command(CLI::App& app) {
       "contact method: pop-throughs, force continuity and the step's cost");
   contact
       ->add_option("--scenes", contact_args->scenes,
-                   "Scene files (default: scenes/knee.json, knee_fem.json and thin_plate.json)")
+                   "Scene files (default: scenes/knee_paper.json, knee.json and thin_plate.json)")
       ->delimiter(',');
   contact->add_option("--methods", contact_args->methods, "exact, spheretree, knee (default: all)")
       ->delimiter(',')
@@ -819,7 +819,7 @@ void add_bench_command(CLI::App& app) {
   soak->add_option("--minutes", soak_args->minutes, "Simulated minutes per scene (default 60)")
       ->check(CLI::Range(0.1, 1440.0));
   soak->add_option("--scenes", soak_args->scenes,
-                   "Scene files (default: scenes/knee.json and scenes/teleop.json)")
+                   "Scene files (default: scenes/knee_paper.json and scenes/teleop.json)")
       ->delimiter(',');
   soak->add_option("--json", soak_args->json_path, "Write the results as JSON to FILE");
   soak->callback([soak_args] { run_soak(*soak_args); });

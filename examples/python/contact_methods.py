@@ -3,7 +3,7 @@ its inputs replayed into worlds built with the exact BVH, sphere trees and the k
 groups; the plot shows each method's force over time and its difference from the exact one.
 
     PYTHONPATH=build/release/python python3 examples/python/contact_methods.py \
-        [--scene scenes/knee.json] [--out docs/images] [--quick]
+        [--scene scenes/knee_paper.json] [--out docs/images] [--quick]
 """
 
 import argparse
@@ -41,7 +41,7 @@ def replay_forces(scene, recording, method):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scene", default=str(ROOT / "scenes" / "knee.json"))
+    parser.add_argument("--scene", default=str(ROOT / "scenes" / "knee_paper.json"))
     parser.add_argument("--out", default=str(ROOT / "docs" / "images"))
     parser.add_argument("--quick", action="store_true", help="the first 1.5 s only (tests)")
     args = parser.parse_args()

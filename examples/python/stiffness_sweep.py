@@ -5,7 +5,7 @@ are kept; the plot draws force against depth for each tissue the probe pressed, 
 line k·depth of the stiffness the world renders it with (no stiffer than the device's rating).
 
     PYTHONPATH=build/release/python python3 examples/python/stiffness_sweep.py \
-        [--scene scenes/knee.json] [--out docs/images] [--quick]
+        [--scene scenes/knee_paper.json] [--out docs/images] [--quick]
 """
 
 import argparse
@@ -41,7 +41,7 @@ def sweep(scene, seconds):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scene", default=str(ROOT / "scenes" / "knee.json"))
+    parser.add_argument("--scene", default=str(ROOT / "scenes" / "knee_paper.json"))
     parser.add_argument("--out", default=str(ROOT / "docs" / "images"))
     parser.add_argument("--quick", action="store_true", help="the first 1.5 s only (tests)")
     args = parser.parse_args()

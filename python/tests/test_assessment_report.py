@@ -59,7 +59,7 @@ def make_session(directory, *, variant=0, teleop=None, picture=True):
     a = {
         "schema": "hapsim.assessment/1",
         "recording": f"session-{variant + 1}.rec",
-        "scene": "scenes/knee.json",
+        "scene": "scenes/knee_paper.json",
         "scene_name": "knee palpation (Visible Human knee)",
         "kind": "palpation",
         "duration_s": DURATION_S - 2.0 * variant,

@@ -1,6 +1,7 @@
-// The default scene, scenes/knee.json: the real Visible Human knee derived by
-// scripts/derive-knee.sh and committed (no ../shared needed). Every part is a closed, valid
-// surface, the whole is at the knee paper's budget, and the main job's palpation touches the
+// The paper's knee model, scenes/knee_paper.json (the default scene until the FEM knee took its
+// place): the real Visible Human knee derived by scripts/derive-knee.sh and committed (no
+// ../shared needed). Every part is a closed, valid surface, the whole is at the knee paper's
+// budget, and its palpation touches the
 // landmarks a surgeon feels with a few newtons, without pop-through or a force above the rating.
 #include <nlohmann/json.hpp>
 
@@ -52,7 +53,7 @@ TEST(DefaultKnee, EveryPartClosedValidAndTheWholeAtThePapersBudget) {
 TEST(DefaultKnee, PalpationTouchesTheLandmarksWithAFewNewtons) {
   const auto json_path = temp_path("default_knee_run.json");
   const auto png = temp_path("default_knee_final.png");
-  const RunResult r = run_hapsim("run " + (kScenes / "knee.json").string() + " -q --json " +
+  const RunResult r = run_hapsim("run " + (kScenes / "knee_paper.json").string() + " -q --json " +
                                  json_path.string() + " --snapshot " + png.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(json_path);

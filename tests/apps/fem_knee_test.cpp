@@ -1,4 +1,4 @@
-// The FEM knee (scenes/knee_fem.json, issue 30): the tissue between the default knee's skin and
+// The FEM knee (scenes/knee.json, issue 30): the tissue between the default knee's skin and
 // its bones meshed by TetGen (scripts/derive-knee-fem.sh, hapsim tetrahedralize), rigid bones a
 // fingertip meets as a wall. The meshing is reproducible, the meshes valid with every region,
 // the shipped palpation finds its landmarks within the limits, a press too hard breaches both the
@@ -88,7 +88,7 @@ nlohmann::json assess(const fs::path& recording, const std::string& name) {
 TEST(FemKnee, ThePalpationFindsItsLandmarksWithinTheLimitsAndReplaysBitForBit) {
   const fs::path rec = temp_path("knee_fem.rec");
   const fs::path run_json = temp_path("knee_fem_run.json");
-  const RunResult r = run_hapsim("run " + (kScenes / "knee_fem.json").string() + " -q --record " +
+  const RunResult r = run_hapsim("run " + (kScenes / "knee.json").string() + " -q --record " +
                                  rec.string() + " --json " + run_json.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(run_json);
@@ -120,7 +120,7 @@ TEST(FemKnee, ThePalpationFindsItsLandmarksWithinTheLimitsAndReplaysBitForBit) {
   EXPECT_TRUE(a.at("breaches").empty()) << a.dump(2);
 
   const RunResult replay =
-      run_hapsim("run " + (kScenes / "knee_fem.json").string() + " -q --replay " + rec.string());
+      run_hapsim("run " + (kScenes / "knee.json").string() + " -q --replay " + rec.string());
   EXPECT_EQ(replay.exit_code, 0) << replay.output;
   EXPECT_NE(replay.output.find("bit for bit"), std::string::npos) << replay.output;
 }
@@ -134,7 +134,7 @@ TEST(FemKnee, APressTooHardOnThePatellaBreachesTheTissuesAndTheBonesLimit) {
                                   "2.5,-10,90,28,1,0,0,0\n");
   const fs::path rec = temp_path("knee_fem_press_hard.rec");
   const RunResult r =
-      run_hapsim("run " + (kScenes / "knee_fem.json").string() +
+      run_hapsim("run " + (kScenes / "knee.json").string() +
                  " -q --duration 3 --device sim:" + csv.string() + " --record " + rec.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json a = assess(rec, "knee_fem_press_hard");
@@ -149,3 +149,60 @@ TEST(FemKnee, APressTooHardOnThePatellaBreachesTheTissuesAndTheBonesLimit) {
 }
 
 }  // namespace
+
+// The glove scene on the FEM knee (scenes/knee_hand.json, the knee paper's Fig. 6): the index and
+// middle fingertips find the vastus medialis within the limits, and the run replays bit for bit.
+TEST(FemKneeHand, TheGlovesFingersFindTheMuscleWithinTheLimitsAndReplayBitForBit) {
+  const fs::path rec = temp_path("knee_hand_fem.rec");
+  const fs::path run_json = temp_path("knee_hand_fem_run.json");
+  const RunResult r = run_hapsim("run " + (kScenes / "knee_hand.json").string() + " -q --record " +
+                                 rec.string() + " --json " + run_json.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in(run_json);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("pop_throughs").get<std::size_t>(), 0u);
+  const nlohmann::json a = assess(rec, "knee_hand_fem");
+  std::set<std::string> found;
+  for (const auto& l : a.at("landmarks")) {
+    if (l.at("found").get<bool>()) {
+      found.insert(l.at("name").get<std::string>());
+    }
+  }
+  EXPECT_EQ(found, (std::set<std::string>{"vastus medialis, distal", "vastus medialis, proximal"}))
+      << a.dump(2);
+  EXPECT_TRUE(a.at("breaches").empty()) << a.dump(2);
+  const RunResult replay =
+      run_hapsim("run " + (kScenes / "knee_hand.json").string() + " -q --replay " + rec.string());
+  EXPECT_EQ(replay.exit_code, 0) << replay.output;
+  EXPECT_NE(replay.output.find("bit for bit"), std::string::npos) << replay.output;
+}
+
+// A hand pressing 30 mm in with three fingers (each up to the glove's 4 N) puts more than the
+// scene's 7 N limit into the tissue: the limit can be breached, and the report says so.
+TEST(FemKneeHand, AHandPressingTooHardWithThreeFingersBreachesTheTissuesLimit) {
+  std::ifstream in(kScenes / "knee_hand.json");
+  nlohmann::json scene = nlohmann::json::parse(in);
+  scene.erase("$schema");
+  // The copy lives in a temporary folder: its data paths made absolute.
+  auto& folder = scene["bodies"][0]["geometry"]["mesh_folder"]["folder"];
+  folder = (kScenes / folder.get<std::string>()).string();
+  auto& tet = scene["bodies"][1]["geometry"]["tet_mesh"];
+  tet["file"] = (kScenes / tet["file"].get<std::string>()).string();
+  tet["surface"] = (kScenes / tet["surface"].get<std::string>()).string();
+  auto& glove = scene["device"]["glove_palpation"];
+  glove["depth_m"] = 0.03;
+  glove["fingers"].push_back(
+      {{"finger", 3}, {"body", "knee"}, {"toward_m", {0.011, 0.0206, 0.1265}}});
+  const fs::path scene_file = write_file("knee_hand_press_hard.json", scene.dump(1));
+  const fs::path rec = temp_path("knee_hand_press_hard.rec");
+  const RunResult r = run_hapsim("run " + scene_file.string() + " -q --record " + rec.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json a = assess(rec, "knee_hand_press_hard");
+  double worst_tissue_excess_n = 0.0;
+  for (const auto& b : a.at("breaches")) {
+    if (b.at("tissue").get<std::string>() == "soft_tissue") {
+      worst_tissue_excess_n = std::max(worst_tissue_excess_n, b.at("excess_n").get<double>());
+    }
+  }
+  EXPECT_GT(worst_tissue_excess_n, 1.0) << a.dump(2);
+}

@@ -155,7 +155,7 @@ TEST(HostileInput, UnboundedStepCountsAreRefused) {
 }
 
 TEST(HostileInput, DevZeroAsTrajectoryIsRefusedAtOnce) {
-  expect_one_line_error(run_limited("run " + kScenes + "knee.json --device sim:/dev/zero"),
+  expect_one_line_error(run_limited("run " + kScenes + "knee_paper.json --device sim:/dev/zero"),
                         {"/dev/zero", "not a text file"});
 }
 

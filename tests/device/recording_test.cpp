@@ -258,7 +258,7 @@ TEST(Recording, TheHeaderNamesTheSceneAndVersionOneStillReads) {
   const auto path = test::temp_path(".hrec");
   {
     SessionRecorder recorder(path, "scene-abc123", 7, SessionRecorder::Overflow::kFlushInline,
-                             "scenes/knee.json");
+                             "scenes/knee_paper.json");
     for (const RecordedFrame& f : frames) {
       EXPECT_TRUE(recorder.record(f));
     }
@@ -266,9 +266,9 @@ TEST(Recording, TheHeaderNamesTheSceneAndVersionOneStillReads) {
   }
   const Recording rec = read_recording(path);
   EXPECT_EQ(rec.header.version, 2u);
-  EXPECT_EQ(rec.header.scene_path, "scenes/knee.json");
+  EXPECT_EQ(rec.header.scene_path, "scenes/knee_paper.json");
   EXPECT_EQ(rec.header.scene_path_absolute,
-            (std::filesystem::current_path() / "scenes/knee.json").string());
+            (std::filesystem::current_path() / "scenes/knee_paper.json").string());
   EXPECT_EQ(rec.frames.size(), 3u);
 
   // The same session as version 1 wrote it: no path fields, version 1, the checksum over the rest

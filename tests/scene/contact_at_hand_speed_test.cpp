@@ -1,7 +1,7 @@
 // Contact that holds at hand speed (issue 30): a fingertip pressed into the patella from the side
 // and dragged across it at 50, 200 and 500 mm/s, past its inferior pole and back, then held
-// inside, keeps feeling the bone, on the paper's knee (scenes/knee.json: the patella a proxy
-// segment of one body) and on the FEM knee (scenes/knee_fem.json: a rigid bone body under FEM
+// inside, keeps feeling the bone, on the paper's knee (scenes/knee_paper.json: the patella a proxy
+// segment of one body) and on the FEM knee (scenes/knee.json: a rigid bone body under FEM
 // tissue). Before the god-object settled its proxy back after a friction step, the contact
 // dropped for tens of milliseconds at a time while sliding (the force fell from 8.5 to 1 N, the
 // skin's) and a hold could end with the device 2.9 mm inside the patella feeling only the skin,
@@ -113,10 +113,11 @@ TEST_P(ContactAtHandSpeed, ADragAcrossThePatellaKeepsTheBoneAndAHoldInsideFeelsI
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Knees, ContactAtHandSpeed, ::testing::Values("knee.json", "knee_fem.json"),
+INSTANTIATE_TEST_SUITE_P(Knees, ContactAtHandSpeed,
+                         ::testing::Values("knee_paper.json", "knee.json"),
                          [](const auto& param_info) {
-                           return param_info.param == "knee.json" ? std::string("PaperKnee")
-                                                                  : std::string("FemKnee");
+                           return param_info.param == "knee_paper.json" ? std::string("PaperKnee")
+                                                                        : std::string("FemKnee");
                          });
 
 }  // namespace

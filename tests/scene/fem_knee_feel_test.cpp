@@ -19,7 +19,7 @@ namespace {
 
 TEST(FemKneeFeel, TheQuadricepsModulusIsInThePublishedInVivoRange) {
   SceneDescription scene =
-      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee_fem.json");
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
   RunSetup setup = make_run_setup(std::move(scene), DeviceChoice::scene_script());
   World& world = *setup.world;
   const double radius_m = world.description().tools.front().radius_m;

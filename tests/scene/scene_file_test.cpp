@@ -609,6 +609,15 @@ TEST_F(SceneFileTest, GloveScenesNameTheirMistakes) {
       {"an unknown segment",
        [](Json& j) { j["device"]["glove_palpation"]["fingers"][0]["segment"] = "patella"; },
        "/device/glove_palpation/fingers/0/segment", "got 'patella'"},
+      {"neither a segment nor a point",
+       [](Json& j) { j["device"]["glove_palpation"]["fingers"][0].erase("segment"); },
+       "/device/glove_palpation/fingers/0", "segment"},
+      {"a point that is no vector",
+       [](Json& j) {
+         j["device"]["glove_palpation"]["fingers"][0].erase("segment");
+         j["device"]["glove_palpation"]["fingers"][0]["toward_m"] = {0, 1};
+       },
+       "/device/glove_palpation/fingers/0/toward_m", ""},
       {"no direction",
        [](Json& j) {
          j["device"]["glove_palpation"]["from"] = {0, 0, 0};
@@ -632,6 +641,16 @@ TEST_F(SceneFileTest, GloveScenesNameTheirMistakes) {
   EXPECT_TRUE(s.world.has_hand);
   EXPECT_TRUE(s.device.has_glove_palpation);
   EXPECT_EQ(s.device.glove_palpation.fingers.at(0).finger, 1);
+  EXPECT_FALSE(s.device.glove_palpation.fingers.at(0).toward_world);
+  // A finger may aim at a point instead of a segment (a FEM body has none to name).
+  Json at_point = glove;
+  at_point["device"]["glove_palpation"]["fingers"][0].erase("segment");
+  at_point["device"]["glove_palpation"]["fingers"][0]["toward_m"] = {0.01, 0.02, 0.03};
+  const SceneDescription p = load_scene(write("glove_point.json", at_point.dump()));
+  ASSERT_TRUE(p.device.glove_palpation.fingers.at(0).toward_world);
+  EXPECT_TRUE(
+      p.device.glove_palpation.fingers.at(0).toward_world->isApprox(Vec3(0.01, 0.02, 0.03)));
+  EXPECT_TRUE(p.device.glove_palpation.fingers.at(0).segment.empty());
 }
 
 TEST(ShippedScenes, KneeLoadsElevenSegmentsWithTissueMaterials) {

@@ -224,9 +224,10 @@ Json small_scene() {
 TEST(SceneSchema, ShippedScenesAndASmallSceneSatisfyIt) {
   const SchemaValidator v = schema();
   for (const char* name :
-       {"knee.json", "knee_procedural.json", "knee_vhf.json", "knee_hand_procedural.json",
+       {"knee_paper.json", "knee_procedural.json", "knee_vhf.json", "knee_hand_procedural.json",
         "knee_hand.json", "teleop.json", "teleop_gp7.json", "csg_block.json",
-        "hand_ball_sheet.json", "fem_block.json"}) {
+        "hand_ball_sheet.json", "fem_block.json", "knee.json", "knee_hand_paper.json",
+        "knee_fem_80k.json", "knee_fem_five_fingers.json", "thin_plate.json"}) {
     EXPECT_EQ(v.validate(read_json(kScenes / name)), "") << name;
   }
   EXPECT_EQ(v.validate(small_scene()), "");

@@ -42,7 +42,7 @@ class RecordingAssessmentTest : public test::TempDirTest {
 };
 
 TEST_F(RecordingAssessmentTest, TheKneesPalpationFindsTheLandmarksItPressesAndMissesTheOthers) {
-  const fs::path scene_file = kScenes / "knee.json";
+  const fs::path scene_file = kScenes / "knee_paper.json";
   const fs::path recording = dir_ / "knee.rec";
   (void)record_scripted_run(scene_file, recording);
   const SceneDescription scene = load_scene(scene_file);
@@ -172,7 +172,7 @@ TEST_F(RecordingAssessmentTest, ARecordingOfAnotherSceneIsRefusedNamingIt) {
     recorder.close();
   }
   try {
-    (void)assess_recording(recording, load_scene(kScenes / "knee.json"));
+    (void)assess_recording(recording, load_scene(kScenes / "knee_paper.json"));
     ADD_FAILURE() << "assessed a recording of another scene";
   } catch (const Error& e) {
     EXPECT_EQ(std::string(e.where()), recording.string()) << e.what();

@@ -28,7 +28,7 @@ TEST(ForceScale, ShippedScenesFitTheirForcesNotAHundredNewtons) {
     return load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / file);
   };
   // The knee on a simulated device rated 100 N: its contacts saturate at a few newtons.
-  const SceneDescription knee = scene("knee.json");
+  const SceneDescription knee = scene("knee_paper.json");
   double largest = 0.0;
   for (const BodyDescription& b : knee.world.bodies) {
     for (const SegmentDescription& seg : b.segments) {

@@ -42,7 +42,7 @@ void read_glove_palpation(const SceneReader& r, const Json& j, const std::string
   for (std::size_t i = 0; i < fingers.size(); ++i) {
     const std::string ip = JsonReader::at(fp, i);
     const Json& f = r.object(fingers[i], ip, "a finger target {finger, body, segment}");
-    r.allow_keys(f, ip, {"finger", "body", "segment"});
+    r.allow_keys(f, ip, {"finger", "body", "segment", "toward_m"});
     GloveFingerTarget t;
     const Json& n = r.required(f, ip, "finger");
     if (!n.is_number_integer() || n.get<int>() < 0 || n.get<int>() >= kHandFingers) {
@@ -61,15 +61,21 @@ void read_glove_palpation(const SceneReader& r, const Json& j, const std::string
     }
     t.body =
         r.nonempty_string(r.required(f, ip, "body"), JsonReader::at(ip, "body"), "a body name");
-    t.segment = r.nonempty_string(r.required(f, ip, "segment"), JsonReader::at(ip, "segment"),
-                                  "a segment name");
+    if (f.contains("toward_m")) {
+      t.toward_world = r.vec3(f["toward_m"], JsonReader::at(ip, "toward_m"), "m");
+    }
+    if (f.contains("segment") || !t.toward_world) {
+      t.segment = r.nonempty_string(r.required(f, ip, "segment"), JsonReader::at(ip, "segment"),
+                                    "a segment name");
+    }
     const auto body = std::find_if(scene.world.bodies.begin(), scene.world.bodies.end(),
                                    [&](const BodyDescription& b) { return b.name == t.body; });
     if (body == scene.world.bodies.end()) {
       r.fail(JsonReader::at(ip, "body"),
              "expected the name of a body in /bodies, got '" + t.body + "'");
     }
-    if (std::none_of(body->segments.begin(), body->segments.end(),
+    if ((!t.segment.empty() || !t.toward_world) &&
+        std::none_of(body->segments.begin(), body->segments.end(),
                      [&](const SegmentDescription& s) { return s.name == t.segment; })) {
       r.fail(JsonReader::at(ip, "segment"),
              "expected a segment of body '" + t.body + "', got '" + t.segment + "'");

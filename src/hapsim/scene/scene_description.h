@@ -45,11 +45,13 @@ struct PalpationScriptDescription {
   double sample_period_s = 0.001;
 };
 
-/// One finger of a glove palpation: the finger (0 thumb .. 4 little) presses the named segment.
+/// One finger of a glove palpation: the finger (0 thumb .. 4 little) presses the named segment,
+/// or the body's surface over `toward_world` (a FEM body has no segments to name).
 struct GloveFingerTarget {
   int finger = 1;
   std::string body;
   std::string segment;
+  std::optional<Vec3> toward_world;
 };
 
 /// A scripted glove palpation (knee paper §3.1, the hand variant): the hand comes at the body from

@@ -321,6 +321,7 @@ Trajectory make_scene_glove_palpation(const World& world, const GlovePalpationDe
     PalpationTargetDescription aim_at;
     aim_at.body = t.body;
     aim_at.segment = t.segment;
+    aim_at.toward_world = t.toward_world;
     aim_at.from_world = from;
     const Vec3 surface = aim_palpation_target(world, aim_at).surface_world;
     double radius = 0.0;
@@ -355,8 +356,11 @@ Trajectory make_scene_glove_palpation(const World& world, const GlovePalpationDe
   const HandPoseSolution solved = solve_hand_pose(hand, R, fingers, goals);
   if (solved.worst_m > 1e-3) {
     throw Error(where, "finger " + std::to_string(g.fingers[solved.worst_index].finger) +
-                           " cannot reach segment '" + g.fingers[solved.worst_index].segment +
-                           "' from a common hand pose (off by " +
+                           " cannot reach its target (" +
+                           (g.fingers[solved.worst_index].segment.empty()
+                                ? std::string("the point toward_m")
+                                : "segment '" + g.fingers[solved.worst_index].segment + "'") +
+                           ") from a common hand pose (off by " +
                            std::to_string(solved.worst_m * 1e3) +
                            " mm); press fewer or nearer segments");
   }

@@ -287,7 +287,10 @@ void FemCoupling::adopt(WorldState& state, double dt_s) noexcept {
   }
   for (std::size_t t = 0; t < tool_count_; ++t) {
     for (std::size_t b = 0; b < bodies_.size(); ++b) {
-      state.fem_contacts[t * kMaxFemBodies + b].model = u.models[t * kMaxFemBodies + b];
+      FemToolContact& fc = state.fem_contacts[t * kMaxFemBodies + b];
+      fc.previous_model = fc.model;
+      fc.model = u.models[t * kMaxFemBodies + b];
+      fc.adopted_this_step = true;
     }
   }
   pending_known_ = false;

@@ -237,6 +237,16 @@ struct SegmentState {
 /// the haptic path (adopted before the step), and the force the step rendered from it.
 struct FemToolContact {
   LocalContactModel model;
+  /// The model `model` replaced at the last adoption, and whether that adoption is still to be
+  /// blended in (set by FemCoupling::adopt, read by the FEM contacts stage).
+  LocalContactModel previous_model;
+  bool adopted_this_step = false;
+  /// The blend: at an adoption, what the old model (and what was left of its blend) rendered at
+  /// the tool minus what the new one renders there; it decays linearly to zero over one FEM
+  /// period from `blend_from_step`, so a new model is felt as a ramp, not a step (as a device
+  /// host blends a served model: device/local_model_renderer.h).
+  Vec3 blend_offset_n = Vec3::Zero();
+  std::uint64_t blend_from_step = 0;
   /// Respond stage: this step's force on the tool from the body, world frame (the FEM's load).
   Vec3 push_world_n = Vec3::Zero();
 };
