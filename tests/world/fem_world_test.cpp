@@ -121,6 +121,73 @@ TEST(FemWorld, AHeldProbeSettlesWhereTheContactSpringMeetsTheTissue) {
   EXPECT_LT(force_n, 0.9 * kContactStiffness_n_per_m * depth_m);
 }
 
+// Strain stiffening (Zheng & Mak's E(ε) = E₀ + E₁·ε, ε = δ/h): the block held 4 mm deep with
+// E₁ = 10·E₀ settles where the contact spring meets a tissue that indents as
+// F = k₁·δ·(1 + κ·δ), κ = (E₁/E₀)/h, h each patch node's distance to the table (20 mm under the
+// top's centre); checked against the same independent static solve as above (linear: δ = c·F
+// for the linear tissue, so the stiffened δ solves κ·δ² + δ − c·F = 0), and harder than the
+// linear block at the same depth.
+TEST(FemWorld, AStiffeningTissueSettlesOnItsQuadraticLoadIndentation) {
+  const double depth_m = 0.004;
+  const auto hold = [&](World& world) {
+    for (int k = 0; k < 100; ++k) {
+      world.step(pressed(depth_m * (k + 1) / 100.0), 1e-3);
+    }
+    double force_n = 0.0;
+    for (int k = 0; k < 1500; ++k) {
+      force_n = world.step(pressed(depth_m), 1e-3).tools[0].force_world_n.z();
+    }
+    return force_n;
+  };
+  World linear(block_world());
+  const double linear_n = hold(linear);
+  WorldDescription wd = block_world();
+  auto volume = std::make_shared<FemBodyDescription>(*wd.bodies[0].fem);
+  const double ratio = 10.0;
+  volume->materials[0].material.nonlinear_modulus_pa =
+      ratio * volume->materials[0].material.youngs_modulus_pa;
+  wd.bodies[0].fem = volume;
+  World world(wd);
+  const double force_n = hold(world);
+  ASSERT_GT(force_n, 0.05);
+  const FemBodyDescription& d = *volume;
+  const std::vector<FemNodeWeight> patch = world.fem()->contact_patch(0, 0);
+  ASSERT_FALSE(patch.empty());
+  std::vector<std::uint32_t> fixed;
+  for (std::size_t i = 0; i < d.tets.nodes.size(); ++i) {
+    if (d.tets.nodes[i].z() <= 1e-6) {
+      fixed.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+  double kappa_per_m = 0.0;
+  for (const FemNodeWeight& w : patch) {
+    double nearest_m = kInf;
+    for (const std::uint32_t n : fixed) {
+      nearest_m = std::min(nearest_m, (d.tets.nodes[n] - d.tets.nodes[w.node]).norm());
+    }
+    kappa_per_m += w.weight * ratio / nearest_m;
+  }
+  EXPECT_NEAR(kappa_per_m, ratio / 0.02, 0.1 * ratio / 0.02);  // h ≈ the block's 20 mm
+  // The linear tissue's compliance at the patch, c (m/N), from a static solve under 1 N.
+  FemBody reference(d.tets, d.materials, fixed, d.options);
+  std::vector<FemNodeForce> loads;
+  for (const FemNodeWeight& w : patch) {
+    loads.push_back({w.node, Vec3(0.0, 0.0, -w.weight)});
+  }
+  reference.set_loads(loads);
+  reference.solve_static();
+  double c_m_per_n = 0.0;
+  for (const FemNodeWeight& w : patch) {
+    c_m_per_n -= w.weight * reference.displacement(w.node).z();
+  }
+  ASSERT_GT(c_m_per_n, 0.0);
+  const double delta_m =
+      (-1.0 + std::sqrt(1.0 + 4.0 * kappa_per_m * c_m_per_n * force_n)) / (2.0 * kappa_per_m);
+  EXPECT_NEAR(force_n, kContactStiffness_n_per_m * (depth_m - delta_m), 0.03 * force_n)
+      << "indentation " << delta_m * 1e3 << " mm, linear " << c_m_per_n * force_n * 1e3 << " mm";
+  EXPECT_GT(force_n, 1.1 * linear_n) << "linear " << linear_n << " N";
+}
+
 // Held still 7 mm deep (the tissue gives ~6 mm), off the top's centre, on the flat top: the force
 // settles along the top's normal, steady. Taking the load's direction from the dent's own
 // deformed normal once fed the dent's slope back into the load: the probe then rang or wandered

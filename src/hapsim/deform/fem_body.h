@@ -35,6 +35,11 @@ struct FemMaterial {
   /// Rayleigh damping C = α·M + β·K: α (1/s) and β (s).
   double rayleigh_mass_per_s = 0.0;
   double rayleigh_stiffness_s = 0.0;
+  /// Strain stiffening under a contact, Pa: Zheng & Mak's (1999) nonlinear factor E₁ of the
+  /// in-vivo modulus E(ε) = E₀ + E₁·ε, ε the indentation over the tissue's thickness there, E₀
+  /// `youngs_modulus_pa`. The elastic law stays linear (prefactored); the coupling applies it to
+  /// each contact's load–indentation (world/fem_coupling.h). 0: no stiffening.
+  double nonlinear_modulus_pa = 0.0;
 };
 
 /// Which material a region (TetMesh::regions value) gets.

@@ -13,7 +13,7 @@ using Json = JsonReader::Json;
 FemMaterial fem_region_material(const JsonReader& r, const Json& m, const std::string& p) {
   r.allow_keys(m, p,
                {"region", "name", "youngs_modulus_pa", "poisson_ratio", "density_kg_per_m3",
-                "rayleigh_mass_per_s", "rayleigh_stiffness_s", "source"});
+                "rayleigh_mass_per_s", "rayleigh_stiffness_s", "nonlinear_modulus_pa", "source"});
   for (const char* key : {"name", "source"}) {
     if (m.contains(key)) {
       (void)r.string(m[key], JsonReader::at(p, key), "text");  // documentation only
@@ -28,6 +28,7 @@ FemMaterial fem_region_material(const JsonReader& r, const Json& m, const std::s
       r.number_in(m, p, "density_kg_per_m3", out.density_kg_per_m3, 0.0, 1e5, "kg/m^3", true);
   out.rayleigh_mass_per_s = r.number_in(m, p, "rayleigh_mass_per_s", 0.0, 0.0, 1e4, "1/s");
   out.rayleigh_stiffness_s = r.number_in(m, p, "rayleigh_stiffness_s", 0.0, 0.0, 10.0, "s");
+  out.nonlinear_modulus_pa = r.number_in(m, p, "nonlinear_modulus_pa", 0.0, 0.0, 1e12, "Pa");
   return out;
 }
 

@@ -50,6 +50,12 @@ struct FemCoupling::Body {
     double softening = 1.0;
   };
   std::array<Secant, kMaxTools> secant{};
+  /// Per surface vertex: the strain stiffening's rate, 1/m: E₁/E₀ of the tissue under it over the
+  /// tissue's thickness there (fem_stiffening_per_m); 0 where the tissue is linear.
+  std::vector<double> stiffening_per_m;
+  /// Per tool: its patch's stiffening rate and rest normal (body frame) at the last update.
+  std::array<double, kMaxTools> patch_stiffening_per_m{};
+  std::array<Vec3, kMaxTools> patch_normal;
   std::vector<FemNodeForce> loads;
   /// Stress for display: per tet, and per surface vertex; a boundary vertex's tets (CSR).
   std::vector<double> tet_von_mises_pa;
@@ -120,6 +126,58 @@ std::vector<std::uint32_t> fem_fixed_nodes(const WorldModel& model, const BodyDe
 constexpr double kFemSecantMinLoadStepN = 1e-3;
 constexpr double kFemSecantMinLoadFraction = 0.02;
 constexpr double kFemMaxSoftening = 10.0;
+
+// The thinnest tissue a stiffening rate is taken over: a surface vertex on (or at) a fixed node
+// would otherwise stiffen without bound.
+constexpr double kFemMinThicknessM = 1e-3;
+
+// Per surface vertex, the rate of Zheng & Mak's strain stiffening E(ε) = E₀ + E₁·ε per metre of
+// indentation: E₁/E₀ of the region under it (an embedded vertex: its tet's; a boundary vertex: the
+// mean over its tets) over the tissue's thickness there, taken as the distance to the nearest
+// fixed node (tissue held on bone: how deep the bone lies; a block on a table: its height).
+std::vector<double> fem_stiffening_per_m(const FemBodyDescription& fd, const FemBody& fem,
+                                         const TriangleMesh& rest_surface,
+                                         const std::vector<TetEmbedding>& embedding,
+                                         const std::vector<std::uint32_t>& vertex_tets_start,
+                                         const std::vector<std::uint32_t>& vertex_tets) {
+  const TetMesh& tets = fd.tets;
+  std::vector<double> ratio_of_tet(tets.tets.size(), 0.0);
+  bool any = false;
+  for (std::size_t t = 0; t < tets.tets.size(); ++t) {
+    for (const FemRegionMaterial& m : fd.materials) {
+      if (m.region == tets.region(t) && m.material.youngs_modulus_pa > 0.0) {
+        ratio_of_tet[t] = m.material.nonlinear_modulus_pa / m.material.youngs_modulus_pa;
+        any = any || ratio_of_tet[t] > 0.0;
+      }
+    }
+  }
+  std::vector<double> out(rest_surface.vertices.size(), 0.0);
+  if (!any) {
+    return out;
+  }
+  const std::vector<std::uint32_t>& fixed = fem.fixed_nodes();
+  for (std::size_t v = 0; v < out.size(); ++v) {
+    double ratio = 0.0;
+    if (!embedding.empty()) {
+      ratio = ratio_of_tet[embedding[v].tet];
+    } else if (vertex_tets_start[v + 1] > vertex_tets_start[v]) {
+      for (std::uint32_t k = vertex_tets_start[v]; k < vertex_tets_start[v + 1]; ++k) {
+        ratio += ratio_of_tet[vertex_tets[k]];
+      }
+      ratio /= static_cast<double>(vertex_tets_start[v + 1] - vertex_tets_start[v]);
+    }
+    if (!(ratio > 0.0)) {
+      continue;
+    }
+    double nearest2 = kInf;
+    for (const std::uint32_t n : fixed) {
+      nearest2 = std::min(nearest2, (tets.nodes[n] - rest_surface.vertices[v]).squaredNorm());
+    }
+    out[v] = ratio / std::max(std::sqrt(nearest2), kFemMinThicknessM);
+  }
+  return out;
+}
+
 }  // namespace
 
 double fem_patch_radius_m(double configured_m, const TriangleMesh& rest_surface) {
@@ -220,6 +278,12 @@ FemCoupling::FemCoupling(const WorldModel& model) {
         body->vertex_tets.insert(body->vertex_tets.end(), l.begin(), l.end());
         body->vertex_tets_start.push_back(static_cast<std::uint32_t>(body->vertex_tets.size()));
       }
+    }
+    body->stiffening_per_m =
+        fem_stiffening_per_m(fd, *body->fem, body->rest_surface, body->embedding,
+                             body->vertex_tets_start, body->vertex_tets);
+    for (Vec3& n : body->patch_normal) {
+      n.setZero();
     }
     body->tet_von_mises_pa.assign(fd.tets.tets.size(), 0.0);
     body->frame.vertices = body->surface.vertices;
@@ -389,7 +453,12 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     if (body.patch[t].empty() || !(push.squaredNorm() > 0.0)) {
       continue;
     }
-    const Vec3 f_tissue_body = body.X_body_world.linear() * (-push);
+    // Strain stiffening: the linear tissue takes the force over the secant factor
+    // s = 1 + κ·δ at its patch's indentation δ, so it indents as F = k₁·δ·(1 + κ·δ) would
+    // (κ = E₁/(E₀·h): Zheng & Mak's quadratic); 1 where the tissue is linear.
+    const double indentation_m = std::max(0.0, -body.patch_normal[t].dot(body.patch_shift[t]));
+    const double secant_factor = 1.0 + body.patch_stiffening_per_m[t] * indentation_m;
+    const Vec3 f_tissue_body = body.X_body_world.linear() * (-push) / secant_factor;
     for (const FemNodeWeight& w : body.patch[t]) {
       body.loads.push_back({w.node, w.weight * f_tissue_body});
     }
@@ -445,6 +514,7 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     // rest), weighted by a smooth bump (their sum is one).
     const double r_patch = std::max(body.patch_radius_m, radius);
     double sum = 0.0;
+    double stiffening_per_m = 0.0;  // the patch's, weighted as its load
     // The load's direction: the patch's rest normal (in the body's frame, so it turns with the
     // body), as small-strain contact theory (Hertz, Boussinesq) takes it. Not the dent's deformed
     // normal: that fed the dent's own slope back into the load, and a probe held still 6-8 mm
@@ -455,6 +525,7 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
       if (d2 < r_patch * r_patch) {
         const double w = 1.0 - d2 / (r_patch * r_patch);
         sum += w;
+        stiffening_per_m += w * body.stiffening_per_m[v];
         normal += w * body.rest_surface.vertex_normals[v];
         if (body.embedding.empty()) {
           patch.push_back({body.node_of_vertex[v], w});
@@ -471,6 +542,7 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
       for (std::uint32_t c : body.rest_surface.triangles[sp.triangle]) {
         const double w = 1.0 / 3.0;
         sum += w;
+        stiffening_per_m += w * body.stiffening_per_m[c];
         if (body.embedding.empty()) {
           patch.push_back({body.node_of_vertex[c], w});
         } else {
@@ -531,6 +603,11 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
       compliance_m_per_n *= sc.softening;
       body.secant[t] = sc;
     }
+    // Strain stiffening: the slope of F = k₁·δ·(1 + κ·δ) at the patch's indentation.
+    stiffening_per_m /= sum;
+    compliance_m_per_n /= 1.0 + 2.0 * stiffening_per_m * std::max(0.0, -normal.dot(shift));
+    body.patch_stiffening_per_m[t] = stiffening_per_m;
+    body.patch_normal[t] = normal;
     const double k_tissue = compliance_m_per_n > 0.0 && std::isfinite(compliance_m_per_n)
                                 ? 1.0 / compliance_m_per_n
                                 : kInf;
@@ -570,6 +647,10 @@ void FemCoupling::reset() {
     for (Vec3& shift : body->patch_shift) {
       shift.setZero();
     }
+    for (Vec3& n : body->patch_normal) {
+      n.setZero();
+    }
+    body->patch_stiffening_per_m = {};
     body->secant = {};
   }
   // The rest surfaces again.
