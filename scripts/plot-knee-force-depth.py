@@ -40,7 +40,7 @@ def main(csv_path, png_path):
         lo = [hertz_n(220.0, d * 1e-3) for d in depths]
         hi = [hertz_n(58400.0, d * 1e-3) for d in depths]
         ax.fill_between(depths, lo, hi, color="#999999", alpha=0.25,
-                        label="in vivo 0.22-58.4 kPa (Zheng & Mak 1999), Hertz")
+                        label="in vivo initial modulus 0.22-58.4 kPa (Zheng & Mak 1999), Hertz")
         for scene in scenes:
             pts = [(float(r["depth_mm"]), float(r["force_n"])) for r in rows
                    if r["scene"] == scene and r["landmark"] == name]

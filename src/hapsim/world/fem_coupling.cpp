@@ -53,6 +53,15 @@ struct FemCoupling::Body {
   /// Per surface vertex: the strain stiffening's rate, 1/m: E₁/E₀ of the tissue under it over the
   /// tissue's thickness there (fem_stiffening_per_m); 0 where the tissue is linear.
   std::vector<double> stiffening_per_m;
+  /// Per tool, linear elasticity only: the last compliance_along solved, and where (the contact's
+  /// rest point and normal, body frame), reused while the contact stays there (update_body).
+  struct Compliance {
+    bool valid = false;
+    Vec3 point = Vec3::Zero();
+    Vec3 normal = Vec3::Zero();
+    double m_per_n = 0.0;
+  };
+  std::array<Compliance, kMaxTools> compliance{};
   /// Per tool: its patch's stiffening rate and rest normal (body frame) at the last update.
   std::array<double, kMaxTools> patch_stiffening_per_m{};
   std::array<Vec3, kMaxTools> patch_normal;
@@ -126,6 +135,13 @@ std::vector<std::uint32_t> fem_fixed_nodes(const WorldModel& model, const BodyDe
 constexpr double kFemSecantMinLoadStepN = 1e-3;
 constexpr double kFemSecantMinLoadFraction = 0.02;
 constexpr double kFemMaxSoftening = 10.0;
+
+// A linear body's compliance at a contact is solved again only when the contact's rest point has
+// moved this far, or its normal turned this much, since the last solve: the solve costs as much
+// as the FEM step itself (a held fingertip doubled the update, 8 → 16 ms on the 26k knee), and
+// over a patch 12 mm across the compliance barely changes in half a millimetre.
+constexpr double kFemComplianceReuseM = 0.5e-3;
+constexpr double kFemComplianceReuseCos = 0.9994;  // 2°
 
 // The thinnest tissue a stiffening rate is taken over: a surface vertex on (or at) a fixed node
 // would otherwise stiffen without bound.
@@ -582,7 +598,14 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     // normal) measures the softening; it is kept between 1 and kFemMaxSoftening and taken only
     // from a load change large enough to measure it. Backward Euler: its lagging surface would
     // make the secant measure inertia, and it damps the loop itself.
-    double compliance_m_per_n = fem.compliance_along(patch, normal);
+    Body::Compliance& cached = body.compliance[t];
+    const bool reuse = fem.options().elasticity == FemElasticity::kLinear && cached.valid &&
+                       (cached.point - sp.point).norm() < kFemComplianceReuseM &&
+                       cached.normal.dot(normal) > kFemComplianceReuseCos;
+    if (!reuse) {
+      cached = Body::Compliance{true, sp.point, normal, fem.compliance_along(patch, normal)};
+    }
+    double compliance_m_per_n = cached.m_per_n;
     if (fem.options().integration == FemIntegration::kQuasiStatic && compliance_m_per_n > 0.0 &&
         std::isfinite(compliance_m_per_n)) {
       Body::Secant& sc = secant;
@@ -651,6 +674,7 @@ void FemCoupling::reset() {
       n.setZero();
     }
     body->patch_stiffening_per_m = {};
+    body->compliance = {};
     body->secant = {};
   }
   // The rest surfaces again.
