@@ -206,6 +206,17 @@ void run_polygonize(const PolygonizeCommandOptions& opt) {
   bounds.min() -= Vec3::Constant(std::max(offset_m, 0.0));
   bounds.max() += Vec3::Constant(std::max(offset_m, 0.0));
   field.bounds = crop ? bounds.intersection(*crop) : bounds;
+  // A cell coarser than half the shape meshes nothing of it, and the grid's padding (a cell each
+  // side) once made a box 1e20 m across out of a 0.1 m one.
+  const double longest_m = field.bounds.isEmpty() ? 0.0 : field.bounds.sizes().maxCoeff();
+  if (opt.cell_m > 0.5 * longest_m) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "--cell-m: %g m is coarser than the shape, whose largest extent is %g m; use at "
+                  "most half of that (a few hundredths of it for a faithful surface)",
+                  opt.cell_m, longest_m);
+    throw CommandError(text);
+  }
   // The grid is centred on the bounds: shift it off the crop planes by an odd fraction of a cell,
   // so no node lies exactly on a flat face (a vertex on a node makes a zero-area triangle).
   field.bounds.max() += Vec3(0.371, 0.293, 0.417) * opt.cell_m;

@@ -13,6 +13,7 @@
 #include "hapsim/kinematics/urdf_chain.h"
 
 #include <array>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -56,6 +57,12 @@ py::dict closest(PyMesh& mesh, const DoubleArray& points, const std::string& met
   py::array_t<double> normal({n, py::ssize_t{3}});
   py::array_t<std::int64_t> triangle(n);
   const double* in = points.data();
+  for (py::ssize_t i = 0; i < 3 * n; ++i) {
+    if (!std::isfinite(in[i])) {
+      throw Error("points", "row " + std::to_string(i / 3) +
+                                " is not finite (NaN or infinity): a closest point needs a point");
+    }
+  }
   double* d = distance.mutable_data();
   double* p = point.mutable_data();
   double* nn = normal.mutable_data();

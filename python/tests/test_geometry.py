@@ -35,6 +35,21 @@ def test_closest_on_a_box_matches_the_analytic_distance():
                                    np.abs(r["signed_distance"]), atol=1e-12)
 
 
+def test_closest_refuses_a_point_that_is_not_finite():
+    # A NaN point once crashed the interpreter inside the tree's traversal.
+    mesh = hapsim.load_mesh("builtin:box")
+    for bad in (np.nan, np.inf, -np.inf):
+        points = np.zeros((3, 3))
+        points[1, 2] = bad
+        for method in ("exact", "spheretree"):
+            with pytest.raises(hapsim.Error, match="row 1 is not finite"):
+                mesh.closest(points, method=method)
+    # Absurdly far but finite (past 1e15 m): no closest point (triangle -1), never a crash.
+    r = mesh.closest(np.array([[1e300, 0.0, 0.0], [0.0, 0.0, 1e19], [0.0, 0.0, 1.0]]))
+    assert list(r["triangle"][:2]) == [-1, -1] and r["triangle"][2] >= 0
+    assert abs(r["signed_distance"][2] - 0.98) < 1e-12  # the builtin box: 20 mm half height
+
+
 def test_closest_refuses_a_bad_shape_and_method():
     mesh = hapsim.load_mesh("builtin:box")
     with pytest.raises(hapsim.Error, match="N×3"):

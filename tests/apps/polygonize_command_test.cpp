@@ -33,4 +33,19 @@ TEST(PolygonizeCommand, TwoApartSpheresKeepTheLargerAndSaySo) {
   EXPECT_GT(mesh.bounds().min().x(), -0.021);
 }
 
+// A cell coarser than the shape is refused in one line: 1e308 m crashed the tree's traversal, and
+// 1e20 m wrote a mesh 5e23 mm across and called it fine.
+TEST(PolygonizeCommand, ACellCoarserThanTheShapeIsRefused) {
+  const auto out = temp_path("coarse.stl");
+  for (const char* cell : {"1e308", "1e20", "0.06"}) {
+    const auto r = run_hapsim("polygonize --mesh builtin:box --cell-m " + std::string(cell) +
+                              " --out " + out.string());
+    EXPECT_EQ(r.exit_code, 2) << cell << ": " << r.output;
+    EXPECT_NE(r.output.find("--cell-m"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("coarser than the shape"), std::string::npos) << r.output;
+  }
+  const auto fine = run_hapsim("polygonize --mesh builtin:box --cell-m 0.02 --out " + out.string());
+  EXPECT_EQ(fine.exit_code, 0) << fine.output;
+}
+
 }  // namespace

@@ -129,6 +129,23 @@ TEST(MeshBvh, BoxMatchesAnalyticDistanceSignAndNormal) {
   EXPECT_NEAR(top.signed_distance, 0.02, 1e-15);
 }
 
+// A point that is not finite, or so far out (> 1e15 m) that a double cannot tell the body's near
+// face from its far one, has no closest point; a far point within that range is still answered
+// right. A query at 1e308 m once crashed the traversal (hapsim polygonize --cell-m 1e308), a NaN
+// one the Python interpreter; at 1e19 m the far face won a tie and the sign said "inside".
+TEST(MeshBvh, NonFiniteAndAbsurdlyFarPointsHaveNoClosestPoint) {
+  const TriangleMesh box = make_box(Vec3(0.01, 0.02, 0.03));
+  const MeshBvh bvh(box);
+  QueryHint hint;
+  for (const double bad : {std::nan(""), kInf, -kInf, 1e19, -1e308}) {
+    EXPECT_FALSE(bvh.closest_point(Vec3(0.0, bad, 0.0), &hint).found()) << bad;
+  }
+  const SurfacePoint far = bvh.closest_point(Vec3(0.0, 0.0, 1e6));
+  ASSERT_TRUE(far.found());
+  EXPECT_NEAR(far.signed_distance, 1e6 - 0.03, 1e-9);
+  EXPECT_NEAR(far.point.z(), 0.03, 1e-12);
+}
+
 TEST(MeshBvh, SheetMatchesDistanceToTheRectangle) {
   const double size = 0.2;
   const TriangleMesh sheet = make_sheet(16, size);

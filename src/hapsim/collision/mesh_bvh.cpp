@@ -24,6 +24,8 @@ constexpr std::size_t kMaxLeafFirst = (std::size_t{1} << 27) - 1;
 // traversal stack below stays bounded whatever the mesh.
 constexpr int kSahMaxDepth = 40;
 constexpr int kStackSize = 512;
+// closest_point answers nothing for a coordinate beyond this (see there).
+constexpr double kMaxQueryCoordinateM = 1e15;
 
 // Conservative double -> float rounding: the float box always contains the double one.
 float round_down(double x) {
@@ -527,6 +529,13 @@ SurfacePoint MeshBvh::closest_point(const Vec3& p, QueryHint* hint) const {
 SurfacePoint MeshBvh::closest_point_counted(const Vec3& p, QueryHint* hint,
                                             QueryCounters* counters) const {
   Best best;
+  // No point, no closest point: a NaN query once crashed the Python interpreter, one at 1e308 m
+  // the traversal (float boxes overflow there). Past 1e15 m a double cannot tell a millimetre
+  // from nothing, so the near face of a metre-sized body and its far one tie, and the sign
+  // came out "inside": no answer is the honest one.
+  if (!p.allFinite() || p.cwiseAbs().maxCoeff() > kMaxQueryCoordinateM) {
+    return {};
+  }
   seed_from_hint(*mesh_, p, hint, best);
   if (counters != nullptr) {
     traverse<true>(impl_->nodes, impl_->leaf_triangles, *mesh_, p, best, counters);
@@ -534,7 +543,7 @@ SurfacePoint MeshBvh::closest_point_counted(const Vec3& p, QueryHint* hint,
     traverse<false>(impl_->nodes, impl_->leaf_triangles, *mesh_, p, best, nullptr);
   }
   if (best.triangle == kNoTriangle) {
-    // Only when float box distances overflowed (|p| ~ 1e19 m) or p is NaN: scan everything.
+    // Only if float box distances overflowed: scan everything.
     for (std::uint32_t t = 0; t < mesh_->triangles.size(); ++t) {
       const auto [a, b, c] = mesh_->corners(t);
       const TriangleClosest closest = closest_point_on_triangle(p, a, b, c);
