@@ -7,6 +7,7 @@
 #include "hapsim/collision/mesh_bvh.h"
 #include "hapsim/collision/sphere_tree.h"
 #include "hapsim/geometry/mesh_argument.h"
+#include "hapsim/geometry/mesh_validation.h"
 #include "hapsim/geometry/tet_mesh.h"
 #include "hapsim/geometry/tet_mesh_io.h"
 
@@ -20,6 +21,10 @@
 
 namespace hapsim::app {
 namespace {
+
+// A triangle mesh larger than this (in metres, read with no --scale) gets a unit hint: no body a
+// haptic scene holds is 5 m across, and millimetres read as metres are 1000 times too large.
+constexpr double kUnitHintLargestM = 5.0;
 
 struct InfoOptions {
   std::string mesh;
@@ -121,8 +126,30 @@ void run_info(const InfoOptions& opt) {
   std::printf("bounds       [%.3f, %.3f, %.3f] .. [%.3f, %.3f, %.3f] mm (%.3f x %.3f x %.3f mm)\n",
               lo_mm.x(), lo_mm.y(), lo_mm.z(), hi_mm.x(), hi_mm.y(), hi_mm.z(), size_mm.x(),
               size_mm.y(), size_mm.z());
-  std::printf("surface      %.4g mm^2, enclosed volume %.6g mm^3\n", mesh.surface_area() * 1e6,
-              mesh.signed_volume() * 1e9);
+  // An open mesh encloses nothing: its "volume" would be a number that depends on where the
+  // origin is. Say why there is none instead.
+  const MeshReport report = validate_mesh(mesh);
+  if (report.closed) {
+    std::printf("surface      %.4g mm^2, enclosed volume %.6g mm^3\n", mesh.surface_area() * 1e6,
+                mesh.signed_volume() * 1e9);
+  } else {
+    std::printf(
+        "surface      %.4g mm^2, no enclosed volume: the mesh is open (%zu edges with one "
+        "triangle)\n",
+        mesh.surface_area() * 1e6, report.open_edges);
+  }
+  // Scenes are in metres: a mesh tens of metres across is almost always millimetres read as
+  // metres (a 42 m patella). Say so once, with the option that fixes it.
+  const double largest_m = box.sizes().maxCoeff();
+  std::string unit_hint;
+  if (largest_m > kUnitHintLargestM && arg.scale == 1.0) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "%.4g m across: if the file is in millimetres, give --scale 0.001 (%.4g mm)",
+                  largest_m, largest_m);
+    unit_hint = text;
+    std::printf("units        %s\n", unit_hint.c_str());
+  }
   if (!arg.validation.empty()) {
     std::printf("validation   %s\n", arg.validation.c_str());
   }
@@ -142,7 +169,12 @@ void run_info(const InfoOptions& opt) {
     j["vertices"] = mesh.vertex_count();
     j["bounds_m"] = {{"min", vec_json(box.min())}, {"max", vec_json(box.max())}};
     j["surface_area_m2"] = mesh.surface_area();
-    j["signed_volume_m3"] = mesh.signed_volume();
+    j["closed"] = report.closed;
+    j["signed_volume_m3"] =
+        report.closed ? nlohmann::json(mesh.signed_volume()) : nlohmann::json(nullptr);
+    if (!unit_hint.empty()) {
+      j["unit_hint"] = unit_hint;
+    }
     if (!arg.validation_json.empty()) {
       j["validation"] = nlohmann::json::parse(arg.validation_json);
     }

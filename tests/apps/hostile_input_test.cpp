@@ -142,6 +142,25 @@ TEST(HostileInput, FileSystemRefusalsNameThePath) {
   expect_one_line_error(run_limited("info " + long_name), {long_name.substr(0, 40)});
 }
 
+// A FIFO where a file is expected: opening it blocks until something writes to it, so assess and
+// calibrate glove hung forever. Each now refuses it in one line (killed after 60 s otherwise).
+TEST(HostileInput, AFifoForAFileIsRefusedNotWaitedOn) {
+  const fs::path fifo = hapsim::test::temp_path("input.fifo");
+  fs::remove(fifo);
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  expect_one_line_error(run_limited("assess " + fifo.string()),
+                        {fifo.string(), "not a regular file"});
+  const std::string example = std::string(HAPSIM_SOURCE_DIR) + "/examples/glove_calibration/";
+  expect_one_line_error(
+      run_limited("calibrate glove " + fifo.string() + " --procedure " + example +
+                  "procedure.json --out " + hapsim::test::temp_path("user.json").string()),
+      {fifo.string(), "pipe"});
+  expect_one_line_error(
+      run_limited("run " + kScenes + "knee_paper.json --device sim:" + fifo.string()),
+      {fifo.string()});
+  fs::remove(fifo);
+}
+
 TEST(HostileInput, UnboundedStepCountsAreRefused) {
   const fs::path tiny_dt = knee_with("tiny_dt.json", "\"dt_s\": 0.001", "\"dt_s\": 1e-9");
   expect_one_line_error(run_limited("run " + tiny_dt.string()), {tiny_dt.string(), "steps"});

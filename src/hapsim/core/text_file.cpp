@@ -21,6 +21,11 @@ std::string read_text_file(const std::filesystem::path& path, std::size_t max_by
   if (std::filesystem::is_directory(status)) {
     throw Error(where, "cannot open the " + std::string(what) + ": it is a folder");
   }
+  // Opening a FIFO blocks until something writes to it: assess and calibrate glove hung forever.
+  if (std::filesystem::is_fifo(status) || std::filesystem::is_socket(status)) {
+    throw Error(where, "cannot open the " + std::string(what) +
+                           ": it is a pipe or a socket, not a file (hapsim reads files)");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     throw Error(where, "cannot open the " + std::string(what) + " (" + std::strerror(errno) + ")");

@@ -413,6 +413,14 @@ void SessionRecorder::close() {
 RecordingReader::RecordingReader(std::filesystem::path path) : path_(std::move(path)) {
   const std::string where = path_.string();
   std::error_code ec;
+  // Not a FIFO, a device or a folder: opening a FIFO blocks until something writes to it (assess
+  // hung forever), and only a regular file has a size to check frames against.
+  const auto status = std::filesystem::status(path_, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    throw Error(where,
+                "cannot open recording file: not a regular file (a pipe, a device or a "
+                "folder); a recording is a file hapsim run --record wrote");
+  }
   file_size_ = std::filesystem::file_size(path_, ec);
   in_.open(path_, std::ios::binary);
   if (ec || !in_) {
