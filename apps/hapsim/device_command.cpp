@@ -218,8 +218,22 @@ void run_device(const DeviceArgs& args) {
               args.dds.session.c_str());
   std::fflush(stdout);
   std::optional<net::SceneInfoSample> info;
+  // --duration bounds the wait too: a scripted `hapsim device --duration 2` with no serve running
+  // used to wait forever.
+  const auto waiting_since = std::chrono::steady_clock::now();
+  const auto waited_s = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - waiting_since).count();
+  };
   while (!info && !stop.load(std::memory_order_relaxed)) {
     info = take_said(info_in);
+    if (!info && !std::isnan(args.duration_s) && waited_s() > args.duration_s) {
+      char text[240];
+      std::snprintf(text, sizeof text,
+                    "no simulation host appeared within --duration %g s on session '%s' (start "
+                    "hapsim serve SCENE --session %s first)",
+                    args.duration_s, args.dds.session.c_str(), args.dds.session.c_str());
+      throw CommandError(text);
+    }
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   if (!info) {
@@ -408,7 +422,8 @@ void add_device_command(CLI::App& app) {
   cmd->add_option("--device-id", args->device_id, "This device's id (default 0)")
       ->check(CLI::Range(0, 65535));
   cmd->add_option("--duration", args->duration_s,
-                  "Seconds to run the loop (default: until stopped)")
+                  "Seconds to run the loop, and the longest wait for a simulation host "
+                  "(default: until stopped)")
       ->check(positive_seconds());
   cmd->add_option("--force-mode", args->force_mode,
                   "local-model (default) or raw (the paper's raw forces: unsafe beyond a few ms "

@@ -32,6 +32,18 @@ std::size_t lines(const std::string& text) {
   return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
 }
 
+// With no simulation host on its session, `hapsim device --duration 1` gives up after that second
+// (it waited forever), in one line naming the session and what to start, exit 2.
+TEST(DeviceHostProcess, WithNoServeItGivesUpAfterItsDuration) {
+  ASSERT_TRUE(test::on_loopback_config());
+  const auto r = hapsim::test::run_hapsim_env(
+      "timeout -s KILL 30", "device --duration 1 --session nobody-serves --domain 79");
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("no simulation host appeared within --duration 1 s on session "
+                          "'nobody-serves'"),
+            std::string::npos)
+      << r.output;
+}
 #if defined(HAPSIM_TEST_DRIVER_WRONG_ABI)
 TEST(DeviceHostProcess, ABrokenPluginIsOneLineAndExitTwo) {
   const auto wrong_abi = hapsim::test::run_hapsim(std::string("device --device plugin:") +
