@@ -60,14 +60,20 @@ SceneDescription knee_scene() {
   return load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "knee.json");
 }
 
-TEST(FemKneeFeel, TheQuadricepsModulusIsInThePublishedInVivoRange) {
-  // The initial modulus: the tissue without its strain stiffening (E1 = 0), as Zheng & Mak's E0.
+// The knee with its tissue linear (E1 = 0 in every region): Zheng & Mak's initial modulus alone.
+SceneDescription linear_knee_scene() {
   SceneDescription scene = knee_scene();
   auto fem = std::make_shared<FemBodyDescription>(*scene.world.bodies.at(1).fem);
   for (FemRegionMaterial& m : fem->materials) {
     m.material.nonlinear_modulus_pa = 0.0;
   }
   scene.world.bodies.at(1).fem = fem;
+  return scene;
+}
+
+TEST(FemKneeFeel, TheQuadricepsModulusIsInThePublishedInVivoRange) {
+  // The initial modulus: the tissue without its strain stiffening (E1 = 0), as Zheng & Mak's E0.
+  SceneDescription scene = linear_knee_scene();
   const double radius_m = scene.world.tools.front().radius_m;
   const double nu = 0.45;
   const std::vector<std::pair<double, double>> depth_force = press_quadriceps(std::move(scene));
@@ -105,13 +111,7 @@ TEST(FemKneeFeel, TheQuadricepsModulusIsInThePublishedInVivoRange) {
 // load-indentation does (F = k1 d (1 + (E1/E0) d/h): at 8 mm into ~30 mm of tissue, more than 1.5
 // times).
 TEST(FemKneeFeel, TheQuadricepsStiffensWithDepthAsTheInVivoCurvesDo) {
-  SceneDescription linear_scene = knee_scene();
-  auto fem = std::make_shared<FemBodyDescription>(*linear_scene.world.bodies.at(1).fem);
-  for (FemRegionMaterial& m : fem->materials) {
-    m.material.nonlinear_modulus_pa = 0.0;
-  }
-  linear_scene.world.bodies.at(1).fem = fem;
-  const auto linear = press_quadriceps(std::move(linear_scene));
+  const auto linear = press_quadriceps(linear_knee_scene());
   const auto stiffening = press_quadriceps(knee_scene());
   ASSERT_FALSE(linear.empty());
   ASSERT_FALSE(stiffening.empty());
