@@ -1,6 +1,7 @@
 #include "hapsim/geometry/mesh_simplify.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/geometry/mesh_unfold.h"
 #include "hapsim/geometry/mesh_validation.h"
 
 #include <meshoptimizer.h>
@@ -178,10 +179,16 @@ MeshSimplifyResult simplify_mesh(const TriangleMesh& source, const MeshSimplifyO
     // result is then validated as a whole).
     collapse_degenerate_triangles(mesh);
     remove_back_to_back_pairs(mesh);
-    const MeshReport report = validate_mesh(mesh);
+    // ... and fins at the source's sharp edges, which it does leave: flip them away.
+    MeshReport report = validate_mesh(mesh);
+    if (report.closed && report.folded_edges > source_report.folded_edges) {
+      result.unfolded_edges = unfold_edges(mesh);
+      report = validate_mesh(mesh);
+    }
     const bool valid = report.closed && !report.has_defects() && report.signed_volume > 0.0 &&
                        report.components == source_report.components &&
-                       report.euler_characteristic == source_report.euler_characteristic;
+                       report.euler_characteristic == source_report.euler_characteristic &&
+                       report.folded_edges <= source_report.folded_edges;
     const bool within = mesh.vertex_count() <= options.target_vertices;
     result.mesh = std::move(mesh);
     result.valid = valid;
@@ -192,6 +199,8 @@ MeshSimplifyResult simplify_mesh(const TriangleMesh& source, const MeshSimplifyO
     result.problem =
         !within
             ? "reached " + std::to_string(result.mesh.vertex_count()) + " vertices, over the target"
+        : report.folded_edges > source_report.folded_edges
+            ? "result has folds the source has not: " + report.summary()
             : "result not a valid closed surface of the source's topology: " + report.summary();
     // Over budget: scale the index budget by the overshoot; invalid: perturb it downwards.
     const double ratio = static_cast<double>(options.target_vertices) /

@@ -27,8 +27,10 @@ struct MeshSimplifyResult {
   /// meshoptimizer's own error estimate (its quadric metric), metres; not a distance bound.
   double simplifier_error_m = 0.0;
   int attempts = 0;
-  /// Whether the result is closed and free of defects (always true when the source was, unless
-  /// no attempt reached one; `problem` then says why).
+  /// Folded edges of the simplifier's result flipped away (mesh_unfold.h) in the last attempt.
+  std::size_t unfolded_edges = 0;
+  /// Whether the result is closed, free of defects and of folds the source has not (always true
+  /// when the source was, unless no attempt reached one; `problem` then says why).
   bool valid = false;
   std::string problem;
 };

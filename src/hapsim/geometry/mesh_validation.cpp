@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 #include <sstream>
 
@@ -217,6 +218,10 @@ Analysis analyse(const TriangleMesh& mesh, const MeshValidationOptions& options)
     } else if (uses[i].forward == uses[i + 1].forward) {
       ++r.inconsistent_edges;
       bad = true;
+    } else if (an.non_finite[uses[i].tri] == 0 && an.non_finite[uses[i + 1].tri] == 0 &&
+               is_fold(mesh.face_normal_area2(uses[i].tri).normalized(),
+                       mesh.face_normal_area2(uses[i + 1].tri).normalized())) {
+      ++r.folded_edges;
     }
     if (bad) {
       component_defective[an.component_of_triangle[uses[i].tri]] = 1;
@@ -450,6 +455,10 @@ std::string MeshReport::summary() const {
     }
   }
   out << "; " << (defects.empty() ? "no defects" : defects);
+  if (folded_edges > 0) {
+    out << "; " << plural(folded_edges, "folded edge")
+        << " (inside/outside unreliable next to them)";
+  }
   return out.str();
 }
 
@@ -462,6 +471,7 @@ std::string MeshReport::to_json(int indent) const {
     const auto defect = static_cast<MeshDefect>(d);
     j[std::string(to_string(defect))] = count(defect);
   }
+  j["folded_edges"] = folded_edges;
   j["components"] = components;
   j["closed"] = closed;
   j["euler_characteristic"] = euler_characteristic;
@@ -477,6 +487,11 @@ std::string MeshReport::to_json(int indent) const {
   }
   j["notes"] = notes;
   return j.dump(indent);
+}
+
+bool is_fold(const Vec3& unit_normal_a, const Vec3& unit_normal_b) {
+  static const double kCos = std::cos(kFoldAngleDeg * std::numbers::pi / 180.0);
+  return unit_normal_a.dot(unit_normal_b) < kCos;
 }
 
 MeshReport validate_mesh(const TriangleMesh& mesh, const MeshValidationOptions& options) {

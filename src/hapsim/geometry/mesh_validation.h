@@ -72,6 +72,13 @@ struct ValidationPolicy {
   static ValidationPolicy warn_only();
 };
 
+/// Two faces sharing an edge are folded when their normals are more than this apart (an interior
+/// angle under 37 degrees: sharper than any ridge of the anatomy, far sharper than a box's 90).
+inline constexpr double kFoldAngleDeg = 143.0;
+
+/// Whether two faces' unit normals meet at a fold (see MeshReport::folded_edges).
+[[nodiscard]] bool is_fold(const Vec3& unit_normal_a, const Vec3& unit_normal_b);
+
 struct MeshValidationOptions {
   /// A triangle is degenerate when twice its area is at most this fraction of the squared
   /// bounding-box diagonal (scale-free, so millimetre and metre files behave alike).
@@ -96,6 +103,11 @@ struct MeshReport {
   std::size_t inverted_components = 0;     ///< closed, consistent, negative volume, not a cavity
   std::size_t unused_vertices = 0;
   std::size_t components = 0;  ///< connected via shared vertices
+  /// Manifold edges whose two faces turn back on each other (normals more than kFoldAngleDeg
+  /// apart: a fin a simplification or a marching-cubes corner left). Not a defect of the
+  /// topology, but inside/outside from the closest point's pseudo-normal is unreliable beside
+  /// them, and such fins usually cross a neighbouring face.
+  std::size_t folded_edges = 0;
 
   /// Watertight: triangles present, no open, non-manifold or inconsistent edge, no bad index.
   bool closed = false;
