@@ -77,7 +77,18 @@ SoakResult run_soak(const SoakOptions& options) {
   double rep_drift = 0.0;
   const Stopwatch wall;
   using Clock = std::chrono::steady_clock;
+  std::size_t steps = 0;
   for (std::size_t k = 0; k < total_steps; ++k) {
+    if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed)) {
+      result.stopped = true;
+      if (!step_us.empty()) {  // the partial minute still counts
+        const SampleSummary s = summarize_samples(step_us);
+        const ProcessMemory memory = process_memory();
+        result.minutes.push_back({s.p50, s.p99, s.max, memory.peak_rss_bytes, memory.rss_bytes});
+      }
+      break;
+    }
+    steps = k + 1;
     const std::size_t in_script = k % script_steps;
     const std::size_t rep = k / script_steps;
     if (in_script == 0) {
@@ -126,10 +137,10 @@ SoakResult run_soak(const SoakOptions& options) {
                       static_cast<double>(k + 1) / static_cast<double>(total_steps));
     }
   }
-  if (result.repetitions > 1 && total_steps % script_steps == 0) {
+  if (!result.stopped && result.repetitions > 1 && total_steps % script_steps == 0) {
     result.last_force_drift_n = rep_drift;
   }
-  result.steps = total_steps;
+  result.steps = steps;
   result.wall_s = wall.elapsed_s();
   return result;
 }
@@ -189,6 +200,7 @@ nlohmann::json soak_to_json(const SoakResult& r) {
           {"script_s", r.script_s},
           {"repetitions", r.repetitions},
           {"steps", r.steps},
+          {"stopped_early", r.stopped},
           {"wall_s", r.wall_s},
           {"max_force_drift_n", r.max_force_drift_n},
           {"last_force_drift_n", r.last_force_drift_n},

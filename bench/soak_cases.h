@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <atomic>
 #include <cstddef>
 #include <filesystem>
 #include <string>
@@ -26,6 +27,8 @@ struct SoakOptions {
   /// Reset the world before each repetition of the script (a rig: the ball back at its start).
   bool reset_between = false;
   ProgressFn progress;
+  /// Stop early when this becomes true (SIGINT/SIGTERM): the result covers the steps run.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct SoakMinute {
@@ -41,6 +44,7 @@ struct SoakResult {
   double script_s = 0.0;
   std::size_t repetitions = 0;
   std::size_t steps = 0;
+  bool stopped = false;  ///< ended early by options.stop
   double wall_s = 0.0;
   std::vector<SoakMinute> minutes;
   /// Largest |F(t) − F_first(t)| over the tools' tip forces and finger forces, N: over every

@@ -11,6 +11,7 @@
 #include "json_output.h"
 #include "network_dds_bench.h"
 #include "progress_printer.h"
+#include "stop_signal.h"
 
 #include "bench/collision_cases.h"
 #include "bench/contact_cases.h"
@@ -97,12 +98,9 @@ void run_collision(const BenchArgs& args) {
     }
   }
   // Open the JSON file first, so a bad path fails before minutes of measuring.
-  std::unique_ptr<std::ofstream> json_out;
+  std::unique_ptr<AtomicFile> json_out;
   if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
+    json_out = open_output("--json", args.json_path);
   }
   const std::vector<std::string> meshes =
       options.meshes.empty() ? bench::collision_mesh_names(options.quick, options.data_dir)
@@ -137,10 +135,7 @@ void run_collision(const BenchArgs& args) {
                                       " answers disagreed with the exact distances (see 'bad')")
             << '\n';
   if (json_out) {
-    *json_out << bench::rows_to_json(rows).dump(2) << '\n';
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": write failed");
-    }
+    commit_output(*json_out, "--json", bench::rows_to_json(rows).dump(2) + '\n');
     std::cout << "wrote " << args.json_path << '\n';
   }
   if (mismatched != 0) {
@@ -157,12 +152,9 @@ struct StepArgs {
 };
 
 void run_step(const StepArgs& args) {
-  std::unique_ptr<std::ofstream> json_out;
+  std::unique_ptr<AtomicFile> json_out;
   if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
+    json_out = open_output("--json", args.json_path);
   }
   bench::StepBenchOptions options;
   options.methods = args.methods;
@@ -190,10 +182,7 @@ void run_step(const StepArgs& args) {
   std::cout << "step = device read + collision + force + deformation + safety + write, timed per "
                "cycle; ratios < 1: faster than the exact-query baseline\n";
   if (json_out) {
-    *json_out << bench::step_rows_to_json(rows).dump(2) << '\n';
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": write failed");
-    }
+    commit_output(*json_out, "--json", bench::step_rows_to_json(rows).dump(2) + '\n');
     std::cout << "wrote " << args.json_path << '\n';
   }
 }
@@ -415,13 +404,20 @@ void run_soak(const SoakArgs& args) {
     options.progress = [&printer](std::string_view label, double fraction) {
       printer(label, fraction);
     };
+    options.stop = &install_stop_signals();  // an hour's soak may be cut short: its JSON stays
     const bench::SoakResult result = bench::run_soak(options);
     std::cout << bench::format_soak(result) << std::flush;
     rows.push_back(bench::soak_to_json(result));
+    if (result.stopped) {
+      std::cout << "stopped      by " << stop_signal_name() << " after " << result.steps
+                << " steps\n";
+      break;
+    }
   }
   if (json_out) {
     json_out.write(rows);
   }
+  exit_status() = with_signal_status(exit_status());
 }
 
 struct NetworkArgs {
@@ -572,12 +568,9 @@ void run_network(const NetworkArgs& args) {
     run_network_dds(dds);
     return;
   }
-  std::unique_ptr<std::ofstream> json_out;
+  std::unique_ptr<AtomicFile> json_out;
   if (!args.json_path.empty()) {
-    json_out = std::make_unique<std::ofstream>(args.json_path);
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": cannot open for writing");
-    }
+    json_out = open_output("--json", args.json_path);
   }
   net::LinkSweepOptions options =
       args.quick ? net::quick_link_sweep_options() : net::LinkSweepOptions{};
@@ -643,10 +636,7 @@ void run_network(const NetworkArgs& args) {
     }
   }
   if (json_out) {
-    *json_out << network_rows_to_json(rows).dump(2) << '\n';
-    if (!*json_out) {
-      throw CommandError("--json " + args.json_path + ": write failed");
-    }
+    commit_output(*json_out, "--json", network_rows_to_json(rows).dump(2) + '\n');
     std::cout << "wrote " << args.json_path << '\n';
   }
 }

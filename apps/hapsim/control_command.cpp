@@ -10,11 +10,13 @@
 #include "session_join.h"
 #include "stop_signal.h"
 
+#include "hapsim/net/command_reply.h"
 #include "hapsim/net/command_sender.h"
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/loaned_reader.h"
 #include "hapsim/net/participant.h"
 #include "hapsim/net/served_scene.h"
+#include "hapsim/net/topic_reader.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/world/world.h"
 
@@ -111,6 +113,27 @@ std::optional<HostView> take_newest_view(net::LoanedReader<hapsim_msg_ViewState>
   return newest;
 }
 
+// The host's reply to the command `sender` sent last, until `deadline` (or a stop signal).
+std::optional<net::CommandReplySample> wait_for_reply(
+    net::TopicReader<hapsim_msg_CommandReply>& replies, const net::CommandSender& sender,
+    std::uint64_t serve_id, std::chrono::steady_clock::time_point deadline,
+    const std::atomic<bool>& stop) {
+  std::optional<net::CommandReplySample> found;
+  while (!found && std::chrono::steady_clock::now() < deadline &&
+         !stop.load(std::memory_order_relaxed)) {
+    replies.take([&](const hapsim_msg_CommandReply& m, const dds_sample_info_t& /*info*/) {
+      if (m.issuer_id == sender.issuer_id() && m.command_sequence == sender.sequence() &&
+          m.serve_id == serve_id) {
+        found = net::decode_command_reply(m);
+      }
+    });
+    if (!found) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+  }
+  return found;
+}
+
 void control(const ControlArgs& args) {
   using Clock = std::chrono::steady_clock;
   if (!net::command_kind(args.action)) {
@@ -126,6 +149,7 @@ void control(const ControlArgs& args) {
   const std::atomic<bool>& stop = session.stop();
   const net::SessionCommand command = make_command(args, *info);
   net::CommandSender sender(session.participant(), *info);
+  net::TopicReader<hapsim_msg_CommandReply> replies(session.participant());
   const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
                                            std::chrono::duration<double>(args.timeout_s));
   // The host's reader must be matched, or a reliable write has no one to reach.
@@ -146,16 +170,23 @@ void control(const ControlArgs& args) {
     throw CommandError("could not send the command on DDS");
   }
   const char* name = net::command_name(command.kind);
+  // The reply says whether the host took it; the transport's acknowledgement only that it arrived.
+  const auto reply_deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(
+                                                 std::chrono::duration<double>(args.timeout_s));
+  const std::optional<net::CommandReplySample> reply =
+      wait_for_reply(replies, sender, info->serve_id, reply_deadline, stop);
+  if (!reply) {
+    throw CommandError(std::string("control ") + name + ": the host in session '" +
+                       args.dds.session + "' did not answer within " +
+                       std::to_string(args.timeout_s) + " s");
+  }
+  if (!reply->accepted) {
+    throw CommandError(std::string("control ") + name + ": the host refused it: " + reply->reason);
+  }
   if (command.kind == net::SessionCommandKind::kSetMaterial) {
-    if (!sender.wait_for_acks(args.timeout_s)) {
-      throw CommandError(std::string("control ") + name +
-                         ": the host did not acknowledge it "
-                         "within " +
-                         std::to_string(args.timeout_s) + " s");
-    }
     std::printf(
-        "control      material %s sent to %s (session '%s'); the host acknowledged it "
-        "and prints what it set\n",
+        "control      material %s: %s (session '%s') took the new values; serve prints what it "
+        "set\n",
         args.material.c_str(), info->scene_file.c_str(), args.dds.session.c_str());
     return;
   }

@@ -196,14 +196,13 @@ struct Silence {
   double zero_after_ms = 0.0;
 };
 
-void run_device(const DeviceArgs& args) {
+void run_device(const DeviceArgs& args, JsonOutput& json_out) {
   const net::ForceMode mode =
       args.force_mode == "raw" ? net::ForceMode::kRaw : net::ForceMode::kLocalModel;
   const std::array<int, kMaxFingers> finger_map = parse_finger_map(args.finger_map);
   const std::optional<net::LinkShimOptions> link =
       args.link_shim.empty() ? std::nullopt
                              : std::optional(net::parse_link_shim(args.link_shim, "--link-shim"));
-  JsonOutput json_out(args.json_path);
   const bool sim = args.device == "sim";
   HostDevice host = sim ? HostDevice{} : open_device(args);
   net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
@@ -238,6 +237,9 @@ void run_device(const DeviceArgs& args) {
   }
   if (!info) {
     std::printf("stopped      before a simulation host appeared\n");
+    json_out.write_failure("stopped by " + std::string(stop_signal_name()) +
+                           " before a simulation host appeared");
+    exit_status() = stopped_by_signal_status();
     return;
   }
   std::printf("serving      %s (hash %016" PRIx64 "), %u tool(s)\n", info->scene_file.c_str(),
@@ -394,8 +396,17 @@ void run_device(const DeviceArgs& args) {
                                {"force_before_n", silence.force_before_n},
                                {"force_zero_after_ms", silence.zero_after_ms}});
     }
+    if (*stop_signal_name() != '\0') {
+      j["stopped_by"] = stop_signal_name();
+    }
     json_out.write(j);
   }
+  exit_status() = with_signal_status(exit_status());
+}
+
+void run_device(const DeviceArgs& args) {
+  JsonOutput json_out(args.json_path);
+  with_failure_json(json_out, [&] { run_device(args, json_out); });
 }
 
 }  // namespace

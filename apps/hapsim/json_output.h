@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <exception>
 #include <memory>
 #include <string>
 
@@ -25,6 +26,23 @@ class JsonOutput {
 
   /// Whether --json was given.
   explicit operator bool() const { return !path_.empty(); }
+  /// Whether it is still to be written (given, and no write was tried).
+  [[nodiscard]] bool pending() const { return file_ != nullptr; }
+
+  /// For a run that failed before its summary: {"ok": false, "error": what}, so a script reading
+  /// the JSON learns the failure rather than finding the file missing or empty. Says nothing
+  /// (the failure's own line is the one line); a failed write here is not said either.
+  void write_failure(const std::string& what) noexcept {
+    if (file_ == nullptr) {
+      return;
+    }
+    const std::unique_ptr<AtomicFile> file = std::move(file_);
+    try {
+      file->write(nlohmann::json{{"ok", false}, {"error", what}}.dump(2) + '\n');
+      file->commit();
+    } catch (...) {  // NOLINT(bugprone-empty-catch): the run's own failure is the one said
+    }
+  }
 
   /// Writes `j` (indented) and says so; throws CommandError when the write fails. Once only.
   void write(const nlohmann::json& j) {
@@ -40,5 +58,17 @@ class JsonOutput {
   std::string path_;
   std::unique_ptr<AtomicFile> file_;
 };
+
+/// Runs `body`, which writes `json` at its end; when it throws first, `json` gets the failure
+/// (JsonOutput::write_failure) and the exception goes on.
+template <typename Body>
+void with_failure_json(JsonOutput& json, Body&& body) {
+  try {
+    body();
+  } catch (const std::exception& e) {
+    json.write_failure(e.what());
+    throw;
+  }
+}
 
 }  // namespace hapsim::app

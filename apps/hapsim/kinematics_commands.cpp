@@ -41,17 +41,6 @@ std::string joint_names(const SerialChain& chain) {
   return names;
 }
 
-std::FILE* open_out(const std::string& path) {
-  if (path.empty()) {
-    return stdout;
-  }
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) {
-    throw CommandError(path + ": cannot write the output file");
-  }
-  return f;
-}
-
 void write_pose(std::FILE* f, const Iso3& X) {
   Quat q(X.linear());
   if (q.w() < 0.0) {
@@ -69,14 +58,15 @@ void run_fk(const KinematicsOptions& opt) {
   for (const auto& q : rows) {
     outside += chain.within_limits(q) ? 0 : 1;
   }
-  std::FILE* out = open_out(opt.out_path);
+  OutputFile out_file("--out", opt.out_path);
+  std::FILE* out = out_file.get();
   std::fprintf(out, "x,y,z,qw,qx,qy,qz\n");
   for (const auto& q : rows) {
     write_pose(out, chain.forward(q));
     std::fprintf(out, "\n");
   }
-  close_checked(out, "--out", opt.out_path);
-  std::FILE* info = out == stdout ? stderr : stdout;
+  out_file.commit();
+  std::FILE* info = out_file.info();
   std::fprintf(info, "hapsim fk: %zu rows, chain %s -> %s (%zu joints)%s\n", rows.size(),
                chain.base_link().c_str(), chain.tip_link().c_str(), n,
                outside > 0
@@ -107,7 +97,8 @@ void run_ik(const KinematicsOptions& opt) {
     const ChainJoint& j = chain.joints()[i];
     seed[i] = std::isfinite(j.lower) && std::isfinite(j.upper) ? 0.5 * (j.lower + j.upper) : 0.0;
   }
-  std::FILE* out = open_out(opt.out_path);
+  OutputFile out_file("--out", opt.out_path);
+  std::FILE* out = out_file.get();
   std::fprintf(out, "%s,reached\n", joint_names(chain).c_str());
   std::vector<double> q(n);
   std::size_t reached = 0;
@@ -126,8 +117,8 @@ void run_ik(const KinematicsOptions& opt) {
       seed = q;  // track the path
     }
   }
-  close_checked(out, "--out", opt.out_path);
-  std::FILE* info = out == stdout ? stderr : stdout;
+  out_file.commit();
+  std::FILE* info = out_file.info();
   std::fprintf(info,
                "hapsim ik: %zu poses, %zu reached (largest error %.3g mm, %.3g deg), %zu "
                "unreachable; chain %s -> %s\n",

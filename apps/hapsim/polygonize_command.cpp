@@ -249,7 +249,11 @@ void run_polygonize(const PolygonizeCommandOptions& opt) {
   }
   MeshSaveOptions save;
   save.scale = 1.0 / opt.scale;
-  save_mesh(opt.out_path, mesh, save);
+  try {
+    save_mesh(opt.out_path, mesh, save);
+  } catch (const Error& e) {
+    throw CommandError("--out " + std::string(e.what()));  // e names the path
+  }
   std::printf("polygonized  %s: %s (cell %.3g mm, %d x %d x %d nodes)\n", opt.out_path.c_str(),
               report.summary().c_str(), stats.cell_size_m * 1e3, stats.grid_nodes[0],
               stats.grid_nodes[1], stats.grid_nodes[2]);

@@ -87,13 +87,8 @@ void run_query(const QueryOptions& opt) {
     query = std::make_unique<KneeIndex>(arg.mesh);
   }
 
-  std::FILE* out = stdout;
-  if (!opt.out_path.empty()) {
-    out = std::fopen(opt.out_path.c_str(), "w");
-    if (out == nullptr) {
-      throw CommandError(opt.out_path + ": cannot write the output file");
-    }
-  }
+  OutputFile out_file("--out", opt.out_path);
+  std::FILE* out = out_file.get();
   std::fprintf(out, "x,y,z,signed_distance,cx,cy,cz,nx,ny,nz,triangle\n");
   const double to_units = 1.0 / opt.scale;
   QueryHint hint;  // consecutive points are usually close: last answer bounds the next
@@ -112,12 +107,12 @@ void run_query(const QueryOptions& opt) {
     min_distance = std::min(min_distance, s.signed_distance);
     max_distance = std::max(max_distance, s.signed_distance);
   }
-  close_checked(out, "--out", opt.out_path);
+  out_file.commit();
   const SampleSummary cost = summarize_samples(query_ns);
   const double median_ns = cost.p50;
   const double p99_ns = cost.p99;
   // The summary goes to stderr when the CSV is on stdout, so pipes stay clean.
-  std::FILE* info = out == stdout ? stderr : stdout;
+  std::FILE* info = out_file.info();
   std::fprintf(info,
                "hapsim query: %zu points vs %s (%zu triangles, method %s): %zu inside, signed "
                "distance %.4g .. %.4g mm; %.0f ns median, %.0f ns p99 per query\n",

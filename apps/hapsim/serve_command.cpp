@@ -189,7 +189,7 @@ class ServeMonitor {
   std::thread thread_;
 };
 
-void serve(const ServeArgs& args) {
+void serve(const ServeArgs& args, JsonOutput& json_out) {
   if (!(args.rate_hz >= 10.0 && args.rate_hz <= 10'000.0)) {
     throw CommandError("--rate " + std::to_string(args.rate_hz) + ": expected 10 to 10000 Hz");
   }
@@ -200,7 +200,6 @@ void serve(const ServeArgs& args) {
   const std::optional<net::LinkShimOptions> link =
       args.link_shim.empty() ? std::nullopt
                              : std::optional(net::parse_link_shim(args.link_shim, "--link-shim"));
-  JsonOutput json_out(args.json_path);
   SceneLoadOptions load_options;
   if (!args.data_dir.empty()) {
     load_options.data_dir = args.data_dir;
@@ -290,6 +289,9 @@ void serve(const ServeArgs& args) {
     std::fflush(stdout);
     if (!remote.wait_for_host(kUntilStopped_s, &stop)) {
       std::printf("stopped      before a device host joined\n");
+      json_out.write_failure("stopped by " + std::string(stop_signal_name()) +
+                             " before a device host joined");
+      exit_status() = stopped_by_signal_status();
       return;
     }
   }
@@ -364,8 +366,17 @@ void serve(const ServeArgs& args) {
     }
     j["serve"]["refused_material_changes"] = monitor.refused_material_changes();
     j["ok"] = summary.pop_throughs == 0 && summary.max_force_limit_violations == 0;
+    if (*stop_signal_name() != '\0') {
+      j["stopped_by"] = stop_signal_name();
+    }
     json_out.write(j);
   }
+  exit_status() = with_signal_status(exit_status());
+}
+
+void serve(const ServeArgs& args) {
+  JsonOutput json_out(args.json_path);
+  with_failure_json(json_out, [&] { serve(args, json_out); });
 }
 
 }  // namespace

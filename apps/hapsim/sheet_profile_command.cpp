@@ -35,14 +35,8 @@ void run_sheet_profile(const SheetProfileArgs& args) {
       throw CommandError("--force: expected newtons in [0, 1e6), got " + std::to_string(f));
     }
   }
-  std::FILE* out = stdout;
-  if (!args.out_path.empty()) {
-    out = std::fopen(args.out_path.c_str(), "w");
-    if (out == nullptr) {
-      throw CommandError("--out " + args.out_path + ": cannot open for writing (" +
-                         std::strerror(errno) + ")");
-    }
-  }
+  OutputFile out_file("--out", args.out_path);
+  std::FILE* out = out_file.get();
   // The sheet as the run builds it (a teleoperation rig adds its sheet as a body).
   const RunSetup setup = make_run_setup(load_scene(args.scene), DeviceChoice::scene_script());
   const WorldDescription& d = setup.world->description();
@@ -54,14 +48,11 @@ void run_sheet_profile(const SheetProfileArgs& args) {
     }
   }
   if (sheet_body == nullptr) {
-    if (out != stdout) {
-      std::fclose(out);
-    }
     throw CommandError(args.scene + ": no virtual sheet (a body with deformation \"sheet\")");
   }
   const GaussianSheetParams& p = sheet_body->sheet_profile;
   const GaussianSheetProfile profile(p);
-  if (out != stdout) {
+  if (!out_file.is_stdout()) {
     std::printf(
         "sheet        %s '%s': %dx%d nodes over %.0f mm; d0 %.1f mm, xi %.1f mm, F0 %.2f N/mm\n",
         args.scene.c_str(), sheet_body->name.c_str(), sheet_body->sheet.nodes_per_side,
@@ -100,7 +91,7 @@ void run_sheet_profile(const SheetProfileArgs& args) {
       }
     }
   }
-  close_checked(out, "--out", args.out_path);
+  out_file.commit();
   if (!args.out_path.empty()) {
     std::printf("written      %s\n", args.out_path.c_str());
   }

@@ -61,7 +61,11 @@ void run_simplify(const SimplifyOptions& opt) {
   const HausdorffDistance h = hausdorff_distance(result.mesh, arg.mesh);
   MeshSaveOptions save;
   save.scale = 1.0 / opt.scale;
-  save_mesh(opt.out_path, result.mesh, save);
+  try {
+    save_mesh(opt.out_path, result.mesh, save);
+  } catch (const Error& e) {
+    throw CommandError("--out " + std::string(e.what()));  // e names the path
+  }
   const MeshReport report = validate_mesh(result.mesh);
   const double to_mm = 1e3;
   std::printf("source       %s: %zu vertices, %zu triangles\n", arg.name.c_str(),

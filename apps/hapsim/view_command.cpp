@@ -3,6 +3,7 @@
 // `hapsim run SCENE --snapshot FILE.png`.
 #include "commands.h"
 #include "dds_options.h"
+#include "stop_signal.h"
 
 #include "hapsim/core/error.h"
 #include "hapsim/render/snapshot_writer.h"
@@ -111,9 +112,10 @@ void view(const ViewArgs& args) {
   o.first_screenshot = args.first_screenshot;
   o.json = args.json;
   o.quiet = args.quiet;
+  o.stop = &install_stop_signals();  // SIGINT/SIGTERM close the window as the user would
   // The scene menu offers the scene files beside the one opened.
   if (args.connect) {
-    exit_status() = run_viewer(o);
+    exit_status() = with_signal_status(run_viewer(o));
     return;
   }
   const std::filesystem::path folder = std::filesystem::path(args.scene).parent_path();
@@ -126,7 +128,7 @@ void view(const ViewArgs& args) {
     }
   }
   std::sort(o.scene_choices.begin(), o.scene_choices.end());
-  exit_status() = run_viewer(o);
+  exit_status() = with_signal_status(run_viewer(o));
 }
 
 }  // namespace

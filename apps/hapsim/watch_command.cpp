@@ -10,6 +10,7 @@
 #include "snapshot_view.h"
 #include "stop_signal.h"
 
+#include "hapsim/core/error.h"
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/loaned_reader.h"
 #include "hapsim/net/participant.h"
@@ -54,9 +55,8 @@ double peak_tool_force_n(const WorldSnapshot& s) {
   return peak;
 }
 
-void watch(const WatchArgs& args) {
+void watch(const WatchArgs& args, JsonOutput& json_out) {
   using Clock = std::chrono::steady_clock;
-  JsonOutput json_out(args.json_path);
   SessionJoin session(args.dds, args.wait_s);
   const net::SceneInfoSample* info = &session.info();
   net::LoanedReader<hapsim_msg_ViewState>& views_in = session.views();
@@ -114,19 +114,27 @@ void watch(const WatchArgs& args) {
       "saw          peak tool force %.3f N, largest deflection %.2f mm, simulation "
       "cycles %" PRIu64 " to %" PRIu64 "\n",
       peak_force_n, max_deflection_m * 1e3, first_cycle, last_cycle);
+  // The snapshot's failure is said after the JSON, which records it: a full disk must not cost
+  // the run's numbers.
+  std::string snapshot_error;
   if (!args.snapshot_path.empty()) {
     if (!at_peak) {
-      throw CommandError("--snapshot: no view arrived to draw");
+      snapshot_error = "--snapshot: no view arrived to draw";
+    } else {
+      try {
+        WorldScene scene(world);
+        scene.update(*at_peak);
+        SnapshotWriter writer(1280, 720);
+        const OrbitCamera camera =
+            chosen.value_or(framed_camera(scene.rest_bounds_world(), 1280.0 / 720.0,
+                                          snapshot_yaw_rad(world), snapshot_pitch_rad(world)));
+        writer.write_png(scene.scene(), camera, args.snapshot_path);
+        std::printf("snapshot     %s (the view at the largest force, %.3f N, t = %.3f s)\n",
+                    args.snapshot_path.c_str(), peak_force_n, at_peak->time_s);
+      } catch (const Error& e) {
+        snapshot_error = "--snapshot " + std::string(e.what());  // e names the path
+      }
     }
-    WorldScene scene(world);
-    scene.update(*at_peak);
-    SnapshotWriter writer(1280, 720);
-    const OrbitCamera camera =
-        chosen.value_or(framed_camera(scene.rest_bounds_world(), 1280.0 / 720.0,
-                                      snapshot_yaw_rad(world), snapshot_pitch_rad(world)));
-    writer.write_png(scene.scene(), camera, args.snapshot_path);
-    std::printf("snapshot     %s (the view at the largest force, %.3f N, t = %.3f s)\n",
-                args.snapshot_path.c_str(), peak_force_n, at_peak->time_s);
   }
   if (json_out) {
     nlohmann::json j;
@@ -139,12 +147,28 @@ void watch(const WatchArgs& args) {
     j["peak_force_n"] = peak_force_n;
     j["max_deflection_m"] = max_deflection_m;
     j["cycles"] = {first_cycle, last_cycle};
+    if (*stop_signal_name() != '\0') {
+      j["stopped_by"] = stop_signal_name();
+    }
+    if (!snapshot_error.empty()) {
+      j["snapshot_error"] = snapshot_error;
+    }
+    j["ok"] = views > 0 && snapshot_error.empty();
     json_out.write(j);
+  }
+  if (!snapshot_error.empty()) {
+    throw CommandError(snapshot_error);
   }
   if (views == 0) {
     std::printf("FAILED: no view arrived\n");
     exit_status() = 1;
   }
+  exit_status() = with_signal_status(exit_status());
+}
+
+void watch(const WatchArgs& args) {
+  JsonOutput json_out(args.json_path);
+  with_failure_json(json_out, [&] { watch(args, json_out); });
 }
 
 }  // namespace

@@ -115,14 +115,18 @@ void AtomicFile::flush_buffer() {
   buffer_.clear();
 }
 
-void AtomicFile::commit() {
+void AtomicFile::sync() {
   if (fd_ < 0) {
-    throw Error(path_.string(), "commit after the file was closed");
+    throw Error(path_.string(), "sync after the file was closed");
   }
   flush_buffer();
   if (!temp_.empty() && ::fsync(fd_) != 0) {
     fail("fsync failed", errno);
   }
+}
+
+void AtomicFile::commit() {
+  sync();
   const int fd = std::exchange(fd_, -1);
   if (::close(fd) != 0) {
     fail("write failed on close", errno);

@@ -30,6 +30,9 @@ class AtomicFile {
 
   /// Appends `bytes` (buffered). Throws hapsim::Error naming the path on a failed write.
   void write(std::string_view bytes);
+  /// Writes out what is buffered and fsyncs it, short of the rename: a caller with several files
+  /// that belong together syncs them all before it commits any. Throws hapsim::Error on failure.
+  void sync();
   /// Flushes, fsyncs and closes the temporary and renames it over the target (then fsyncs the
   /// folder, so the rename itself survives a power cut). Throws hapsim::Error on any failure,
   /// leaving the target as it was.

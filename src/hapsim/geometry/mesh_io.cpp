@@ -1,5 +1,6 @@
 #include "hapsim/geometry/mesh_io.h"
 
+#include "hapsim/core/atomic_file.h"
 #include "hapsim/core/error.h"
 #include "hapsim/core/isolated_call.h"
 
@@ -7,6 +8,8 @@
 #include <assimp/scene.h>
 #include <spdlog/spdlog.h>
 #include <assimp/Exporter.hpp>
+#include <assimp/IOStream.hpp>
+#include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 
 #include <algorithm>
@@ -402,6 +405,88 @@ TriangleMesh finish_imported_mesh(TriangleMesh mesh, std::size_t skipped_primiti
   return mesh;
 }
 
+namespace {
+
+// Assimp's exporters write through an IOSystem; this one gathers each file in memory and writes it
+// atomically when the exporter lets go of it (core/atomic_file.h): Assimp's own file writer does not
+// check its writes, so a full disk gave "success" and a truncated mesh. An exporter may write
+// more than one file (OBJ's .mtl) and may seek back (binary glTF's header).
+struct ExportFailure {
+  std::string file;     // the first file that could not be written, "" when all were
+  std::string message;  // why
+};
+
+// Written when the exporter lets go of it: most exporters hold their stream in a unique_ptr and
+// never call IOSystem::Close.
+class MemoryStream final : public Assimp::IOStream {
+ public:
+  MemoryStream(std::string path, ExportFailure& failure)
+      : path_(std::move(path)), failure_(failure) {}
+  MemoryStream(const MemoryStream&) = delete;
+  MemoryStream& operator=(const MemoryStream&) = delete;
+  ~MemoryStream() override {
+    if (!failure_.file.empty()) {
+      return;  // one failure is said; later files are not written
+    }
+    try {
+      write_file_atomically(path_, bytes_);
+    } catch (const Error& e) {
+      failure_.file = path_;
+      failure_.message = e.detail();
+    } catch (const std::exception& e) {
+      failure_.file = path_;
+      failure_.message = e.what();
+    }
+  }
+  size_t Read(void* /*buffer*/, size_t /*size*/, size_t /*count*/) override { return 0; }
+  size_t Write(const void* buffer, size_t size, size_t count) override {
+    const std::size_t n = size * count;
+    if (at_ + n > bytes_.size()) {
+      bytes_.resize(at_ + n);
+    }
+    std::memcpy(bytes_.data() + at_, buffer, n);
+    at_ += n;
+    return count;
+  }
+  aiReturn Seek(size_t offset, aiOrigin origin) override {
+    const std::size_t base =
+        origin == aiOrigin_SET ? 0 : origin == aiOrigin_CUR ? at_ : bytes_.size();
+    at_ = base + offset;  // past the end, as a file allows (binary glTF skips its header first)
+    if (at_ > bytes_.size()) {
+      bytes_.resize(at_);
+    }
+    return aiReturn_SUCCESS;
+  }
+  [[nodiscard]] size_t Tell() const override { return at_; }
+  [[nodiscard]] size_t FileSize() const override { return bytes_.size(); }
+  void Flush() override {}
+
+ private:
+  std::string path_;
+  ExportFailure& failure_;
+  std::string bytes_;
+  std::size_t at_ = 0;
+};
+
+class AtomicExportSystem final : public Assimp::IOSystem {
+ public:
+  explicit AtomicExportSystem(ExportFailure& failure) : failure_(failure) {}
+  bool Exists(const char* file) const override { return fs::exists(file); }
+  [[nodiscard]] char getOsSeparator() const override { return '/'; }
+  Assimp::IOStream* Open(const char* file, const char* mode) override {
+    if (mode == nullptr || std::strchr(mode, 'w') == nullptr) {
+      return nullptr;  // exporters only write
+    }
+    return new MemoryStream(file, failure_);  // NOLINT(cppcoreguidelines-owning-memory)
+  }
+  void Close(Assimp::IOStream* stream) override { delete stream; }
+
+ private:
+  ExportFailure& failure_;
+};
+
+}  // namespace
+
 void save_mesh(const fs::path& path, const TriangleMesh& mesh, const MeshSaveOptions& options) {
   const std::string where = path.string();
   const std::string ext = lower_extension(path);
@@ -460,9 +545,15 @@ void save_mesh(const fs::path& path, const TriangleMesh& mesh, const MeshSaveOpt
     face.mIndices = new unsigned[3]{tri[0], tri[1], tri[2]};
   }
 
+  ExportFailure failure;
   Assimp::Exporter exporter;
+  exporter.SetIOHandler(new AtomicExportSystem(failure));  // the exporter owns and deletes it
   if (exporter.Export(scene.get(), format, where) != aiReturn_SUCCESS) {
     throw Error(where, std::string("cannot write mesh: ") + exporter.GetErrorString());
+  }
+  if (!failure.file.empty()) {
+    // An exporter's second file (OBJ's .mtl) is named; the mesh file itself is the `where`.
+    throw Error(where, (failure.file == where ? "" : failure.file + ": ") + failure.message);
   }
 }
 

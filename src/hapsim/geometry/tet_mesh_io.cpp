@@ -1,5 +1,6 @@
 #include "hapsim/geometry/tet_mesh_io.h"
 
+#include "hapsim/core/atomic_file.h"
 #include "hapsim/core/error.h"
 #include "hapsim/core/text_file.h"
 
@@ -1067,14 +1068,6 @@ TetMesh parse_vtk_unstructured(std::string_view text, std::string_view source) {
 }
 
 void write_tetgen(const TetMesh& mesh, const std::filesystem::path& path_without_extension) {
-  const auto write = [](const std::filesystem::path& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-    out.flush();
-    if (!out) {
-      throw Error(path.string(), "cannot write the file");
-    }
-  };
   std::string node = std::to_string(mesh.node_count()) + " 3 0 0\n";
   char line[128];
   for (std::size_t i = 0; i < mesh.node_count(); ++i) {
@@ -1089,23 +1082,21 @@ void write_tetgen(const TetMesh& mesh, const std::filesystem::path& path_without
                   mesh.region(t));
     ele += line;
   }
-  // Both to temporary names first, then renamed: a failed write never leaves a new .node
-  // beside an old .ele (a pair that could load as a wrong mesh).
+  // Both written to temporaries (core/atomic_file.h) before either is moved into place: a failed
+  // write never leaves a new .node beside an old .ele (a pair that could load as a wrong mesh).
   const auto with = [&](const char* ext) {
     std::filesystem::path p = path_without_extension;
     p += ext;
     return p;
   };
-  write(with(".node.tmp"), node);
-  write(with(".ele.tmp"), ele);
-  std::error_code ec;
-  std::filesystem::rename(with(".node.tmp"), with(".node"), ec);
-  if (!ec) {
-    std::filesystem::rename(with(".ele.tmp"), with(".ele"), ec);
-  }
-  if (ec) {
-    throw Error(with(".node").string(), "cannot move the written file into place: " + ec.message());
-  }
+  AtomicFile node_file(with(".node"));
+  AtomicFile ele_file(with(".ele"));
+  node_file.write(node);
+  ele_file.write(ele);
+  node_file.sync();
+  ele_file.sync();
+  node_file.commit();
+  ele_file.commit();
 }
 
 TetMesh read_vtk_unstructured(const std::filesystem::path& path) {

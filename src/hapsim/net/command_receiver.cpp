@@ -1,5 +1,6 @@
 #include "hapsim/net/command_receiver.h"
 
+#include "hapsim/net/command_reply.h"
 #include "hapsim/world/world.h"
 
 #include <cinttypes>
@@ -9,17 +10,33 @@ namespace hapsim::net {
 
 CommandReceiver::CommandReceiver(const Participant& participant, const World& world,
                                  std::uint64_t scene_hash, std::uint64_t serve_id)
-    : reader_(participant), gate_(scene_hash, serve_id, world.description().materials.size()) {
+    : reader_(participant),
+      replies_(participant),
+      serve_id_(serve_id),
+      gate_(scene_hash, serve_id, world.description().materials.size()) {
   for (const MaterialDescription& m : world.description().materials) {
     materials_.push_back(m.contact);
   }
 }
 
 CommandEvent CommandReceiver::receive(const hapsim_msg_Command& m, WorldHapticClient& client) {
+  CommandEvent event = act(m, client);
+  CommandReplySample reply;
+  reply.issuer_id = m.issuer_id;
+  reply.command_sequence = m.command_sequence;
+  reply.serve_id = serve_id_;
+  reply.accepted = event.verdict == SampleVerdict::kAccepted && event.applied;
+  reply.reason = event.reason;
+  (void)replies_.write(encode_command_reply(reply));  // a lost reply: the issuer times out
+  return event;
+}
+
+CommandEvent CommandReceiver::act(const hapsim_msg_Command& m, WorldHapticClient& client) {
   CommandEvent event;
   event.issuer_id = m.issuer_id;
   event.verdict = gate_.admit(m, event.command);
   if (event.verdict != SampleVerdict::kAccepted) {
+    event.reason = gate_.explain(m, event.verdict);
     return event;
   }
   switch (event.command.kind) {
@@ -40,6 +57,7 @@ CommandEvent CommandReceiver::receive(const hapsim_msg_Command& m, WorldHapticCl
         current = event.material;
       } else {
         ++not_applied_;
+        event.reason = "not applied: too many changes at once";
       }
       break;
     }
@@ -53,7 +71,7 @@ std::string describe_command_event(const CommandEvent& event,
   std::snprintf(issuer, sizeof issuer, "%08" PRIx64, event.issuer_id >> 32U);
   std::string line = std::string(command_name(event.command.kind)) + " from " + issuer;
   if (event.verdict != SampleVerdict::kAccepted) {
-    return "refused a command from " + std::string(issuer) + ": " + verdict_name(event.verdict);
+    return "refused a command from " + std::string(issuer) + ": " + event.reason;
   }
   if (event.command.kind == SessionCommandKind::kSetMaterial) {
     const ContactMaterial& c = event.material;

@@ -8,6 +8,7 @@
 #include "hapsim/net/participant.h"
 #include "hapsim/net/session_command.h"
 #include "hapsim/net/topic_reader.h"
+#include "hapsim/net/topic_writer.h"
 #include "hapsim/runtime/world_haptic_client.h"
 
 #include <cstdint>
@@ -25,6 +26,8 @@ struct CommandEvent {
   bool applied = false;
   /// The material's values asked for (kSetMaterial), with the fields not set kept.
   ContactMaterial material;
+  /// Why it was refused or not applied ("" when applied), as the issuer's reply says it.
+  std::string reason;
 };
 
 class CommandReceiver {
@@ -34,7 +37,8 @@ class CommandReceiver {
                   std::uint64_t serve_id);
 
   /// Takes what arrived (nothing while `client` is null: commands wait in the reader until the
-  /// loop runs) and acts on each accepted command; calls on_event(const CommandEvent&) for each.
+  /// loop runs), acts on each accepted command, answers each issuer (net/command_reply.h:
+  /// accepted, or refused and why) and calls on_event(const CommandEvent&) for each.
   template <typename OnEvent>
   void poll(WorldHapticClient* client, OnEvent&& on_event) {
     if (client == nullptr) {
@@ -51,8 +55,11 @@ class CommandReceiver {
 
  private:
   CommandEvent receive(const hapsim_msg_Command& m, WorldHapticClient& client);
+  CommandEvent act(const hapsim_msg_Command& m, WorldHapticClient& client);
 
   TopicReader<hapsim_msg_Command> reader_;
+  TopicWriter<hapsim_msg_CommandReply> replies_;
+  std::uint64_t serve_id_;
   CommandGate gate_;
   std::vector<ContactMaterial> materials_;  ///< as last asked for, per material
   std::uint64_t not_applied_ = 0;

@@ -38,6 +38,8 @@ class CommandSender {
   }
   [[nodiscard]] std::uint32_t matched_hosts() const { return writer_.matched_readers(); }
   [[nodiscard]] std::uint64_t issuer_id() const noexcept { return issuer_id_; }
+  /// The sequence number of the last command sent (its reply carries it).
+  [[nodiscard]] std::uint64_t sequence() const noexcept { return sequence_; }
 
  private:
   TopicWriter<hapsim_msg_Command> writer_;

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace hapsim::net {
@@ -159,6 +160,64 @@ SampleVerdict CommandGate::admit(const hapsim_msg_Command& message, SessionComma
     out.contact.dynamic_friction = message.dynamic_friction;
   }
   return verdict;
+}
+
+std::string CommandGate::explain(const hapsim_msg_Command& m, SampleVerdict verdict) const {
+  const std::string name = verdict_name(verdict);
+  if (verdict == SampleVerdict::kAccepted) {
+    return "";
+  }
+  const auto kind = static_cast<SessionCommandKind>(m.kind);
+  if (!command_kind(command_name(kind))) {
+    return name + ": unknown command kind " + std::to_string(m.kind);
+  }
+  if (kind == SessionCommandKind::kSetMaterial &&
+      (verdict == SampleVerdict::kMalformed || verdict == SampleVerdict::kOutOfRange)) {
+    namespace f = material_field;
+    if (m.material >= material_count_) {
+      return name + ": material " + std::to_string(m.material) + " (the scene has " +
+             std::to_string(material_count_) + ")";
+    }
+    if (m.material_fields == 0 || (m.material_fields & ~f::kAll) != 0) {
+      return name + ": no known contact value set";
+    }
+    struct Field {
+      std::uint16_t bit;
+      const char* what;
+      double value;
+      double limit;
+      const char* unit;
+    };
+    const std::array<Field, 6> fields{{
+        {f::kStiffness, "stiffness", m.stiffness_n_per_m, limits_.max_stiffness_n_per_m, " N/m"},
+        {f::kMaxPenetration, "max depth", m.max_penetration_m, limits_.max_penetration_m, " m"},
+        {f::kMaxForce, "max force", m.max_force_n, limits_.max_force_n, " N"},
+        {f::kDamping, "damping", m.damping_n_s_per_m, limits_.max_damping_n_s_per_m, " N s/m"},
+        {f::kStaticFriction, "static friction", m.static_friction, limits_.max_friction, ""},
+        {f::kDynamicFriction, "dynamic friction", m.dynamic_friction, limits_.max_friction, ""},
+    }};
+    for (const Field& field : fields) {
+      if ((m.material_fields & field.bit) != 0 &&
+          check_value(true, field.value, field.limit) != ValueCheck::kOk) {
+        char line[160];
+        std::snprintf(line, sizeof line, "%s: %s %.6g%s is not within 0 .. %.6g%s", name.c_str(),
+                      field.what, field.value, field.unit, field.limit, field.unit);
+        return line;
+      }
+    }
+  }
+  switch (verdict) {
+    case SampleVerdict::kOtherScene:
+      return name + ": the command was made for another scene";
+    case SampleVerdict::kStale:
+      return name + ": the command was meant for an earlier start of this host";
+    case SampleVerdict::kOutOfOrder:
+      return name + ": not newer than this issuer's last command";
+    case SampleVerdict::kOutOfRange:
+      return name + ": too many issuers (" + std::to_string(limits_.max_issuers) + ")";
+    default:
+      return name;
+  }
 }
 
 }  // namespace hapsim::net

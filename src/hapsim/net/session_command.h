@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 #include <unordered_map>
 
@@ -84,6 +85,10 @@ class CommandGate {
   /// issuer too many), other scene, stale (meant for another start of the host), out of order
   /// (not newer than the issuer's newest accepted). On kAccepted `out` holds the command.
   SampleVerdict admit(const hapsim_msg_Command& message, SessionCommand& out);
+
+  /// Why `message` got `verdict`, in words for the issuer ("out of range: stiffness 1e+09 N/m is
+  /// beyond 0 .. 1e+06 N/m"); "" for kAccepted. Call before admit() counts a later command.
+  [[nodiscard]] std::string explain(const hapsim_msg_Command& message, SampleVerdict verdict) const;
 
   [[nodiscard]] const VerdictCounts& counts() const noexcept { return counts_; }
   [[nodiscard]] std::uint64_t count(SampleVerdict verdict) const noexcept {

@@ -48,6 +48,13 @@ struct TopicTraits<hapsim_msg_Command> {
   static constexpr QosProfile kQos = QosProfile::kCommand;
 };
 
+template <>
+struct TopicTraits<hapsim_msg_CommandReply> {
+  static const dds_topic_descriptor_t& descriptor() { return hapsim_msg_CommandReply_desc; }
+  static constexpr const char* kName = "hapsim_command_reply";
+  static constexpr QosProfile kQos = QosProfile::kCommand;
+};
+
 /// The topic of message type T in `participant`'s domain with `qos` (a reader's and a writer's
 /// QoS must match the topic's). Throws hapsim::Error naming the topic when Cyclone refuses.
 template <typename T>

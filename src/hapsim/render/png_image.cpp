@@ -1,5 +1,6 @@
 #include "hapsim/render/png_image.h"
 
+#include "hapsim/core/atomic_file.h"
 #include "hapsim/core/error.h"
 
 // The stb implementations live in this translation unit only.
@@ -26,6 +27,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <string>
 
 namespace hapsim {
 
@@ -41,9 +43,17 @@ void write_png(const std::string& path, int width, int height, std::span<const s
                           std::to_string(width) + "x" + std::to_string(height) + ", got " +
                           std::to_string(rgba.size()));
   }
-  if (stbi_write_png(path.c_str(), width, height, 4, rgba.data(), width * 4) == 0) {
-    throw Error(path, "cannot write the PNG file (missing folder or no permission?)");
+  // Encoded in memory, then written atomically: stbi_write_png's own file writes are not checked
+  // (a full disk gave a success and a 0-byte file), and a failed write keeps the old picture.
+  std::string png;
+  const auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data),
+                                               static_cast<std::size_t>(size));
+  };
+  if (stbi_write_png_to_func(append, &png, width, height, 4, rgba.data(), width * 4) == 0) {
+    throw Error(path, "cannot encode the PNG");
   }
+  write_file_atomically(path, png);
 }
 
 RgbaImage read_png(const std::string& path) {

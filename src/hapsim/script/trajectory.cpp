@@ -1,5 +1,6 @@
 #include "hapsim/script/trajectory.h"
 
+#include "hapsim/core/atomic_file.h"
 #include "hapsim/core/error.h"
 #include "hapsim/core/text_file.h"
 
@@ -468,15 +469,7 @@ std::string format_trajectory_csv(const Trajectory& trajectory) {
 }
 
 void save_trajectory_csv(const Trajectory& trajectory, const std::filesystem::path& path) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (!out) {
-    throw Error(path.string(), "cannot create trajectory file");
-  }
-  out << format_trajectory_csv(trajectory);
-  out.flush();
-  if (!out) {
-    throw Error(path.string(), "cannot write trajectory file");
-  }
+  write_file_atomically(path, format_trajectory_csv(trajectory));
 }
 
 }  // namespace hapsim

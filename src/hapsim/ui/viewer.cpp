@@ -1,5 +1,6 @@
 #include "hapsim/ui/viewer.h"
 
+#include "hapsim/core/atomic_file.h"
 #include "hapsim/core/error.h"
 #include "hapsim/core/leak_check.h"
 #include "hapsim/core/statistics.h"
@@ -257,7 +258,8 @@ class Viewer {
       const double dt_s = std::chrono::duration<double>(now - last).count();
       last = now;
       const double elapsed_s = std::chrono::duration<double>(now - start).count();
-      if (options_.duration_s > 0.0 && elapsed_s >= options_.duration_s) {
+      if ((options_.duration_s > 0.0 && elapsed_s >= options_.duration_s) ||
+          (options_.stop != nullptr && options_.stop->load(std::memory_order_relaxed))) {
         break;
       }
       glfwPollEvents();
@@ -867,11 +869,7 @@ class Viewer {
       j["max_deflection_m"] = peak_deflection_m_;
       j["warnings"] = warnings_;
       j["ok"] = ok;
-      std::ofstream out(options_.json);
-      out << j.dump(2) << '\n';
-      if (!out) {
-        throw Error(options_.json.string(), "cannot write the viewer's JSON summary");
-      }
+      write_file_atomically(options_.json, j.dump(2) + '\n');
     }
     return ok ? 0 : 1;
   }

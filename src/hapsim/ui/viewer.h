@@ -16,6 +16,7 @@
 #include "hapsim/render/stereo.h"
 #include "hapsim/ui/viewer_session.h"
 
+#include <atomic>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -55,6 +56,9 @@ struct ViewerOptions {
   bool contact_vertices_overlay = false;
   /// Close after this many seconds (0: when the window is closed).
   double duration_s = 0.0;
+  /// Close when this becomes true (set by a signal handler: SIGINT/SIGTERM), as if the window
+  /// were closed: the haptic loop stops (zero force) and the screenshot and JSON are written.
+  const std::atomic<bool>* stop = nullptr;
   /// Write the last frame (the whole window) to this PNG when closing.
   std::filesystem::path screenshot;
   /// Also write the first complete frame here.
