@@ -81,9 +81,9 @@ TEST_F(FullDisk, DevFullFailsEveryJsonAndCsvWriter) {
       run_limited("calibrate glove " + (glove / "raw_procedure.csv").string() + " --procedure " +
                   (glove / "procedure.json").string() + " --out /dev/full"),
       "--out", full);
-  expect_full_disk_line(run_limited("bench soak --scenes " + kScenes +
-                                    "teleop.json --minutes 0.1 --json /dev/full"),
-                        "--json", full);
+  expect_full_disk_line(
+      run_limited("bench soak --scenes " + kScenes + "teleop.json --minutes 0.1 --json /dev/full"),
+      "--json", full);
   EXPECT_TRUE(fs::is_character_file(full));  // written in place, never renamed over
 }
 

@@ -408,8 +408,8 @@ TriangleMesh finish_imported_mesh(TriangleMesh mesh, std::size_t skipped_primiti
 namespace {
 
 // Assimp's exporters write through an IOSystem; this one gathers each file in memory and writes it
-// atomically when the exporter lets go of it (core/atomic_file.h): Assimp's own file writer does not
-// check its writes, so a full disk gave "success" and a truncated mesh. An exporter may write
+// atomically when the exporter lets go of it (core/atomic_file.h): Assimp's own file writer does
+// not check its writes, so a full disk gave "success" and a truncated mesh. An exporter may write
 // more than one file (OBJ's .mtl) and may seek back (binary glTF's header).
 struct ExportFailure {
   std::string file;     // the first file that could not be written, "" when all were
@@ -449,8 +449,9 @@ class MemoryStream final : public Assimp::IOStream {
     return count;
   }
   aiReturn Seek(size_t offset, aiOrigin origin) override {
-    const std::size_t base =
-        origin == aiOrigin_SET ? 0 : origin == aiOrigin_CUR ? at_ : bytes_.size();
+    const std::size_t base = origin == aiOrigin_SET   ? 0
+                             : origin == aiOrigin_CUR ? at_
+                                                      : bytes_.size();
     at_ = base + offset;  // past the end, as a file allows (binary glTF skips its header first)
     if (at_ > bytes_.size()) {
       bytes_.resize(at_);
