@@ -10,6 +10,7 @@
 #include "snapshot_view.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/printable_text.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/render/assessment_markers.h"
 #include "hapsim/render/force_scale.h"
@@ -37,6 +38,9 @@
 #ifndef HAPSIM_ASSESSMENT_REPORT_SCRIPT
 #define HAPSIM_ASSESSMENT_REPORT_SCRIPT ""
 #endif
+#ifndef HAPSIM_SCENES_DIR
+#define HAPSIM_SCENES_DIR "scenes"
+#endif
 
 namespace hapsim::app {
 namespace {
@@ -52,8 +56,24 @@ struct AssessArgs {
   bool summary = false;
 };
 
-// The scene a recording was made on: --scene, else the path its header gives (as given, from
-// here; else resolved when it was recorded).
+// Whether `path` (canonical) lies in `root` or a folder below it.
+bool lies_under(const fs::path& path, const fs::path& root) {
+  std::error_code ec;
+  const fs::path canonical_root = fs::canonical(root, ec);
+  if (ec) {
+    return false;
+  }
+  const auto [root_end, path_end] =
+      std::mismatch(canonical_root.begin(), canonical_root.end(), path.begin(), path.end());
+  return root_end == canonical_root.end();
+}
+
+// The scene a recording was made on: --scene (the user's choice, opened like any path given on
+// the command line), else the path its header gives (as given, from here; else resolved when it
+// was recorded). The header is data anyone can write, so the scene it names is followed only to
+// a regular .json file that lies, symbolic links resolved, below the recording's own folder or a
+// scenes/ folder (the project's, or the one in the folder hapsim runs in): a crafted header
+// cannot make assess open /etc/passwd or a key file and echo bits of it.
 fs::path scene_of(const std::string& recording, const RecordingHeader& header,
                   const std::string& scene_option) {
   if (!scene_option.empty()) {
@@ -65,15 +85,33 @@ fs::path scene_of(const std::string& recording, const RecordingHeader& header,
                        ", or a session built in code): give --scene FILE");
   }
   std::error_code ec;
-  if (!header.scene_path.empty() && fs::is_regular_file(header.scene_path, ec)) {
-    return header.scene_path;
+  const std::vector<fs::path> roots = {
+      fs::absolute(recording, ec).parent_path(),
+      HAPSIM_SCENES_DIR,
+      fs::current_path(ec) / "scenes",
+  };
+  std::string refused;
+  for (const std::string* named : {&header.scene_path, &header.scene_path_absolute}) {
+    if (named->empty() || !fs::is_regular_file(*named, ec)) {
+      continue;
+    }
+    const fs::path canonical = fs::canonical(*named, ec);
+    if (!ec && canonical.extension() == ".json" &&
+        std::any_of(roots.begin(), roots.end(),
+                    [&](const fs::path& root) { return lies_under(canonical, root); })) {
+      return *named;
+    }
+    refused = *named;
   }
-  if (!header.scene_path_absolute.empty() && fs::is_regular_file(header.scene_path_absolute, ec)) {
-    return header.scene_path_absolute;
+  if (!refused.empty()) {
+    throw CommandError(recording + ": its header names the scene '" + printable_text(refused) +
+                       "', which is not a .json file below the recording's folder or a scenes/ "
+                       "folder: not opened (give --scene FILE if it is the scene)");
   }
-  throw CommandError(recording + ": its scene " +
-                     (header.scene_path.empty() ? header.scene_path_absolute : header.scene_path) +
-                     " is not there (nor " + header.scene_path_absolute + "): give --scene FILE");
+  const std::string& named =
+      header.scene_path.empty() ? header.scene_path_absolute : header.scene_path;
+  throw CommandError(recording + ": its scene '" + printable_text(named) + "' is not there (nor '" +
+                     printable_text(header.scene_path_absolute) + "'): give --scene FILE");
 }
 
 // The end of the session, framed on the landmarks and breaches (with a margin), from the scene's
@@ -195,7 +233,8 @@ Assessed assess_one(const std::string& recording, const AssessArgs& args,
       return assess_recording(recording, std::move(scene));
     } catch (const Error& e) {
       if (std::string(e.where()) == recording) {
-        throw CommandError(std::string(e.what()) + " (the scene: " + scene_file.string() + ")");
+        throw CommandError(std::string(e.what()) +
+                           " (the scene: " + printable_text(scene_file.string(), 4096) + ")");
       }
       throw;
     }

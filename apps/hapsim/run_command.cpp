@@ -5,6 +5,7 @@
 #include "json_output.h"
 #include "progress_printer.h"
 #include "snapshot_view.h"
+#include "stop_signal.h"
 
 #include "hapsim/core/error.h"
 #include "hapsim/core/stopwatch.h"
@@ -23,6 +24,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -339,7 +341,7 @@ void run(const RunArgs& args) {
   std::unique_ptr<World>& world = setup.world;
   std::unique_ptr<Device>& device = setup.device;
   const std::string& device_name = setup.device_name;
-  const std::optional<Recording>& replayed = setup.replayed;
+  const std::optional<RecordingScan>& replayed = setup.replayed;
   const bool teleop = world->rig() != nullptr;
   if (teleop) {
     const RigState& rig = *world->rig();
@@ -398,6 +400,13 @@ void run(const RunArgs& args) {
                   ("hapsim_replay_" + std::to_string(::getpid()) + ".rec");
     temporary_record = true;
   }
+  // SIGINT and SIGTERM from here on stop the run as its end would: the loop stops (the device
+  // gets a zero command), then the summary, the JSON and the recording's end are written, and
+  // the exit status is 128 + the signal. (Before this a signal ends the program at once: nothing
+  // has been written yet.)
+  const std::atomic<bool>& stop = install_stop_signals();
+  // The recorder is flushed every 100 ms of the run, off the haptic thread (session.cpp): a
+  // killed run keeps all but its last 100 ms. 8192 frames of buffer: slack for a slow disk.
   std::unique_ptr<SessionRecorder> recorder;
   if (!record_path.empty()) {
     recorder = std::make_unique<SessionRecorder>(record_path, world->content_hash(), 8192,
@@ -446,22 +455,30 @@ void run(const RunArgs& args) {
   options.recorder = recorder.get();
   options.progress = progress;
   options.teleop_target_world = setup.teleop_target_world;
+  options.stop = &stop;
   const SessionSummary summary = run_session(*world, *device, options);
+  const int stopped_by = stop.load() ? stop_signal_number().load() : 0;
   if (recorder) {
     recorder->close();
   }
   std::cout << format_session_summary(summary);
+  if (stopped_by != 0) {
+    std::printf(
+        "interrupted  by %s after %.3f of %.3f s: the summary and what is written below cover "
+        "the run so far\n",
+        stop_signal_name(), summary.simulated_s, duration_s);
+  }
   if (snapshots) {
     snapshots->final(*world);
   }
 
   std::optional<RecordingDifference> replay_difference;
   if (replayed) {
-    const Recording again = read_recording(record_path);
-    replay_difference = compare_recordings(*replayed, again);
+    // Frame by frame from both files: memory does not grow with the recording.
+    replay_difference = compare_recording_files(setup.replayed_file, record_path);
     if (replay_difference->identical) {
       std::printf("replay       identical to %s, bit for bit (%zu frames)\n",
-                  args.replay_path.c_str(), again.frames.size());
+                  args.replay_path.c_str(), replayed->frames);
     } else {
       std::printf("replay       DIFFERS from %s: %s\n", args.replay_path.c_str(),
                   replay_difference->message.c_str());
@@ -477,14 +494,20 @@ void run(const RunArgs& args) {
   for (const std::string& failure : run_failures(setup, summary)) {
     std::printf("FAILED: %s\n", failure.c_str());
   }
-  const nlohmann::json j =
+  nlohmann::json j =
       run_summary_json(setup, summary, replay_difference ? &*replay_difference : nullptr);
   const bool failed = !j["ok"].get<bool>();
+  if (stopped_by != 0) {                   // "interrupted": true says it too (run_summary_json)
+    j["stopped_by"] = stop_signal_name();  // as watch, serve and device say it
+  }
   if (json_out) {
     json_out.write(j);
   }
   if (failed) {
     exit_status() = 1;
+  }
+  if (stopped_by != 0) {
+    exit_status() = stopped_by_signal_status();  // 128 + the signal, as a shell reports it
   }
 }
 

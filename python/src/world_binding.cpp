@@ -6,6 +6,7 @@
 
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/device/force_safety.h"
+#include "hapsim/device/input_check.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/runtime/cycle_record.h"
 #include "hapsim/scene/run_setup.h"
@@ -126,6 +127,13 @@ void step(PyWorld& w, const DeviceInput& input, std::optional<double> dt_s) {
   if (!(dt > 0.0) || !std::isfinite(dt)) {
     throw Error("dt", "expected seconds > 0");
   }
+  // Refused where it enters: a NaN or inf input would poison the world and the recording (whose
+  // readers refuse a file holding one). hapsim.Error is a ValueError.
+  if (const std::string bad = nonfinite_input_field(input); !bad.empty()) {
+    throw Error("World.step(input)", "input." + bad +
+                                         ": device input must be finite (nothing was stepped "
+                                         "or recorded)");
+  }
   const StepResult& result = w.world().step(input, dt);
   if (w.recorder) {
     // What run_session records: the world's command clamped to the device (clamp_command).
@@ -135,6 +143,9 @@ void step(PyWorld& w, const DeviceInput& input, std::optional<double> dt_s) {
       throw Error(w.recorder->path().string(), "recording failed: " + w.recorder->last_error());
     }
     ++w.recorded_cycles;
+    if (w.recorder->flush_due()) {
+      w.recorder->flush();  // every 100 ms of the session: a killed interpreter keeps the rest
+    }
   }
 }
 

@@ -65,3 +65,40 @@ def test_a_python_recording_replays_through_the_cli(tmp_path, hapsim_bin):
     cli = run_cli(hapsim_bin, "run", KNEE, "--replay", rec, "-q")
     assert cli.returncode == 0, cli.stdout + cli.stderr
     assert "identical" in cli.stdout
+
+
+def test_a_non_finite_input_is_refused_and_never_recorded(tmp_path):
+    """A NaN or inf device input through World.step raises ValueError naming the field; the
+    world is not stepped and the recording keeps the good frames only (it reads back whole)."""
+    world = hapsim.World(str(KNEE))
+    rec = tmp_path / "nan.rec"
+    world.record(str(rec))
+    good = world.script_input(0.0)
+    for _ in range(10):
+        world.step(good)
+    bad_inputs = {
+        "input.p_world[1] is nan": hapsim.DeviceInput(p_world=(0.0, float("nan"), 0.0)),
+        "input.time_s is -inf": hapsim.DeviceInput(time_s=float("-inf")),
+        "input.finger_rad[1] is nan": hapsim.DeviceInput(finger_rad=(0.1, float("nan"))),
+    }
+    for field, bad in bad_inputs.items():
+        time_before = world.time_s
+        try:
+            world.step(bad)
+        except ValueError as e:
+            assert field in str(e), str(e)
+        else:
+            raise AssertionError(f"World.step accepted {field}")
+        assert world.time_s == time_before  # not stepped
+    # DeviceInput itself refuses a quaternion that is not unit (an inf one included).
+    try:
+        hapsim.DeviceInput(q_world=(float("inf"), 0.0, 0.0, 0.0))
+    except ValueError as e:
+        assert "q_world" in str(e), str(e)
+    else:
+        raise AssertionError("DeviceInput accepted an inf quaternion")
+    world.step(good)
+    assert world.stop_recording() == 11
+    recorded = hapsim.read_recording(str(rec))
+    assert len(recorded) == 11
+    assert np.isfinite(recorded.p_world).all()

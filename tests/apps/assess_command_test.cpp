@@ -3,6 +3,8 @@
 // whose force k·depth is analytic); the report folder gets its three files and the report page; a
 // missing scene, a scene without an assessment, a recording of another scene and a bad definition
 // are each one line with exit status 2.
+#include "hapsim/device/recording.h"
+
 #include <nlohmann/json.hpp>
 
 #include "hapsim_process.h"
@@ -206,6 +208,56 @@ TEST(AssessCommand, BadInputIsOneLineAndExitTwo) {
         run_hapsim("assess " + rec.recording.string() + " " + rec.recording.string());
     EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_NE(r.output.find("--summary"), std::string::npos) << r.output;
+  }
+}
+
+// A recording's header is data anyone can write: the scene it names is followed only to a .json
+// file below the recording's folder or a scenes/ folder. A header naming /etc/passwd, or a real
+// scene elsewhere, is refused with one line (nothing of the file echoed), and the header's text is
+// printed with control characters escaped (no terminal escape sequence reaches the screen).
+TEST(AssessCommand, AHeaderIsNotAPathToFollow) {
+  // A recording whose header names `scene_path` (its frames never matter: it is refused first).
+  const auto crafted = [](const std::string& name, const std::string& scene_path) {
+    const fs::path rec = temp_path(name);
+    hapsim::SessionRecorder recorder(rec, "crafted", 4,
+                                     hapsim::SessionRecorder::Overflow::kFlushInline, scene_path);
+    EXPECT_TRUE(recorder.record(hapsim::RecordedFrame{}));
+    recorder.close();
+    return rec;
+  };
+  {
+    const fs::path rec = crafted("assess_passwd.rec", "/etc/passwd");
+    const RunResult r = run_hapsim("assess " + rec.string());
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_TRUE(one_line(r.output)) << r.output;
+    EXPECT_NE(r.output.find("'/etc/passwd'"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("not opened (give --scene FILE"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("root:"), std::string::npos) << r.output;  // nothing of it read
+  }
+  {  // A real scene, but in a folder above the recording's: refused too.
+    const Recorded real = record_press("assess_elsewhere");
+    const fs::path below = temp_path("assess_below");
+    fs::create_directories(below);
+    const fs::path moved = below / "session.rec";
+    fs::copy_file(real.recording, moved, fs::copy_options::overwrite_existing);
+    const RunResult r = run_hapsim("assess " + moved.string());
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_TRUE(one_line(r.output)) << r.output;
+    EXPECT_NE(r.output.find("not opened"), std::string::npos) << r.output;
+    // Given on the command line it is the user's choice, and assessed.
+    const RunResult given =
+        run_hapsim("assess " + moved.string() + " --scene " + real.scene.string());
+    EXPECT_EQ(given.exit_code, 0) << given.output;
+  }
+  {  // Escape codes in the header's path are printed escaped.
+    const fs::path rec = crafted("assess_escape.rec", "/nowhere/\x1b]0;owned\x07\x1b[2J.json");
+    const RunResult r = run_hapsim("assess " + rec.string());
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_TRUE(one_line(r.output)) << r.output;
+    EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find('\x07'), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("/nowhere/\\x1b]0;owned\\x07\\x1b[2J.json"), std::string::npos)
+        << r.output;
   }
 }
 

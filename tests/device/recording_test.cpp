@@ -5,6 +5,7 @@
 #include "hapsim/device/simulated_device.h"
 #include "support/temp_path.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
@@ -127,21 +128,72 @@ std::string read_error(const std::filesystem::path& path) {
   return "";
 }
 
-// Version 2: magic, six counts, the hash, two scene paths (empty here: a length each), checksum.
+// Versions 2 and 3: magic, six counts, the hash, two scene paths (empty here: a length each),
+// checksum.
 std::size_t header_size(const std::string& hash) {
   return 8 + 6 * 4 + hash.size() + 4 + 4 + 8;
+}
+
+// A version 3 block's bytes around its frames: marker, count, length, checksum.
+constexpr std::size_t kBlockOverhead = 4 + 4 + 4 + 8;
+
+std::uint64_t fnv1a(const char* data, std::size_t size) {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= static_cast<unsigned char>(data[i]);
+    h *= 0x100000001b3ull;
+  }
+  return h;
+}
+
+template <class T>
+void append(std::vector<char>& out, const T& value) {
+  const auto* p = reinterpret_cast<const char*>(&value);
+  out.insert(out.end(), p, p + sizeof(T));
+}
+
+// The same session as versions 1 and 2 wrote it, from a version 3 file with empty scene paths,
+// written here from docs/recording-format.md (not with the library's encoder): the header without
+// (v1) or with (v2) the path fields, then each frame as "HFR1", its fields, FNV-1a 64 of them.
+std::vector<char> as_old_version(const std::vector<char>& v3, const std::string& hash,
+                                 std::uint32_t version) {
+  const std::size_t hash_end = 8 + 6 * 4 + hash.size();
+  const std::size_t payload = recorded_frame_payload_bytes();
+  std::vector<char> out(v3.begin(), v3.begin() + static_cast<std::ptrdiff_t>(hash_end));
+  std::memcpy(out.data() + 8, &version, 4);
+  const auto frame_size = static_cast<std::uint32_t>(payload + 12);
+  std::memcpy(out.data() + 12, &frame_size, 4);
+  if (version == 2) {
+    append(out, std::uint32_t{0});
+    append(out, std::uint32_t{0});
+  }
+  append(out, fnv1a(out.data(), out.size()));
+  for (std::size_t at = header_size(hash); at < v3.size();) {
+    std::uint32_t count = 0;
+    std::memcpy(&count, v3.data() + at + 4, 4);
+    for (std::size_t i = 0; i < count; ++i) {
+      const char* fields = v3.data() + at + 12 + i * payload;
+      out.insert(out.end(), {'H', 'F', 'R', '1'});
+      out.insert(out.end(), fields, fields + payload);
+      append(out, fnv1a(fields, payload));
+    }
+    at += kBlockOverhead + count * payload;
+  }
+  return out;
 }
 
 TEST(Recording, RoundTripIsBitExact) {
   const auto frames = make_frames(23);  // 3 full buffers of 7 and a partial one
   const auto path = write_recording(frames);
-  EXPECT_EQ(std::filesystem::file_size(path),
-            header_size("scene-abc123") + frames.size() * recorded_frame_size_bytes());
+  // Blocks of 7, 7, 7 and 2 frames (a flush each).
+  EXPECT_EQ(std::filesystem::file_size(path), header_size("scene-abc123") +
+                                                  frames.size() * recorded_frame_payload_bytes() +
+                                                  4 * kBlockOverhead);
   const Recording rec = read_recording(path);
   std::filesystem::remove(path);
   EXPECT_EQ(rec.header.version, kRecordingVersion);
   EXPECT_EQ(rec.header.scene_hash, "scene-abc123");
-  EXPECT_EQ(rec.header.frame_size_bytes, recorded_frame_size_bytes());
+  EXPECT_EQ(rec.header.frame_size_bytes, recorded_frame_payload_bytes());
   ASSERT_EQ(rec.frames.size(), frames.size());
   for (std::size_t i = 0; i < frames.size(); ++i) {
     SCOPED_TRACE(i);
@@ -173,41 +225,192 @@ TEST(Recording, RealTimeBufferDropsInsteadOfBlockingAndCounts) {
   EXPECT_EQ(rec.frames[4].cycle_index, 9u);
 }
 
-TEST(Recording, TruncatedFileNamesTheFrame) {
-  const auto path = write_recording(make_frames(5));
-  auto bytes = file_bytes(path);
-  const std::size_t frame = recorded_frame_size_bytes();
-  bytes.resize(header_size("scene-abc123") + 3 * frame + frame / 2);
-  write_bytes(path, bytes);
-  const std::string message = read_error(path);
-  EXPECT_NE(message.find("frame 3"), std::string::npos) << message;
-  EXPECT_NE(message.find("truncated"), std::string::npos) << message;
-
-  bytes.resize(20);  // inside the header
+// A run killed while writing leaves a torn end: every whole block before it is kept, with one
+// warning on stderr naming the file and the frames kept. Cut at every byte of the last two blocks
+// and through the rest in steps: the frames read are those of the whole blocks before the cut.
+TEST(Recording, TornEndKeepsEveryWholeBlock) {
+  const auto frames = make_frames(23);  // blocks of 7, 7, 7, 2
+  const auto path = write_recording(frames);
+  const auto original = file_bytes(path);
+  const std::size_t header = header_size("scene-abc123");
+  const std::size_t payload = recorded_frame_payload_bytes();
+  const std::vector<std::size_t> block_frames = {7, 7, 7, 2};
+  const auto torn = test::temp_path("_torn.hrec");
+  // Every byte near a block's start or end and through the short last block, in steps elsewhere.
+  std::vector<std::size_t> boundaries = {header};
+  for (const std::size_t n : block_frames) {
+    boundaries.push_back(boundaries.back() + n * payload + kBlockOverhead);
+  }
+  ASSERT_EQ(boundaries.back(), original.size());
+  const auto step_after = [&](std::size_t cut) -> std::size_t {
+    for (const std::size_t b : boundaries) {
+      if (cut + 24 >= b && cut <= b + 24) {
+        return 1;
+      }
+    }
+    return cut >= boundaries[3] ? 7 : 53;
+  };
+  for (std::size_t cut = header; cut < original.size(); cut += step_after(cut)) {
+    write_bytes(torn, {original.begin(), original.begin() + static_cast<std::ptrdiff_t>(cut)});
+    std::size_t expected = 0;
+    std::size_t end = header;
+    for (const std::size_t n : block_frames) {
+      end += n * payload + kBlockOverhead;
+      if (end > cut) {
+        break;
+      }
+      expected += n;
+    }
+    ::testing::internal::CaptureStderr();
+    Recording rec;
+    try {
+      rec = read_recording(torn);
+    } catch (const Error& e) {
+      (void)::testing::internal::GetCapturedStderr();
+      ADD_FAILURE() << "cut at " << cut << ": " << e.what();
+      continue;
+    }
+    const std::string warning = ::testing::internal::GetCapturedStderr();
+    ASSERT_EQ(rec.frames.size(), expected) << "cut at " << cut;
+    EXPECT_TRUE(compare_frames({frames.data(), expected}, rec.frames).identical);
+    std::size_t whole_end = header;
+    for (std::size_t k = 0, n = 0; k < block_frames.size() && n < expected; ++k) {
+      whole_end += block_frames[k] * payload + kBlockOverhead;
+      n += block_frames[k];
+    }
+    if (cut == whole_end) {
+      EXPECT_EQ(warning, "") << "cut at " << cut;  // ends after a whole block: a clean end
+    } else {
+      // One line: the file, the kept frames.
+      EXPECT_NE(warning.find(torn.string()), std::string::npos) << warning;
+      EXPECT_NE(warning.find("kept the " + std::to_string(expected) + " whole frame(s)"),
+                std::string::npos)
+          << warning;
+      EXPECT_EQ(std::count(warning.begin(), warning.end(), '\n'), 1) << warning;
+    }
+  }
+  // A header cut short is still an error: there is nothing to keep.
+  auto bytes = original;
+  bytes.resize(20);
   write_bytes(path, bytes);
   EXPECT_NE(read_error(path).find("too short for the header"), std::string::npos);
+  bytes = original;
+  bytes.resize(header - 3);
+  write_bytes(path, bytes);
+  EXPECT_NE(read_error(path).find("truncated header"), std::string::npos);
   bytes.clear();
   write_bytes(path, bytes);
   EXPECT_NE(read_error(path).find("too short"), std::string::npos);
   std::filesystem::remove(path);
+  std::filesystem::remove(torn);
   EXPECT_NE(read_error(path).find("cannot open"), std::string::npos);
 }
 
-TEST(Recording, CorruptFrameNamesTheFrame) {
-  const auto frames = make_frames(6);
+// A whole block that fails its checks is corruption, not a torn end: an error naming the block.
+TEST(Recording, CorruptBlockNamesTheBlock) {
+  const auto frames = make_frames(23);
   const auto path = write_recording(frames);
   const auto original = file_bytes(path);
+  const std::size_t block_bytes = 7 * recorded_frame_payload_bytes() + kBlockOverhead;
+  const std::size_t block1 = header_size("scene-abc123") + block_bytes;
+  // Every single-byte flip anywhere in block 1 is caught (marker, count, length, fields or
+  // checksum).
+  for (std::size_t offset = 0; offset < block_bytes; offset += offset < 16 ? 1 : 37) {
+    auto bytes = original;
+    bytes[block1 + offset] = static_cast<char>(bytes[block1 + offset] ^ 0x10);
+    write_bytes(path, bytes);
+    const std::string message = read_error(path);
+    EXPECT_NE(message.find("block at byte offset " + std::to_string(block1) + " (frame 7 on)"),
+              std::string::npos)
+        << offset << ": " << message;
+    EXPECT_NE(message.find("corrupt"), std::string::npos) << message;
+  }
+  std::filesystem::remove(path);
+}
+
+// The version 1 and 2 layout: a frame at a time, each with its marker and checksum. A torn end
+// keeps the whole frames; a corrupt frame is named.
+TEST(Recording, OldVersionsStillReadTornOrCorrupt) {
+  const auto frames = make_frames(6);
+  const auto path = write_recording(frames);
+  const auto v2 = as_old_version(file_bytes(path), "scene-abc123", 2);
   const std::size_t frame = recorded_frame_size_bytes();
   const std::size_t frame2 = header_size("scene-abc123") + 2 * frame;
+  ASSERT_EQ(v2.size(), header_size("scene-abc123") + 6 * frame);
+  write_bytes(path, v2);
+  Recording rec = read_recording(path);
+  EXPECT_EQ(rec.header.version, 2u);
+  EXPECT_TRUE(compare_frames(frames, rec.frames).identical);
+
+  auto bytes = v2;
+  bytes.resize(frame2 + frame + frame / 2);
+  write_bytes(path, bytes);
+  ::testing::internal::CaptureStderr();
+  rec = read_recording(path);
+  const std::string warning = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(rec.frames.size(), 3u);
+  EXPECT_NE(warning.find("kept the 3 whole frame(s)"), std::string::npos) << warning;
+
   // Every single-byte flip anywhere in frame 2 is caught (marker, payload or checksum).
   for (std::size_t offset = 0; offset < frame; offset += 37) {
-    auto bytes = original;
+    bytes = v2;
     bytes[frame2 + offset] = static_cast<char>(bytes[frame2 + offset] ^ 0x10);
     write_bytes(path, bytes);
     const std::string message = read_error(path);
     EXPECT_NE(message.find("frame 2 "), std::string::npos) << offset << ": " << message;
     EXPECT_NE(message.find("corrupt"), std::string::npos) << message;
   }
+  std::filesystem::remove(path);
+}
+
+// A file the version 2 code wrote (hapsim run scenes/csg_block.json --duration 0.03 --record, at
+// commit 0ae5a42): it still reads, whole.
+TEST(Recording, AFileTheVersionTwoCodeWroteStillReads) {
+  const std::filesystem::path file =
+      std::filesystem::path(HAPSIM_SOURCE_DIR) / "tests/data/recordings/v2_csg_block_30_frames.rec";
+  const Recording rec = read_recording(file);
+  EXPECT_EQ(rec.header.version, 2u);
+  EXPECT_EQ(rec.header.frame_size_bytes, recorded_frame_size_bytes());
+  EXPECT_EQ(rec.header.scene_path, "/work/main/scenes/csg_block.json");
+  ASSERT_EQ(rec.frames.size(), 30u);
+  for (std::size_t i = 0; i < rec.frames.size(); ++i) {
+    EXPECT_EQ(rec.frames[i].cycle_index, i);
+    EXPECT_TRUE(rec.frames[i].input.healthy);
+  }
+  EXPECT_NEAR(rec.frames[29].input.time_s - rec.frames[0].input.time_s, 0.029, 1e-12);
+}
+
+// A streamed replay plays the file's frames in order, holds the last, and restarts on rewind;
+// its memory is the ring, not the file.
+TEST(ReplayDevice, StreamsAFileFrameByFrame) {
+  const auto frames = make_frames(5000);  // more than the prefetch ring holds
+  const auto path = write_recording(frames);
+  const RecordingScan scan = scan_recording(path);
+  ASSERT_EQ(scan.frames, 5000u);
+  ReplayDevice device(device_profile("simulated"), path, scan.frames);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      const DeviceInput in = device.read(0.0);
+      ASSERT_EQ(std::memcmp(&in.time_s, &frames[i].input.time_s, sizeof(double)), 0) << i;
+      ASSERT_EQ(in.healthy, frames[i].input.healthy) << i;
+    }
+    EXPECT_TRUE(device.finished());
+    EXPECT_EQ(device.read(0.0).time_s, frames.back().input.time_s);
+    device.rewind();
+  }
+  EXPECT_TRUE(device.frames().empty());
+
+  // The file shrinks after it was checked: the device says why and holds its last input.
+  auto bytes = file_bytes(path);
+  bytes.resize(header_size("scene-abc123") + 10 * (7 * recorded_frame_payload_bytes() + 20));
+  write_bytes(path, bytes);
+  ReplayDevice shrunk(device_profile("simulated"), path, scan.frames);
+  for (std::size_t i = 0; i < 100; ++i) {
+    (void)shrunk.read(0.0);
+  }
+  EXPECT_EQ(shrunk.status().health, DeviceHealth::kFailed);
+  EXPECT_NE(std::string(shrunk.status().reason).find("fewer than the 5000"), std::string::npos)
+      << shrunk.status().reason;
   std::filesystem::remove(path);
 }
 
@@ -265,37 +468,25 @@ TEST(Recording, TheHeaderNamesTheSceneAndVersionOneStillReads) {
     recorder.close();
   }
   const Recording rec = read_recording(path);
-  EXPECT_EQ(rec.header.version, 2u);
+  EXPECT_EQ(rec.header.version, 3u);
   EXPECT_EQ(rec.header.scene_path, "scenes/knee_paper.json");
   EXPECT_EQ(rec.header.scene_path_absolute,
             (std::filesystem::current_path() / "scenes/knee_paper.json").string());
   EXPECT_EQ(rec.frames.size(), 3u);
 
-  // The same session as version 1 wrote it: no path fields, version 1, the checksum over the rest
-  // (FNV-1a 64, docs/recording-format.md).
-  const auto v2 = write_recording(frames);
-  auto bytes = file_bytes(v2);
-  const std::size_t hash_end = 8 + 6 * 4 + std::string("scene-abc123").size();
-  bytes.erase(bytes.begin() + static_cast<std::ptrdiff_t>(hash_end),
-              bytes.begin() + static_cast<std::ptrdiff_t>(hash_end + 8 + 8));
-  bytes[8] = 1;
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  for (std::size_t i = 0; i < hash_end; ++i) {
-    h ^= static_cast<unsigned char>(bytes[i]);
-    h *= 0x100000001b3ull;
-  }
-  std::vector<char> sum(8);
-  std::memcpy(sum.data(), &h, 8);
-  bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(hash_end), sum.begin(), sum.end());
-  write_bytes(v2, bytes);
-  const Recording old = read_recording(v2);
+  // The same session as version 1 wrote it: no path fields, frames one by one.
+  const auto v3 = write_recording(frames);
+  const auto v1 = test::temp_path("_v1.hrec");
+  write_bytes(v1, as_old_version(file_bytes(v3), "scene-abc123", 1));
+  const Recording old = read_recording(v1);
   EXPECT_EQ(old.header.version, 1u);
   EXPECT_EQ(old.header.scene_hash, "scene-abc123");
   EXPECT_EQ(old.header.scene_path, "");
   ASSERT_EQ(old.frames.size(), 3u);
   EXPECT_TRUE(compare_frames(frames, old.frames).identical);
   std::filesystem::remove(path);
-  std::filesystem::remove(v2);
+  std::filesystem::remove(v1);
+  std::filesystem::remove(v3);
 }
 
 TEST(Recording, CompareReportsTheFirstDifferingFrameAndField) {

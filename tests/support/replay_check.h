@@ -36,7 +36,7 @@ inline bool replays_bit_for_bit(const SceneDescription& scene,
       std::filesystem::temp_directory_path() /
       ("hapsim_replay_check_" + std::to_string(::getpid()) + ".rec");
   record_run(setup, again);
-  const RecordingDifference d = compare_recordings(*setup.replayed, read_recording(again));
+  const RecordingDifference d = compare_recording_files(setup.replayed_file, again);
   std::filesystem::remove(again);
   if (!d.identical) {
     ADD_FAILURE() << "replay of " << recording << " differs: " << d.message;

@@ -1,12 +1,18 @@
 #include "hapsim/device/recording.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/printable_text.h"
+#include "hapsim/core/spsc_ring.h"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <charconv>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <thread>
 #include <type_traits>
 #include <utility>
 
@@ -17,7 +23,11 @@ static_assert(std::endian::native == std::endian::little,
               "recordings are little-endian and written with memcpy; add byte swapping to port");
 
 constexpr std::array<char, 8> kMagic = {'H', 'A', 'P', 'S', 'I', 'M', 'R', 'C'};
-constexpr std::uint32_t kFrameMarker = 0x31524648u;  // "HFR1" in file byte order
+constexpr std::uint32_t kFrameMarker = 0x31524648u;  // "HFR1" in file byte order (v1, v2)
+constexpr std::uint32_t kBlockMarker = 0x334b4248u;  // "HBK3" in file byte order (v3)
+// Block: marker, frame count, payload length (u32 each), the frames' fields, FNV-1a 64 of all that.
+constexpr std::size_t kBlockHeadBytes = 3 * 4;
+constexpr std::size_t kBlockChecksumBytes = 8;
 // magic + version + frame size + max contacts + max fingers + max joints + hash length
 constexpr std::size_t kHeaderFixedBytes = 8 + 6 * 4;
 
@@ -162,11 +172,17 @@ std::size_t payload_size() {
   return size;
 }
 
-// Encodes marker + payload + checksum into `out` (recorded_frame_size_bytes() long).
+// Encodes the frame's fields into `out` (payload_size() long).
+void encode_payload(const RecordedFrame& frame, unsigned char* out) {
+  Encoder encoder{out};
+  visit_frame(frame, encoder);
+}
+
+// Encodes marker + payload + checksum into `out` (recorded_frame_size_bytes() long): a version 1
+// or 2 frame, and the unit the comparison compares.
 void encode_frame(const RecordedFrame& frame, unsigned char* out) {
   std::memcpy(out, &kFrameMarker, 4);
-  Encoder encoder{out + 4};
-  visit_frame(frame, encoder);
+  encode_payload(frame, out + 4);
   const std::uint64_t sum = fnv1a(out + 4, payload_size());
   std::memcpy(out + 4 + payload_size(), &sum, 8);
 }
@@ -254,10 +270,34 @@ struct NonFiniteFinder {
   }
 };
 
+// Decodes one frame's fields and checks them; the problem, or "" when the frame is sound.
+std::string decode_checked(const unsigned char* payload, RecordedFrame& frame) {
+  RecordedFrame decoded;
+  Decoder decoder{payload};
+  visit_frame(decoded, decoder);
+  if (decoder.bad_bool) {
+    return "input.healthy is neither 0 nor 1";
+  }
+  if (const char* problem = check_counts(decoded)) {
+    return problem;
+  }
+  NonFiniteFinder non_finite;
+  visit_frame(decoded, non_finite);
+  if (!non_finite.field.empty()) {
+    return non_finite.field + "; a recording holds finite inputs and commands only";
+  }
+  frame = decoded;
+  return {};
+}
+
 }  // namespace
 
 std::size_t recorded_frame_size_bytes() {
   return 4 + payload_size() + 8;
+}
+
+std::size_t recorded_frame_payload_bytes() {
+  return payload_size();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -297,7 +337,7 @@ SessionRecorder::SessionRecorder(std::filesystem::path path, std::string scene_h
   }
   std::vector<unsigned char> header(kMagic.begin(), kMagic.end());
   put(header, kRecordingVersion);
-  put(header, static_cast<std::uint32_t>(recorded_frame_size_bytes()));
+  put(header, static_cast<std::uint32_t>(payload_size()));
   put(header, static_cast<std::uint32_t>(kMaxRecordedContacts));
   put(header, static_cast<std::uint32_t>(kMaxFingers));
   put(header, static_cast<std::uint32_t>(kMaxDeviceJoints));
@@ -314,9 +354,11 @@ SessionRecorder::SessionRecorder(std::filesystem::path path, std::string scene_h
   if (!out_) {
     throw Error(where, "cannot write recording header");
   }
-  header_bytes_ = header.size();
+  bytes_written_ = header.size();
   buffer_.reserve(capacity_frames_);
-  bytes_.resize(recorded_frame_size_bytes());
+  bytes_.resize(kBlockHeadBytes +
+                std::min(capacity_frames_, kRecordingBlockMaxFrames) * payload_size() +
+                kBlockChecksumBytes);
 }
 
 SessionRecorder::~SessionRecorder() {
@@ -351,38 +393,53 @@ bool SessionRecorder::record(const RecordedFrame& frame) noexcept {
   return true;
 }
 
+bool SessionRecorder::flush_due() const noexcept {
+  if (buffer_.empty()) {
+    return false;
+  }
+  return buffer_.size() >= std::min(capacity_frames_, kRecordingFlushFrames) ||
+         buffer_.back().input.time_s - buffer_.front().input.time_s >= kRecordingFlushPeriodS;
+}
+
 void SessionRecorder::write_buffer() {
-  for (const RecordedFrame& frame : buffer_) {
-    encode_frame(frame, bytes_.data());
-    out_.write(reinterpret_cast<const char*>(bytes_.data()),
-               static_cast<std::streamsize>(bytes_.size()));
+  const std::size_t payload = payload_size();
+  for (std::size_t first = 0; first < buffer_.size(); first += kRecordingBlockMaxFrames) {
+    const std::size_t count = std::min(kRecordingBlockMaxFrames, buffer_.size() - first);
+    const auto length = static_cast<std::uint32_t>(count * payload);
+    unsigned char* p = bytes_.data();
+    std::memcpy(p, &kBlockMarker, 4);
+    const auto count32 = static_cast<std::uint32_t>(count);
+    std::memcpy(p + 4, &count32, 4);
+    std::memcpy(p + 8, &length, 4);
+    for (std::size_t i = 0; i < count; ++i) {
+      encode_payload(buffer_[first + i], p + kBlockHeadBytes + i * payload);
+    }
+    const std::size_t checked = kBlockHeadBytes + length;
+    const std::uint64_t sum = fnv1a(p, checked);
+    std::memcpy(p + checked, &sum, 8);
+    // One block, one write handed to the kernel: a killed process leaves whole blocks and at
+    // most one torn one, which the reader drops.
+    out_.write(reinterpret_cast<const char*>(p), static_cast<std::streamsize>(checked + 8));
+    out_.flush();
+    if (!out_) {
+      keep_complete_blocks();
+      throw Error(path_.string(), "write failed (disk full?): the recording keeps its first " +
+                                      std::to_string(frames_written_) +
+                                      " frame(s), readable and replayable; later ones are lost");
+    }
+    bytes_written_ += checked + 8;
+    frames_written_ += count;
   }
-  out_.flush();
-  if (!out_) {
-    keep_complete_frames();
-    throw Error(path_.string(), "write failed (disk full?): the recording keeps its first " +
-                                    std::to_string(frames_written_) +
-                                    " frame(s), readable and replayable; later ones are lost");
-  }
-  frames_written_ += buffer_.size();
   buffer_.clear();  // keeps the capacity
 }
 
-void SessionRecorder::keep_complete_frames() noexcept {
-  // A full disk takes what fits: whole frames and maybe part of one. Cut the part (its checksum
-  // would make the reader refuse the file) so every frame recorded up to the fault stays usable.
+void SessionRecorder::keep_complete_blocks() noexcept {
+  // A full disk takes what fits: whole blocks and maybe part of one. Cut the part (the reader
+  // would drop it as a torn end and warn) so the file ends cleanly after the last whole block.
   closed_ = true;
   out_.close();
   std::error_code ec;
-  const std::uintmax_t size = std::filesystem::file_size(path_, ec);
-  const std::size_t frame_bytes = bytes_.size();
-  std::size_t frames = 0;
-  if (!ec && size >= header_bytes_ && frame_bytes > 0) {
-    frames = std::min<std::size_t>(static_cast<std::size_t>((size - header_bytes_) / frame_bytes),
-                                   frames_written_ + buffer_.size());
-  }
-  std::filesystem::resize_file(path_, header_bytes_ + frames * frame_bytes, ec);
-  frames_written_ = ec ? std::min(frames, frames_written_) : frames;
+  std::filesystem::resize_file(path_, bytes_written_, ec);
   buffer_.clear();
 }
 
@@ -410,7 +467,8 @@ void SessionRecorder::close() {
 // ---------------------------------------------------------------------------------------------
 // RecordingReader
 
-RecordingReader::RecordingReader(std::filesystem::path path) : path_(std::move(path)) {
+RecordingReader::RecordingReader(std::filesystem::path path, TornEnd torn_end)
+    : path_(std::move(path)), torn_end_(torn_end) {
   const std::string where = path_.string();
   std::error_code ec;
   // Not a FIFO, a device or a folder: opening a FIFO blocks until something writes to it (assess
@@ -441,20 +499,21 @@ RecordingReader::RecordingReader(std::filesystem::path path) : path_(std::move(p
   const auto max_fingers = get<std::uint32_t>(&head[20]);
   const auto max_joints = get<std::uint32_t>(&head[24]);
   const auto hash_length = get<std::uint32_t>(&head[28]);
-  if (header_.version != 1 && header_.version != kRecordingVersion) {
+  if (header_.version < 1 || header_.version > kRecordingVersion) {
     throw Error(where, "recording version " + std::to_string(header_.version) +
-                           ", this build reads versions 1 and " +
-                           std::to_string(kRecordingVersion));
+                           ", this build reads versions 1 to " + std::to_string(kRecordingVersion));
   }
-  if (header_.frame_size_bytes != recorded_frame_size_bytes() ||
+  // Versions 1 and 2: each frame has its marker and checksum; version 3: the fields only.
+  const std::size_t frame_bytes =
+      header_.version >= 3 ? payload_size() : recorded_frame_size_bytes();
+  if (header_.frame_size_bytes != frame_bytes ||
       max_contacts != static_cast<std::uint32_t>(kMaxRecordedContacts) ||
       max_fingers != static_cast<std::uint32_t>(kMaxFingers) ||
       max_joints != static_cast<std::uint32_t>(kMaxDeviceJoints)) {
     throw Error(where, "corrupt header: frame size " + std::to_string(header_.frame_size_bytes) +
                            " bytes, " + std::to_string(max_contacts) + " contacts, " +
                            std::to_string(max_fingers) + " fingers, " + std::to_string(max_joints) +
-                           " joints; this build expects " +
-                           std::to_string(recorded_frame_size_bytes()) + ", " +
+                           " joints; this build expects " + std::to_string(frame_bytes) + ", " +
                            std::to_string(kMaxRecordedContacts) + ", " +
                            std::to_string(kMaxFingers) + ", " + std::to_string(kMaxDeviceJoints));
   }
@@ -496,21 +555,100 @@ RecordingReader::RecordingReader(std::filesystem::path path) : path_(std::move(p
   }
   offset_ = head.size();
   frame_count_hint_ = static_cast<std::size_t>((file_size_ - offset_) / header_.frame_size_bytes);
-  bytes_.resize(header_.frame_size_bytes);
+  if (header_.version < 3) {
+    bytes_.resize(header_.frame_size_bytes);
+  }
+}
+
+void RecordingReader::note_torn_end(std::uintmax_t bytes_left) {
+  torn_bytes_ = bytes_left;
+  offset_ = file_size_;
+  if (torn_end_ == TornEnd::kWarn) {
+    // Once per reader: it reads no further. The file name is data: printed escaped.
+    std::fprintf(stderr,
+                 "warning: %s: the recording ends in %ju byte(s) that are not a whole %s (the "
+                 "session was interrupted while writing); kept the %zu whole frame(s) before\n",
+                 printable_text(path_.string(), 4096).c_str(), bytes_left,
+                 header_.version >= 3 ? "block" : "frame", frame_index_);
+  }
+}
+
+bool RecordingReader::read_block() {
+  const std::string where = path_.string();
+  const std::uintmax_t left = file_size_ - offset_;
+  const std::string which = "block at byte offset " + std::to_string(offset_) + " (frame " +
+                            std::to_string(frame_index_) + " on)";
+  if (left < kBlockHeadBytes) {
+    note_torn_end(left);
+    return false;
+  }
+  std::array<unsigned char, kBlockHeadBytes> head{};
+  in_.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  if (static_cast<std::size_t>(in_.gcount()) != head.size()) {
+    throw Error(where, which + ": read failed");
+  }
+  const auto count = get<std::uint32_t>(&head[4]);
+  const auto length = get<std::uint32_t>(&head[8]);
+  if (get<std::uint32_t>(head.data()) != kBlockMarker) {
+    throw Error(where, which + " is corrupt: bad block marker");
+  }
+  if (count == 0 || count > kRecordingBlockMaxFrames ||
+      length != static_cast<std::uint64_t>(count) * payload_size()) {
+    throw Error(where, which + " is corrupt: " + std::to_string(count) + " frame(s) in " +
+                           std::to_string(length) + " bytes (1 to " +
+                           std::to_string(kRecordingBlockMaxFrames) + " frames of " +
+                           std::to_string(payload_size()) + " bytes expected)");
+  }
+  const std::uintmax_t block_bytes = kBlockHeadBytes + length + kBlockChecksumBytes;
+  if (block_bytes > left) {
+    note_torn_end(left);
+    return false;
+  }
+  bytes_.resize(kBlockHeadBytes + length + kBlockChecksumBytes);  // at most one largest block
+  std::memcpy(bytes_.data(), head.data(), head.size());
+  const std::size_t rest = length + kBlockChecksumBytes;
+  in_.read(reinterpret_cast<char*>(bytes_.data() + kBlockHeadBytes),
+           static_cast<std::streamsize>(rest));
+  if (static_cast<std::size_t>(in_.gcount()) != rest) {
+    throw Error(where, which + ": read failed");
+  }
+  if (get<std::uint64_t>(bytes_.data() + kBlockHeadBytes + length) !=
+      fnv1a(bytes_.data(), kBlockHeadBytes + length)) {
+    throw Error(where, which + " is corrupt: checksum mismatch");
+  }
+  offset_ += block_bytes;
+  block_frames_ = count;
+  block_next_ = 0;
+  return true;
 }
 
 bool RecordingReader::next(RecordedFrame& frame) {
-  if (offset_ == file_size_) {
+  if (offset_ == file_size_ && block_next_ == block_frames_) {
     return false;
   }
   const std::string where = path_.string();
+  if (header_.version >= 3) {
+    if (block_next_ == block_frames_ && !read_block()) {
+      return false;
+    }
+    const unsigned char* payload = bytes_.data() + kBlockHeadBytes + block_next_ * payload_size();
+    if (const std::string problem = decode_checked(payload, frame); !problem.empty()) {
+      throw Error(where, "frame " + std::to_string(frame_index_) + " is corrupt: " + problem);
+    }
+    ++block_next_;
+    ++frame_index_;
+    return true;
+  }
   const std::string which =
       "frame " + std::to_string(frame_index_) + " (byte offset " + std::to_string(offset_) + ")";
+  if (file_size_ - offset_ < bytes_.size()) {
+    note_torn_end(file_size_ - offset_);
+    return false;
+  }
   in_.read(reinterpret_cast<char*>(bytes_.data()), static_cast<std::streamsize>(bytes_.size()));
   const auto got = static_cast<std::size_t>(in_.gcount());
   if (got != bytes_.size()) {
-    throw Error(where, which + " is truncated: " + std::to_string(got) + " of " +
-                           std::to_string(bytes_.size()) + " bytes; the file ends early");
+    throw Error(where, which + ": read failed");
   }
   if (get<std::uint32_t>(bytes_.data()) != kFrameMarker) {
     throw Error(where, which + " is corrupt: bad frame marker");
@@ -519,22 +657,9 @@ bool RecordingReader::next(RecordedFrame& frame) {
   if (get<std::uint64_t>(bytes_.data() + 4 + payload) != fnv1a(bytes_.data() + 4, payload)) {
     throw Error(where, which + " is corrupt: checksum mismatch");
   }
-  RecordedFrame decoded;
-  Decoder decoder{bytes_.data() + 4};
-  visit_frame(decoded, decoder);
-  if (decoder.bad_bool) {
-    throw Error(where, which + " is corrupt: input.healthy is neither 0 nor 1");
-  }
-  if (const char* problem = check_counts(decoded)) {
+  if (const std::string problem = decode_checked(bytes_.data() + 4, frame); !problem.empty()) {
     throw Error(where, which + " is corrupt: " + problem);
   }
-  NonFiniteFinder non_finite;
-  visit_frame(decoded, non_finite);
-  if (!non_finite.field.empty()) {
-    throw Error(where, which + " is corrupt: " + non_finite.field +
-                           "; a recording holds finite inputs and commands only");
-  }
-  frame = decoded;
   offset_ += got;
   ++frame_index_;
   return true;
@@ -552,18 +677,118 @@ Recording read_recording(const std::filesystem::path& path) {
   return recording;
 }
 
+RecordingScan scan_recording(const std::filesystem::path& path) {
+  RecordingReader reader(path);
+  RecordingScan scan;
+  scan.header = reader.header();
+  RecordedFrame frame;
+  while (reader.next(frame)) {
+    if (scan.frames == 0) {
+      scan.first_frame = frame;
+    }
+    ++scan.frames;
+  }
+  scan.torn_bytes = reader.torn_bytes();
+  return scan;
+}
+
 // ---------------------------------------------------------------------------------------------
 // ReplayDevice
 
+// The reader thread of a streamed replay and the ring it fills.
+struct ReplayDevice::Stream {
+  explicit Stream(std::size_t capacity) : ring(capacity) {}
+  SpscRing<RecordedFrame> ring;
+  std::thread thread;
+  std::atomic<bool> stop{false};
+  std::atomic<bool> done{false};  // the thread has pushed all it will (error_text is set first)
+  std::string error_text;         // why it stopped early; read after done
+  bool failed = false;            // the haptic side saw done with frames missing
+};
+
 ReplayDevice::ReplayDevice(DeviceProfile profile, std::vector<RecordedFrame> frames)
-    : profile_(std::move(profile)), frames_(std::move(frames)) {
+    : profile_(std::move(profile)), frames_(std::move(frames)), frame_count_(frames_.size()) {
   if (frames_.empty()) {
     throw Error("replay device '" + profile_.name + "'", "recording has no frames");
   }
   commands_.reserve(frames_.size());
 }
 
-DeviceInput ReplayDevice::read(double /*time_s*/) noexcept {
+ReplayDevice::ReplayDevice(DeviceProfile profile, std::filesystem::path recording,
+                           std::size_t frame_count)
+    : profile_(std::move(profile)), frame_count_(frame_count), path_(std::move(recording)) {
+  if (frame_count_ == 0) {
+    throw Error(path_.string(), "the recording has no frames");
+  }
+  start_stream();
+}
+
+ReplayDevice::~ReplayDevice() {
+  stop_stream();
+}
+
+void ReplayDevice::start_stream() {
+  stream_ = std::make_unique<Stream>(kReplayPrefetchFrames);
+  Stream& st = *stream_;
+  st.thread = std::thread([&st, path = path_, count = frame_count_] {
+    try {
+      RecordingReader reader(path, RecordingReader::TornEnd::kQuiet);
+      RecordedFrame frame;
+      std::size_t pushed = 0;
+      while (pushed < count && !st.stop.load(std::memory_order_relaxed)) {
+        if (!reader.next(frame)) {
+          st.error_text = path.string() + ": the recording has " + std::to_string(pushed) +
+                          " frames, fewer than the " + std::to_string(count) +
+                          " it had when checked (changed meanwhile?)";
+          break;
+        }
+        while (!st.ring.push(frame)) {  // the ring is full: the replay is far enough ahead
+          if (st.stop.load(std::memory_order_relaxed)) {
+            st.done.store(true, std::memory_order_release);
+            return;
+          }
+          std::this_thread::sleep_for(std::chrono::microseconds(500));
+        }
+        ++pushed;
+      }
+    } catch (const std::exception& e) {
+      st.error_text = e.what();
+    }
+    st.done.store(true, std::memory_order_release);
+  });
+  // The first frame is there before the first read(), so the loop does not start by waiting.
+  while (st.ring.front() == nullptr && !st.done.load(std::memory_order_acquire)) {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+}
+
+void ReplayDevice::stop_stream() noexcept {
+  if (stream_ && stream_->thread.joinable()) {
+    stream_->stop.store(true, std::memory_order_relaxed);
+    stream_->thread.join();
+  }
+}
+
+DeviceInput ReplayDevice::read(double /*time_s*/) noexcept {  // haptic path
+  if (stream_) {
+    Stream& st = *stream_;
+    while (next_frame_ < frame_count_ && !st.failed) {
+      if (const RecordedFrame* f = st.ring.front()) {
+        last_input_ = f->input;
+        st.ring.pop();
+        ++next_frame_;
+        break;
+      }
+      // Empty: the reader is behind (rare: it keeps kReplayPrefetchFrames ahead) or has stopped.
+      if (st.done.load(std::memory_order_acquire) && st.ring.front() == nullptr) {
+        st.failed = true;
+        break;
+      }
+      std::this_thread::yield();
+    }
+    last_healthy_ = last_input_.healthy && !st.failed;
+    return last_input_;
+  }
   const std::size_t i = std::min(next_frame_, frames_.size() - 1);
   if (next_frame_ < frames_.size()) {
     ++next_frame_;
@@ -579,16 +804,23 @@ void ReplayDevice::write(const DeviceCommand& command) noexcept {
 }
 
 DeviceStatus ReplayDevice::status() const noexcept {
+  if (stream_ && stream_->failed) {
+    return {DeviceHealth::kFailed, stream_->error_text};
+  }
   if (!last_healthy_) {
     return {DeviceHealth::kFailed, "the recorded input was marked unhealthy"};
   }
   return {DeviceHealth::kConnected, {}};
 }
 
-void ReplayDevice::rewind() noexcept {
+void ReplayDevice::rewind() {
   next_frame_ = 0;
   last_healthy_ = true;
   commands_.clear();
+  if (stream_) {
+    stop_stream();
+    start_stream();
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -646,6 +878,55 @@ RecordingDifference compare_recordings(const Recording& expected, const Recordin
     return diff;
   }
   return compare_frames(expected.frames, actual.frames);
+}
+
+RecordingDifference compare_recording_files(const std::filesystem::path& expected,
+                                            const std::filesystem::path& actual) {
+  RecordingReader a(expected, RecordingReader::TornEnd::kQuiet);
+  RecordingReader b(actual, RecordingReader::TornEnd::kQuiet);
+  if (a.header().scene_hash != b.header().scene_hash) {
+    Recording ha;
+    Recording hb;
+    ha.header = a.header();
+    hb.header = b.header();
+    return compare_recordings(ha, hb);
+  }
+  RecordedFrame fa;
+  RecordedFrame fb;
+  std::size_t index = 0;
+  for (;;) {
+    const bool more_a = a.next(fa);
+    const bool more_b = b.next(fb);
+    if (more_a && more_b) {
+      RecordingDifference d = compare_frames({&fa, 1}, {&fb, 1});
+      if (!d.identical) {
+        d.frame_index = index;
+        d.message = "frame " + std::to_string(index) + d.message.substr(d.message.find(','));
+        return d;
+      }
+      ++index;
+      continue;
+    }
+    RecordingDifference d;
+    if (more_a != more_b) {
+      // Count the rest of the longer one, for the same message as compare_frames.
+      std::size_t expected_count = index + (more_a ? 1 : 0);
+      std::size_t actual_count = index + (more_b ? 1 : 0);
+      while (more_a && a.next(fa)) {
+        ++expected_count;
+      }
+      while (more_b && b.next(fb)) {
+        ++actual_count;
+      }
+      d.identical = false;
+      d.field = "frame count";
+      d.expected_value = std::to_string(expected_count);
+      d.actual_value = std::to_string(actual_count);
+      d.message = "frame count: expected " + d.expected_value + ", got " + d.actual_value +
+                  " (the first " + std::to_string(index) + " frames are identical)";
+    }
+    return d;
+  }
 }
 
 }  // namespace hapsim

@@ -212,8 +212,9 @@ class SessionAccountant {
       } else {
         ++summary_.recorded_frames;
       }
-      // The disk is touched here, between cycles (inline) or off the haptic thread (real time).
-      if (options_.recorder->frames_buffered() >= options_.recorder->capacity_frames()) {
+      // The disk is touched here, between cycles (inline) or off the haptic thread (real time),
+      // every 100 ms of the session at most: a killed run keeps all but its last 100 ms.
+      if (options_.recorder->flush_due()) {
         options_.recorder->flush();
       }
     }
@@ -323,6 +324,9 @@ SessionSummary run_inline(World& world, Device& device, const SessionOptions& op
     World& world;
   } fem_between_cycles(world);
   for (std::size_t i = 0; i < steps; ++i) {
+    if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed)) {
+      break;  // stopped from outside (a signal): the summary covers the cycles run
+    }
     const double t_s = static_cast<double>(i) * options.dt_s;
     // The timed haptic cycle: read, step (collision, force, deformation), safety, write.
     const auto c0 = std::chrono::steady_clock::now();
@@ -510,6 +514,8 @@ SessionSummary run_session(World& world, Device& device, const SessionOptions& o
   }
   SessionSummary summary = options.realtime ? run_realtime(world, device, options, steps)
                                             : run_inline(world, device, options, steps);
+  summary.interrupted = options.stop != nullptr && options.stop->load(std::memory_order_relaxed) &&
+                        summary.steps < steps;
   summary.stiffness_clamps = stiffness_clamps(world);
   if (!summary.fem) {
     summary.fem = fem_summary(world);

@@ -60,8 +60,9 @@ struct SessionOptions {
   /// from another thread: WorldHapticClient's thread-safe requests) before the loop starts, and
   /// null once it has stopped, before the client goes (both calls on the calling thread).
   std::function<void(WorldHapticClient*)> on_client;
-  /// Real-time runs only: when this becomes true the run ends after the current cycle (a
-  /// served world runs until stopped). Not owned; may be null.
+  /// When this becomes true the run ends after the current cycle (a served world runs until
+  /// stopped; SIGINT stops `hapsim run`), and the summary covers the cycles run. Not owned; may be
+  /// null.
   const std::atomic<bool>* stop = nullptr;
   /// Inline runs only: called after every cycle's bookkeeping with the cycle index (between
   /// cycles, on the stepping thread: may read the world, e.g. to render a snapshot).
@@ -206,6 +207,8 @@ struct StiffnessClamp {
 
 struct SessionSummary {
   std::size_t steps = 0;
+  /// SessionOptions::stop ended the run before its last cycle (the figures are of `steps`).
+  bool interrupted = false;
   double simulated_s = 0.0;
   double wall_s = 0.0;
   StepTimingUs step_us;

@@ -157,6 +157,8 @@ std::vector<std::string> run_failures(const RunSetup& setup, const SessionSummar
 nlohmann::json run_summary_json(const RunSetup& setup, const SessionSummary& summary,
                                 const RecordingDifference* replay) {
   nlohmann::json j = session_summary_json(setup.scene, *setup.world, summary, setup.device_name);
+  // Stopped early (SIGINT in `hapsim run`): the figures are of the cycles run.
+  j["interrupted"] = summary.interrupted;
   if (summary.teleop) {
     const TeleopSummary& t = *summary.teleop;
     j["slave"] = setup.slave_name;

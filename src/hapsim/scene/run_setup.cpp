@@ -77,19 +77,25 @@ RunSetup make_run_setup(SceneDescription scene, const DeviceChoice& choice,
     world_options.max_stiffness_n_per_m = r.profile->max_stiffness_n_per_m;
     r.world = std::make_unique<World>(scene.world, world_options);
   }
+  for (const std::string& note : r.world->model().notes()) {
+    scene.warnings.push_back(note);
+  }
   double device_length_s = 0.0;
   switch (choice.kind) {
     case DeviceChoice::Kind::kReplay: {
-      r.replayed = read_recording(choice.file);
+      // Read through once, every frame checked (a corrupt file fails here, before the run), then
+      // streamed by the device: memory does not grow with the recording's length.
+      r.replayed = scan_recording(choice.file);
+      r.replayed_file = choice.file;
       if (r.replayed->header.scene_hash != r.world->content_hash()) {
         throw Error(choice.file.string(), "recorded on a different scene (content hash differs)");
       }
-      if (r.replayed->frames.empty()) {
+      if (r.replayed->frames == 0) {
         throw Error(choice.file.string(), "the recording has no frames");
       }
-      device_length_s = static_cast<double>(r.replayed->frames.size()) * scene.run.dt_s;
-      r.script_start = r.replayed->frames.front().input;
-      r.device = std::make_unique<ReplayDevice>(*r.profile, r.replayed->frames);
+      device_length_s = static_cast<double>(r.replayed->frames) * scene.run.dt_s;
+      r.script_start = r.replayed->first_frame.input;
+      r.device = std::make_unique<ReplayDevice>(*r.profile, choice.file, r.replayed->frames);
       r.device_name = "replay of " + choice.file.string();
       break;
     }

@@ -66,8 +66,10 @@ struct RunSetup {
   std::optional<Vec3> teleop_target_world;
   /// A teleoperation scene's slave: "procedural Motoman" or its URDF.
   std::string slave_name;
-  /// DeviceChoice::kReplay: the recording being replayed.
-  std::optional<Recording> replayed;
+  /// DeviceChoice::kReplay: the recording being replayed (checked frame by frame, not held: the
+  /// device streams it from replayed_file).
+  std::optional<RecordingScan> replayed;
+  std::filesystem::path replayed_file;
 };
 
 /// Builds the run. Throws hapsim::Error naming the file and what is wrong: a recording made on

@@ -20,9 +20,11 @@ RecordingAssessment assess_recording(const std::filesystem::path& recording,
   RunSetup& setup = out.setup;
   World& world = *setup.world;
   AssessmentScorer scorer(definition, world, setup.scene.run.dt_s, setup.teleop_target_world);
-  // The replay must reproduce the recording: each cycle's frame is compared as it goes.
-  const std::vector<RecordedFrame>& frames = setup.replayed->frames;
-  out.frames = frames.size();
+  // The replay must reproduce the recording: each cycle's frame is compared as it goes, read
+  // from the file beside the replay's own stream (memory independent of the file's length).
+  RecordingReader expected(setup.replayed_file, RecordingReader::TornEnd::kQuiet);
+  RecordedFrame recorded;
+  out.frames = setup.replayed->frames;
   SessionOptions options;
   options.duration_s = setup.duration_s;
   options.dt_s = setup.scene.run.dt_s;
@@ -31,9 +33,9 @@ RecordingAssessment assess_recording(const std::filesystem::path& recording,
   options.on_record = [&](const CycleRecord& record) {
     scorer.add(record);
     const auto i = static_cast<std::size_t>(record.cycle);
-    if (out.replay_difference.empty() && i < frames.size()) {
+    if (out.replay_difference.empty() && i == expected.frame_index() && expected.next(recorded)) {
       const RecordedFrame again = to_recorded_frame(record, *setup.profile);
-      const RecordingDifference d = compare_frames({&frames[i], 1}, {&again, 1});
+      const RecordingDifference d = compare_frames({&recorded, 1}, {&again, 1});
       if (!d.identical) {
         out.replay_difference = "frame " + std::to_string(i) + ": " + d.message;
       }

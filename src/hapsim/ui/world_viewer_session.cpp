@@ -198,7 +198,9 @@ class WorldViewerSession final : public ViewerSession {
         if (!recorder_->record(to_recorded_frame(*r, device_->profile()))) {
           ++recorded_dropped_;
         }
-        if (recorder_->frames_buffered() >= recorder_->capacity_frames() / 2) {
+        // Every 100 ms of the session at most (off the haptic thread: this is the graphics loop),
+        // so a killed viewer loses little.
+        if (recorder_->flush_due()) {
           recorder_->flush();
         }
       }
