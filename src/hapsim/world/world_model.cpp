@@ -9,6 +9,7 @@
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/deform/sheet_profile.h"
 #include "hapsim/force/god_object.h"
+#include "hapsim/world/knee_method_query.h"
 
 #include <Eigen/Eigenvalues>
 
@@ -22,8 +23,9 @@ namespace {
 // A CSG segment (and an exact sphere) always answers from its solid's signed distance (exact, and
 // cheaper than any mesh structure), whatever the body's method: the method names how a *mesh* is
 // searched, and the polygonised mesh only approximates the solid (edges bevelled by about a cell).
-std::unique_ptr<ProximityQuery> make_query(ContactMethod method,
-                                           const SegmentDescription& segment) {
+std::unique_ptr<ProximityQuery> make_query(ContactMethod method, const SegmentDescription& segment,
+                                           ContactResponse response,
+                                           std::optional<ApproximationError>* knee_error) {
   if (segment.csg) {
     return std::make_unique<CsgQuery>(*segment.csg, segment.mesh);
   }
@@ -37,8 +39,13 @@ std::unique_ptr<ProximityQuery> make_query(ContactMethod method,
   switch (method) {
     case ContactMethod::kSphereTree:
       return std::make_unique<SphereTree>(mesh);
-    case ContactMethod::kKnee:
-      return std::make_unique<KneeIndex>(mesh);
+    case ContactMethod::kKnee: {
+      KneeMethodQuery knee = make_knee_method_query(mesh, response);
+      if (knee.poor) {
+        *knee_error = knee.error;
+      }
+      return std::move(knee.query);
+    }
     case ContactMethod::kExact:
       break;
   }
@@ -210,6 +217,9 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
     if (body.segments.empty()) {
       throw Error("body '" + body.name + "'", "has no segments");
     }
+    std::vector<std::string> exact_proxy_segments;  // knee method asked, exact query given
+    std::vector<std::pair<std::string, ApproximationError>> poor_knee_segments;
+    std::size_t knee_penalty_segments = 0;
     for (std::size_t s = 0; s < body.segments.size(); ++s) {
       const SegmentDescription& sd = body.segments[s];
       const std::string where = "body '" + body.name + "' segment '" + sd.name + "'";
@@ -256,11 +266,39 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
             std::isfinite(body.sheet.max_depth_m) ? body.sheet.max_depth_m : body.sheet.side_m;
         seg.rest_bounds_body.extend(seg.rest_bounds_body.min() - Vec3(0.0, 0.0, deepest));
       }
-      seg.rest_query = make_query(body.method, sd);
+      std::optional<ApproximationError> knee_error;
+      seg.rest_query = make_query(body.method, sd, seg.response, &knee_error);
+      if (knee_error) {
+        poor_knee_segments.emplace_back(sd.name, *knee_error);
+      }
+      knee_penalty_segments += body.method == ContactMethod::kKnee && !sd.csg && !sd.sphere &&
+                                       seg.response == ContactResponse::kPenalty
+                                   ? 1
+                                   : 0;
+      if (body.method == ContactMethod::kKnee && !sd.csg && !sd.sphere &&
+          seg.response == ContactResponse::kProxy) {
+        exact_proxy_segments.push_back(sd.name);
+      }
       if (!fem) {
         (seg.response == ContactResponse::kProxy ? proxy_segments_ : penalty_segments_) += 1;
       }
       segments_.push_back(std::move(seg));
+    }
+    if (!exact_proxy_segments.empty()) {
+      std::string names;
+      for (const std::string& n : exact_proxy_segments) {
+        names += (names.empty() ? "" : ", ") + n;
+      }
+      notes_.push_back("body '" + body.name + "' (contact_method knee): its " +
+                       std::to_string(exact_proxy_segments.size()) +
+                       " proxy segment(s) answer with the exact query (" + names +
+                       "): the god-object keeps its proxy on a surface only with a continuous "
+                       "signed distance, which the knee method's planes are not; its penalty "
+                       "segments use the knee method");
+    }
+    if (!poor_knee_segments.empty()) {
+      notes_.push_back(describe_poor_knee_segments(body.name, knee_penalty_segments,
+                                                   std::move(poor_knee_segments)));
     }
   }
   for (std::size_t b = 0; b < description_.bodies.size(); ++b) {

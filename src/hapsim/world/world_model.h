@@ -136,6 +136,10 @@ class WorldModel {
   /// its own materials at build; a live edit is checked before it is taken. haptic path
   [[nodiscard]] bool sheet_presses_settle(std::span<const ContactMaterial> materials,
                                           SheetPress* unsettled = nullptr) const noexcept;
+  /// What the model decided that the description did not say, one sentence each, to be said
+  /// once where a user reads it: a knee-method body's proxy segments answering exactly, a
+  /// segment the knee method answers far off the exact surface (world/knee_method_query.h).
+  [[nodiscard]] const std::vector<std::string>& notes() const { return notes_; }
   /// Bytes of all rest-shape query structures (meshes excluded).
   [[nodiscard]] std::size_t query_memory_bytes() const;
   [[nodiscard]] double build_ms() const { return build_ms_; }
@@ -144,6 +148,7 @@ class WorldModel {
   void check_sheet_contacts() const;
 
   WorldDescription description_;
+  std::vector<std::string> notes_;
   WorldOptions options_;
   std::unique_ptr<HandModel> hand_;
   std::unique_ptr<MasterArm> master_;

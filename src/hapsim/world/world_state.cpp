@@ -218,7 +218,7 @@ WorldState::WorldState(const WorldModel& model) {
     VertexDeflectionOptions dopt;
     dopt.segments = {d.materials[sd.material].deflection};
     dopt.typical_contact_radius_m = model.max_tool_radius_m();
-    if (d.bodies[seg.body].method == ContactMethod::kKnee && !sd.csg) {
+    if (seg.rest_query->method_name() == "knee") {
       // The knee paper moves vertices along their group's radial direction.
       const auto& knee = static_cast<const KneeIndex&>(*seg.rest_query);
       dopt.directions.resize(sd.mesh.vertex_count());
