@@ -9,6 +9,7 @@
 #include "hapsim/net/scene_info.h"
 #include "hapsim/net/served_scene.h"
 #include "hapsim/net/view_state_codec.h"
+#include "hapsim/render/force_scale.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
@@ -59,6 +60,14 @@ class NetViewerSession final : public ViewerSession {
     snapshot_ = make_world_snapshot(*world_);
     decoder_.emplace(*world_);
     view_ = std::make_unique<WorldScene>(*world_);
+    // The scene's device is the one served (its limits built the world): its rating, not the
+    // readout's default.
+    readout_.rated_force_n = device_rated_force_n(*setup_->profile);
+    readout_.bar_full_scale_n =
+        force_display_scale_n(world_->description(), readout_.rated_force_n);
+    WorldSceneOptions o = view_->options();
+    o.force_full_scale_n = readout_.bar_full_scale_n;
+    view_->set_options(o);
     view_->update(snapshot_);
     commands_.emplace(participant_, info_);
     device_name_ = "simulation host '" + session_ + "'";
