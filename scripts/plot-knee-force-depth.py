@@ -34,7 +34,7 @@ def main(csv_path, png_path):
     axes = [a for row in (axes if nrows > 1 else [axes]) for a in row]
     depths = [i * 0.1 for i in range(0, 121)]
     styles = {"knee_paper.json": ("#c0504d", "paper model (capped springs)"),
-              "knee.json": ("#1f77b4", "FEM knee, 26k tets"),
+              "knee.json": ("#1f77b4", "FEM knee, 24k tets"),
               "knee_fem_80k.json": ("#2ca02c", "FEM knee, 86k tets")}
     for ax, name in zip(axes, landmarks):
         lo = [hertz_n(220.0, d * 1e-3) for d in depths]
