@@ -13,6 +13,7 @@
 #include "hapsim/scene/scene_file.h"
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,10 +29,30 @@ struct PyWorld {
   std::unique_ptr<SessionRecorder> recorder;
   std::uint64_t recorded_cycles = 0;
   std::unique_ptr<CycleRecord> record = std::make_unique<CycleRecord>();
+  /// The last step's command as the device renders it and a recording holds it: clamped to the
+  /// device's profile (what run_session does), so Python reads what a trainee would feel.
+  DeviceCommand command;
+  std::uint64_t clamped_steps = 0;
 
   World& world() { return *setup.world; }
   [[nodiscard]] const World& world() const { return *setup.world; }
 };
+
+// "12.0 N" or "4.0 N per finger" (and the tip's, when a glove has one), for the clamp's warning.
+std::string describe_rating(const DeviceProfile& profile) {
+  std::string out;
+  char text[64];
+  if (profile.max_force_n > 0.0) {
+    std::snprintf(text, sizeof text, "%.1f N", profile.max_force_n);
+    out = text;
+  }
+  if (profile.finger_count > 0) {
+    std::snprintf(text, sizeof text, "%s%.1f N per finger", out.empty() ? "" : ", ",
+                  profile.max_finger_force_n);
+    out += text;
+  }
+  return out.empty() ? std::string("rated 0 N") : out;
+}
 
 template <class Fixed>
 void set_channels(const DoubleArray& values, Fixed& out, int& count, const char* what) {
@@ -135,10 +156,21 @@ void step(PyWorld& w, const DeviceInput& input, std::optional<double> dt_s) {
                                          "or recorded)");
   }
   const StepResult& result = w.world().step(input, dt);
+  // What run_session renders and records: the world's command clamped to the device.
+  ClampReport clamp;
+  w.command = clamp_command(result.command, *w.setup.profile, &clamp);
+  if (clamp.changed() && w.clamped_steps++ == 0) {
+    // Said once (the count is World.clamped_steps): the device's limit, not the world's force.
+    const std::string said = "World.step: the command exceeded the device '" +
+                             w.setup.profile->name + "' (" + describe_rating(*w.setup.profile) +
+                             "); force_world_n, finger_force_n and joint_torque_nm are clamped "
+                             "to it, as the device renders and a recording holds them";
+    if (PyErr_WarnEx(PyExc_RuntimeWarning, said.c_str(), 1) != 0) {
+      throw py::error_already_set();
+    }
+  }
   if (w.recorder) {
-    // What run_session records: the world's command clamped to the device (clamp_command).
-    const DeviceCommand out = clamp_command(result.command, *w.setup.profile);
-    fill_cycle_record(*w.record, w.recorded_cycles, input, result, out, 0.0);
+    fill_cycle_record(*w.record, w.recorded_cycles, input, result, w.command, 0.0);
     if (!w.recorder->record(to_recorded_frame(*w.record, *w.setup.profile))) {
       throw Error(w.recorder->path().string(), "recording failed: " + w.recorder->last_error());
     }
@@ -268,7 +300,11 @@ void bind_world(py::module_& m) {
           "script_input", [](PyWorld& w, double time_s) { return w.setup.device->read(time_s); },
           py::arg("time_s"),
           "The scene's own scripted device's input at time_s (call once per step, in order).")
-      .def("reset", [](PyWorld& w) { w.world().reset(); })
+      .def("reset",
+           [](PyWorld& w) {
+             w.world().reset();
+             w.command = DeviceCommand{};
+           })
       .def_property_readonly("dt_s", [](const PyWorld& w) { return w.dt_s; })
       .def_property_readonly("duration_s", [](const PyWorld& w) { return w.setup.duration_s; })
       .def_property_readonly("time_s",
@@ -368,18 +404,23 @@ void bind_world(py::module_& m) {
                                    self, [](const ToolState& t) { return t.force_world_n.data(); });
                              })
       .def_property_readonly(
-          "force_world_n",
-          [](const PyWorld& w) { return from_vec3(w.world().last_result().command.force_world_n); })
-      .def_property_readonly("finger_force_n",
-                             [](const PyWorld& w) {
-                               const DeviceCommand& c = w.world().last_result().command;
-                               return channels(c.finger_force_n, c.finger_count);
-                             })
-      .def_property_readonly("joint_torque_nm",
-                             [](const PyWorld& w) {
-                               const DeviceCommand& c = w.world().last_result().command;
-                               return channels(c.joint_torque_nm, c.joint_count);
-                             })
+          "force_world_n", [](const PyWorld& w) { return from_vec3(w.command.force_world_n); },
+          "The tip force the device renders (clamped to its rating, as recorded), N")
+      .def_property_readonly(
+          "finger_force_n",
+          [](const PyWorld& w) {
+            return channels(w.command.finger_force_n, w.command.finger_count);
+          },
+          "The finger forces the device renders (clamped to its rating, as recorded), N")
+      .def_property_readonly(
+          "joint_torque_nm",
+          [](const PyWorld& w) {
+            return channels(w.command.joint_torque_nm, w.command.joint_count);
+          },
+          "The joint torques the device renders (clamped to its rating, as recorded), N m")
+      .def_property_readonly(
+          "clamped_steps", [](const PyWorld& w) { return w.clamped_steps; },
+          "Steps whose command the device's limits clamped (warned once, at the first)")
       .def("contacts", [](const PyWorld& w) { return contacts(w.world()); })
       .def(
           "body_pose",

@@ -96,3 +96,28 @@ def test_a_glove_scene_reports_finger_forces():
         peak = np.maximum(peak, f)
     assert world.finger_force_n.dtype == np.float64
     assert peak.max() > 0.1  # the index or middle finger pressed
+
+
+def test_a_glove_pressed_too_hard_reads_the_device_clamp(tmp_path):
+    # The knee_hand script's hand pushed 30 mm further down: the world asks for over 9 N on a
+    # finger of the Rutgers Master (4 N). Python reads what the device renders and the recording
+    # holds (4.0 N), and says the clamp once.
+    world = hapsim.World(str(HAND))
+    rec = tmp_path / "pressed.rec"
+    world.record(str(rec))
+    read = []
+    with pytest.warns(RuntimeWarning, match="rutgers_master.*4.0 N per finger") as said:
+        for i in range(3000):
+            inp = world.script_input(i * world.dt_s)
+            p = np.array(inp.p_world)
+            p[1] -= 0.03 * min(i / 1500, 1.0)
+            inp.p_world = p
+            world.step(inp)
+            read.append(np.array(world.finger_force_n))
+    world.stop_recording()
+    assert len([w for w in said if w.category is RuntimeWarning]) == 1
+    assert world.clamped_steps > 0
+    read = np.array(read)
+    assert read.max() == pytest.approx(4.0)
+    recorded = hapsim.read_recording(str(rec))
+    np.testing.assert_array_equal(read, recorded.finger_force_n[:, : read.shape[1]])
