@@ -456,10 +456,16 @@ void run(const RunArgs& args) {
   options.progress = progress;
   options.teleop_target_world = setup.teleop_target_world;
   options.stop = &stop;
-  const SessionSummary summary = run_session(*world, *device, options);
+  SessionSummary summary = run_session(*world, *device, options);
   const int stopped_by = stop.load() ? stop_signal_number().load() : 0;
   if (recorder) {
-    recorder->close();
+    try {
+      recorder->close();
+    } catch (const Error& e) {  // a full disk: the summary and the JSON are still written
+      if (summary.recording_error.empty()) {
+        summary.recording_error = e.what();
+      }
+    }
   }
   std::cout << format_session_summary(summary);
   if (stopped_by != 0) {
@@ -504,7 +510,7 @@ void run(const RunArgs& args) {
     json_out.write(j);
   }
   if (failed) {
-    exit_status() = 1;
+    exit_status() = summary.recording_error.empty() ? 1 : 2;  // 2: an output was not written
   }
   if (stopped_by != 0) {
     exit_status() = stopped_by_signal_status();  // 128 + the signal, as a shell reports it

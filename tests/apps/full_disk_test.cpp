@@ -158,4 +158,32 @@ TEST(FullTmpfs, CsvAndJsonWritersFailPartWay) {
   EXPECT_EQ(std::distance(fs::directory_iterator(disk.dir()), fs::directory_iterator()), 0);
 }
 
+// A recording that fills the disk ends the recording, not the run: the run goes on to its end,
+// prints its summary with the reason, writes its --json (elsewhere) with ok false and the
+// recording's error, and exits 2; the file keeps its complete blocks and reads back.
+TEST(FullTmpfs, ARecordingThatFillsTheDiskStillGivesTheSummaryAndTheJson) {
+  const hapsim::test::SmallTmpfs disk("apps_rec");
+  if (!disk.mounted()) {
+    GTEST_SKIP() << disk.why_not();
+  }
+  const fs::path rec = disk.dir() / "run.rec";
+  const fs::path json = hapsim::test::temp_path("full_disk_run.json");
+  const RunResult r = run_limited("run " + kScenes + "csg_block.json -q --record " + rec.string() +
+                                  " --json " + json.string());
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("recording STOPPED early: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("FAILED: the recording stopped early"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("step cost"), std::string::npos) << r.output;  // the whole summary
+  EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
+  const std::string written = contents(json);
+  EXPECT_NE(written.find("\"ok\": false"), std::string::npos) << written;
+  EXPECT_NE(written.find("\"recording_error\""), std::string::npos) << written;
+  EXPECT_NE(written.find("\"steps\""), std::string::npos) << written;
+  // What the recording kept is readable: its complete blocks.
+  const RunResult replay =
+      run_limited("run " + kScenes + "csg_block.json -q --replay " + rec.string());
+  EXPECT_EQ(replay.output.find("internal error"), std::string::npos) << replay.output;
+  EXPECT_EQ(replay.output.find("corrupt"), std::string::npos) << replay.output;
+}
+
 }  // namespace

@@ -1,8 +1,9 @@
 // Faults around the real `hapsim run` (issue 14 item 3): the real-time process stopped for 2 s
 // (SIGSTOP) and continued, and the disk filling up while a run records. Expected: the run goes on
-// and exits cleanly (its summary counts the gap the haptic thread ramped), or it stops with one
-// line naming the file; nothing recorded before the fault is lost (the recording reads and replays
-// bit for bit up to it). The disk is "full" through the file size limit (ulimit -f, SIGXFSZ
+// and exits cleanly (its summary counts the gap the haptic thread ramped), or, when the disk
+// fills, the recording stops and the run goes on to its end, then says why, naming the file, and
+// exits 2; nothing recorded before the fault is lost (the recording reads and replays bit for bit
+// up to it). The disk is "full" through the file size limit (ulimit -f, SIGXFSZ
 // ignored), which fails a write past it with EFBIG as a full disk fails it with ENOSPC.
 #include "hapsim_process.h"
 
@@ -32,10 +33,10 @@ RunResult run_with_file_limit(int kib, const std::string& args) {
                                       args);
 }
 
-// The one "hapsim: PATH: write failed (disk full?): the recording keeps its first K frame(s)..."
-// line; K (-1 when the line is missing).
+// The summary's "recording STOPPED early: PATH: write failed (disk full?): the recording keeps
+// its first K frame(s)..." line; K (-1 when the line is missing).
 long kept_frames(const RunResult& r, const fs::path& recording) {
-  const std::regex line("hapsim: " + recording.string() +
+  const std::regex line("recording STOPPED early: " + recording.string() +
                         ": write failed \\(disk full\\?\\): the recording keeps its first "
                         "([0-9]+) frame");
   std::smatch m;

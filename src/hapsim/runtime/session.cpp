@@ -206,7 +206,7 @@ class SessionAccountant {
       sheet.max_depth_m = std::max(sheet.max_depth_m, r.sheet_depth_m[i]);
       sheet.final_depth_m = r.sheet_depth_m[i];
     }
-    if (options_.recorder != nullptr) {
+    if (options_.recorder != nullptr && summary_.recording_error.empty()) {
       if (!options_.recorder->record(to_recorded_frame(r, profile_))) {
         ++summary_.recording_dropped_frames;
       } else {
@@ -215,7 +215,7 @@ class SessionAccountant {
       // The disk is touched here, between cycles (inline) or off the haptic thread (real time),
       // every 100 ms of the session at most: a killed run keeps all but its last 100 ms.
       if (options_.recorder->flush_due()) {
-        options_.recorder->flush();
+        flush_recording();
       }
     }
     ++summary_.steps;
@@ -250,9 +250,19 @@ class SessionAccountant {
     seg.max_deflection_m = std::max(seg.max_deflection_m, deflection_m);
   }
 
-  SessionSummary finish(double dt_s, double wall_s) {
-    if (options_.recorder != nullptr) {
+  // A failed write (a full disk) ends the recording, not the run: the recorder has cut the file
+  // back to its last complete block, and the summary says why it stopped there.
+  void flush_recording() {
+    try {
       options_.recorder->flush();
+    } catch (const Error& e) {
+      summary_.recording_error = e.what();
+    }
+  }
+
+  SessionSummary finish(double dt_s, double wall_s) {
+    if (options_.recorder != nullptr && summary_.recording_error.empty()) {
+      flush_recording();
     }
     summary_.wall_s = wall_s;
     summary_.simulated_s = static_cast<double>(summary_.steps) * dt_s;
@@ -724,6 +734,9 @@ std::string format_session_summary(const SessionSummary& s) {
   if (s.recorded_frames > 0 || s.recording_dropped_frames > 0) {
     out << "recorded frames: " << s.recorded_frames << " (dropped " << s.recording_dropped_frames
         << ")\n";
+  }
+  if (!s.recording_error.empty()) {
+    out << "recording STOPPED early: " << s.recording_error << "\n";
   }
   if (s.realtime) {
     out << format_realtime_summary(*s.realtime);

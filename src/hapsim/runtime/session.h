@@ -228,6 +228,9 @@ struct SessionSummary {
   std::size_t dropped_contacts = 0;
   std::size_t recorded_frames = 0;
   std::size_t recording_dropped_frames = 0;
+  /// Why the recording stopped before the run did (a full disk): the run goes on, its summary
+  /// and JSON are still written, and the run fails with this. Empty when it did not.
+  std::string recording_error;
   /// Realtime only: periods longer than two nominal periods.
   std::size_t missed_deadlines = 0;
   std::optional<RealtimeSummary> realtime;

@@ -76,6 +76,9 @@ nlohmann::json session_summary_json(const SceneDescription& scene, const World& 
   j["dropped_contacts"] = s.dropped_contacts;
   j["missed_deadlines"] = s.missed_deadlines;
   j["recorded_frames"] = s.recorded_frames;
+  if (!s.recording_error.empty()) {
+    j["recording_error"] = s.recording_error;
+  }
   if (s.realtime) {
     j["realtime"] = realtime_json(*s.realtime);
   }
@@ -150,6 +153,9 @@ std::vector<std::string> run_failures(const RunSetup& setup, const SessionSummar
   if (summary.max_force_limit_violations > 0) {
     failures.push_back(std::to_string(summary.max_force_limit_violations) +
                        " command(s) above the device's rated force");
+  }
+  if (!summary.recording_error.empty()) {
+    failures.push_back("the recording stopped early: " + summary.recording_error);
   }
   return failures;
 }
