@@ -1,7 +1,8 @@
 // Fuzz target: bytes as a recording file (read_recording: header, frames, checksums). The bytes
 // go through a scratch file, so the checksums are mostly wrong; the seeds are real recordings
 // and the replay's mutations keep their checksums only by chance, so a second mode (first byte
-// odd) re-seals every frame's checksum before the read, to reach the frame checks. Checks: it
+// odd) re-seals the header's and every frame's (block's, version 3) checksum before the read, to
+// reach the frame checks. Checks: it
 // returns frames whose counts are in range and whose inputs and commands are finite, or throws
 // hapsim::Error; nothing else escapes.
 #include "file_fuzz_support.h"
@@ -21,25 +22,58 @@ std::uint64_t fnv1a(const unsigned char* data, std::size_t size) {
   return h;
 }
 
-// Rewrites the header's and every whole frame's checksum (docs/recording-format.md).
+std::uint32_t u32_at(const std::string& bytes, std::size_t at) {
+  std::uint32_t v = 0;
+  std::memcpy(&v, bytes.data() + at, 4);
+  return v;
+}
+
+void seal(std::string& bytes, std::size_t from, std::size_t length, std::size_t checksum_at) {
+  const std::uint64_t h =
+      fnv1a(reinterpret_cast<const unsigned char*>(bytes.data() + from), length);
+  std::memcpy(bytes.data() + checksum_at, &h, 8);
+}
+
+// Rewrites the header's checksum, then every whole frame's (versions 1 and 2) or every whole
+// block's (version 3: marker, count, length, frames, checksum), as docs/recording-format.md
+// lays them out.
 void reseal(std::string& bytes) {
-  constexpr std::size_t kFixed = 8 + 6 * 4;
+  constexpr std::size_t kFixed = 8 + 6 * 4;  // magic, version, sizes, the hash's length
   if (bytes.size() < kFixed) {
     return;
   }
-  std::uint32_t hash_length = 0;
-  std::memcpy(&hash_length, bytes.data() + kFixed - 4, 4);
-  const std::size_t header = kFixed + hash_length;
-  if (hash_length > 4096 || bytes.size() < header + 8) {
+  const std::uint32_t version = u32_at(bytes, 8);
+  std::size_t header = kFixed;
+  for (int field = 0; field < (version >= 2 ? 3 : 1); ++field) {  // hash (and the two paths)
+    if (bytes.size() < header + (field == 0 ? 0 : 4)) {
+      return;
+    }
+    const std::size_t length_at = field == 0 ? kFixed - 4 : header;
+    const std::uint32_t length = u32_at(bytes, length_at);
+    if (length > 4096) {
+      return;
+    }
+    header = (field == 0 ? kFixed : header + 4) + length;
+  }
+  if (bytes.size() < header + 8) {
     return;
   }
-  const std::uint64_t h = fnv1a(reinterpret_cast<const unsigned char*>(bytes.data()), header);
-  std::memcpy(bytes.data() + header, &h, 8);
-  const std::size_t frame = hapsim::recorded_frame_size_bytes();
-  for (std::size_t at = header + 8; at + frame <= bytes.size(); at += frame) {
-    const std::uint64_t f =
-        fnv1a(reinterpret_cast<const unsigned char*>(bytes.data() + at + 4), frame - 12);
-    std::memcpy(bytes.data() + at + frame - 8, &f, 8);
+  seal(bytes, 0, header, header);
+  std::size_t at = header + 8;
+  if (version < 3) {
+    const std::size_t frame = hapsim::recorded_frame_size_bytes();
+    for (; at + frame <= bytes.size(); at += frame) {
+      seal(bytes, at + 4, frame - 12, at + frame - 8);
+    }
+    return;
+  }
+  while (at + 12 <= bytes.size()) {
+    const std::size_t length = u32_at(bytes, at + 8);
+    if (length > bytes.size() || at + 12 + length + 8 > bytes.size()) {
+      return;
+    }
+    seal(bytes, at, 12 + length, at + 12 + length);
+    at += 12 + length + 8;
   }
 }
 
