@@ -1,6 +1,7 @@
 // The `hapsim` command as a user runs it: exit codes, one-line messages naming the bad input,
 // and query output checked against analytic answers on a built-in box.
 #include "hapsim_process.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -236,11 +237,9 @@ TEST(Cli, SimplifyWritesAClosedMeshAndItsHausdorffDistance) {
 }
 
 TEST(Cli, InfoOnTheRealKnee) {
-  const std::filesystem::path stl = std::filesystem::path(HAPSIM_TEST_DATA_DIR) /
-                                    "knee_vhf_left/stl/VHF_Left_Bone_Patella_smooth.stl";
-  if (!std::filesystem::exists(stl)) {
-    GTEST_SKIP() << "real knee data not found at " << stl << " (../shared/data absent)";
-  }
+  const std::filesystem::path stl =
+      hapsim::test::data_path("knee_vhf_left/stl/VHF_Left_Bone_Patella_smooth.stl");
+  HAPSIM_SKIP_WITHOUT_DATA(std::filesystem::exists(stl), "real knee data not found at " << stl);
   const RunResult r = run_hapsim("info " + stl.string() + " --scale 0.001");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("closed"), std::string::npos) << r.output;

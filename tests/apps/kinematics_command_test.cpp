@@ -1,6 +1,7 @@
 // `hapsim fk` and `hapsim ik` as a user runs them: a planar two-link URDF whose answers are known
 // by hand, the GP7 when the data is there, and every bad input one named line with exit status 2.
 #include "hapsim_process.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -72,10 +73,8 @@ TEST(KinematicsCommands, ForwardThenInverseOnAPlanarArm) {
 }
 
 TEST(KinematicsCommands, Gp7HomePose) {
-  const auto urdf = std::filesystem::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7" / "gp7.urdf";
-  if (!std::filesystem::exists(urdf)) {
-    GTEST_SKIP() << "Motoman GP7 URDF not found at " << urdf << " (real-data tests skip)";
-  }
+  const auto urdf = hapsim::test::data_path("motoman_gp7/gp7.urdf");
+  HAPSIM_SKIP_WITHOUT_DATA(std::filesystem::exists(urdf), "Motoman GP7 URDF not found at " << urdf);
   const auto joints = write_file("gp7.csv", "0,0,0,0,0,0\n");
   const auto out = temp_path("gp7_pose.csv");
   const RunResult r = run_hapsim("fk " + urdf.string() + " --joints " + joints.string() +

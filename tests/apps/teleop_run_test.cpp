@@ -3,6 +3,7 @@
 // hold what the issue lists, the GP7 variant runs when its URDF is there, and options a teleop
 // scene cannot honour are refused with one line.
 #include "hapsim_process.h"
+#include "support/test_data.h"
 
 #include <nlohmann/json.hpp>
 
@@ -48,10 +49,9 @@ TEST(TeleopRun, PickAndPlaceCompletesUnattended) {
 }
 
 TEST(TeleopRun, Gp7VariantRunsWhenTheDataIsThere) {
-  const auto data = std::filesystem::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7";
-  if (!std::filesystem::exists(data / "gp7.urdf")) {
-    GTEST_SKIP() << "Motoman GP7 URDF not found in " << data << " (real-data tests skip)";
-  }
+  const auto data = hapsim::test::data_path("motoman_gp7");
+  HAPSIM_SKIP_WITHOUT_DATA(std::filesystem::exists(data / "gp7.urdf"),
+                           "Motoman GP7 URDF not found in " << data);
   expect_pick_and_place("run " + kScenes + "/teleop_gp7.json --data " + data.string(),
                         "teleop_gp7.json");
 }

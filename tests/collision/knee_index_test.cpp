@@ -11,6 +11,7 @@
 #include "hapsim/geometry/mesh_io.h"
 #include "hapsim/geometry/polygonizer.h"
 #include "hapsim/geometry/procedural.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -53,7 +54,7 @@ TriangleMesh make_csg_part() {
 }
 
 std::optional<std::filesystem::path> knee_stl_dir() {
-  const auto data = find_data_dir(HAPSIM_TEST_DATA_DIR);
+  const auto data = test::data_dir();
   if (!data || !std::filesystem::is_directory(*data / "knee_vhf_left" / "stl")) {
     return std::nullopt;
   }
@@ -455,13 +456,10 @@ TEST(KneeIndex, PolygonisedCsgPartErrorWithinBound) {
 
 TEST(KneeIndex, RealKneePartsErrorWithinBound) {
   const auto dir = knee_stl_dir();
-  if (!dir) {
-    GTEST_SKIP() << "knee STLs not found (set HAPSIM_DATA or provide ../shared/data)";
-  }
+  HAPSIM_SKIP_WITHOUT_DATA(dir.has_value(), "knee STLs not found");
   for (const char* file : {"VHF_Left_Bone_Patella_smooth.stl", "VHF_Left_Bone_Tibia_smooth.stl"}) {
-    if (!std::filesystem::exists(*dir / file)) {
-      GTEST_SKIP() << file << " not found in " << dir->string();
-    }
+    HAPSIM_SKIP_WITHOUT_DATA(std::filesystem::exists(*dir / file),
+                             file << " not found in " << dir->string());
     (void)expect_within_bound(load_knee_part(*dir, file), file, 20000, 0.002, 0.001);
   }
 }

@@ -4,6 +4,7 @@
 #include "hapsim/core/data_dir.h"
 #include "hapsim/geometry/procedural.h"
 #include "oracles/closest_point_oracle.h"
+#include "support/test_data.h"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -126,10 +127,9 @@ TEST(MeshBvhOracle, SheetsAgreeWithCgal) {
 }
 
 TEST(MeshBvhOracle, KneeStlsAgreeWithCgal) {
-  const auto data = find_data_dir(HAPSIM_TEST_DATA_DIR);
-  if (!data || !std::filesystem::is_directory(*data / "knee_vhf_left" / "stl")) {
-    GTEST_SKIP() << "knee STLs not found (set HAPSIM_DATA or provide ../shared/data)";
-  }
+  const auto data = test::data_dir();
+  HAPSIM_SKIP_WITHOUT_DATA(data && std::filesystem::is_directory(*data / "knee_vhf_left" / "stl"),
+                           "knee STLs not found");
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(*data / "knee_vhf_left" / "stl")) {
     if (entry.path().extension() != ".stl") {

@@ -14,6 +14,7 @@
 #include "hapsim/geometry/mesh_validation.h"
 #include "hapsim/geometry/polygonizer.h"
 #include "hapsim/geometry/procedural.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -95,12 +96,10 @@ TEST(MeshSimplify, BumpySphereClosedValidWithinReportedHausdorff) {
 }
 
 TEST(MeshSimplify, RealKneePatellaClosedValidWithinReportedHausdorff) {
-  const auto data = find_data_dir(HAPSIM_TEST_DATA_DIR);
   const std::filesystem::path file =
-      data ? *data / "knee_vhf_left/stl/VHF_Left_Bone_Patella_smooth.stl" : "";
-  if (!data || !std::filesystem::exists(file)) {
-    GTEST_SKIP() << "real data folder not found (set HAPSIM_DATA or place ../shared/data)";
-  }
+      test::data_path("knee_vhf_left/stl/VHF_Left_Bone_Patella_smooth.stl");
+  HAPSIM_SKIP_WITHOUT_DATA(std::filesystem::exists(file),
+                           "real knee patella not found at " << file);
   MeshLoadOptions options;
   options.scale = 0.001;
   expect_simplified_within_reported(load_mesh(file, options), 300);

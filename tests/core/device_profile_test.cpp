@@ -1,7 +1,8 @@
 #include "hapsim/core/device_profile.h"
 
-#include "hapsim/core/error.h"
 #include "hapsim/core/device_io.h"
+#include "hapsim/core/error.h"
+#include "support/test_data.h"
 
 #include <cmath>
 #include <fstream>
@@ -54,11 +55,9 @@ TEST(DeviceProfile, ValuesFromTheSeedAndCsv) {
 
 // The CHAI3D-derived profiles must agree with the project's data table, row by row.
 TEST(DeviceProfile, Chai3dProfilesMatchTheDataTable) {
-  const std::string csv_path = std::string(HAPSIM_TEST_DATA_DIR) + "/tissue_device_values.csv";
+  const std::string csv_path = test::data_path("tissue_device_values.csv").string();
   std::ifstream in(csv_path);
-  if (!in) {
-    GTEST_SKIP() << "no data table at " << csv_path;
-  }
+  HAPSIM_SKIP_WITHOUT_DATA(in.is_open(), "no data table at " << csv_path);
   std::stringstream text;
   text << in.rdbuf();
   const std::string csv = text.str();

@@ -4,6 +4,7 @@
 #include "hapsim/core/data_dir.h"
 #include "hapsim/core/error.h"
 #include "hapsim/geometry/procedural.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -471,10 +472,9 @@ TEST(MeshIoUnits, MetresPerUnit) {
 // ---- real data (skipped when ../shared/data is absent) ----
 
 TEST(MeshIoRealData, KneeStlsMatchPublishedStats) {
-  const auto data = find_data_dir(HAPSIM_TEST_DATA_DIR);
-  if (!data || !fs::exists(*data / "knee_vhf_left/mesh_stats.jsonl")) {
-    GTEST_SKIP() << "real data folder not found (set HAPSIM_DATA or place ../shared/data)";
-  }
+  const auto data = test::data_dir();
+  HAPSIM_SKIP_WITHOUT_DATA(data && fs::exists(*data / "knee_vhf_left/mesh_stats.jsonl"),
+                           "real knee mesh statistics not found");
   std::ifstream stats_file(*data / "knee_vhf_left/mesh_stats.jsonl");
   int files = 0;
   std::size_t total_vertices = 0;
@@ -517,10 +517,9 @@ TEST(MeshIoRealData, KneeStlsMatchPublishedStats) {
 }
 
 TEST(MeshIoRealData, MotomanGp7MeshesLoad) {
-  const auto data = find_data_dir(HAPSIM_TEST_DATA_DIR);
-  if (!data || !fs::is_directory(*data / "motoman_gp7/meshes")) {
-    GTEST_SKIP() << "real data folder not found (set HAPSIM_DATA or place ../shared/data)";
-  }
+  const auto data = test::data_dir();
+  HAPSIM_SKIP_WITHOUT_DATA(data && fs::is_directory(*data / "motoman_gp7/meshes"),
+                           "Motoman GP7 meshes not found");
   int files = 0;
   for (const char* kind : {"collision", "visual"}) {
     for (const auto& entry : fs::directory_iterator(*data / "motoman_gp7/meshes" / kind)) {

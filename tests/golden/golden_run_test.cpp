@@ -13,6 +13,7 @@
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/world/world.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -38,7 +39,7 @@ std::optional<SceneLoadOptions> load_options(const std::string& data_folder) {
   if (data_folder.empty()) {
     return o;
   }
-  const auto root = find_data_dir(HAPSIM_TEST_DATA_DIR);
+  const auto root = test::data_dir();
   if (!root || !fs::is_directory(*root / data_folder)) {
     return std::nullopt;
   }
@@ -131,10 +132,7 @@ test::GoldenTrace run_scene(SceneDescription scene, const std::string& name) {
 
 void check_scene(const std::string& name, const std::string& data_folder = {}) {
   const auto options = load_options(data_folder);
-  if (!options) {
-    GTEST_SKIP() << "real data '" << data_folder << "' not found under " << HAPSIM_TEST_DATA_DIR
-                 << " (tests with real data skip)";
-  }
+  HAPSIM_SKIP_WITHOUT_DATA(options.has_value(), "real data '" << data_folder << "' not found");
   const test::GoldenTrace actual =
       run_scene(load_scene(kScenes / (name + ".json"), *options), name);
   const fs::path golden = kGolden / (name + ".trace.gz");

@@ -7,6 +7,7 @@
 #include "hapsim/kinematics/urdf_chain.h"
 
 #include "support/allocation_counter.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -83,10 +84,8 @@ TEST(InverseKinematics, RoundTripsWhenTrackingAndFromCold) {
 }
 
 TEST(InverseKinematics, Gp7RoundTrips) {
-  const fs::path urdf = fs::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7" / "gp7.urdf";
-  if (!fs::exists(urdf)) {
-    GTEST_SKIP() << "Motoman GP7 URDF not found at " << urdf << " (real-data tests skip)";
-  }
+  const fs::path urdf = test::data_path("motoman_gp7/gp7.urdf");
+  HAPSIM_SKIP_WITHOUT_DATA(fs::exists(urdf), "Motoman GP7 URDF not found at " << urdf);
   UrdfChainOptions o;
   o.load_collision_meshes = false;
   const SerialChain gp7 = load_urdf_chain(urdf, o);

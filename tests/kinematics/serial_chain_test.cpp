@@ -5,6 +5,7 @@
 #include "hapsim/kinematics/urdf_chain.h"
 
 #include "hapsim/core/error.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -124,13 +125,11 @@ TEST(SerialChain, BadJointsAreRefused) {
 }
 
 fs::path gp7_urdf() {
-  return fs::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7" / "gp7.urdf";
+  return test::data_path("motoman_gp7/gp7.urdf");
 }
 
-#define SKIP_WITHOUT_GP7()                                                                       \
-  if (!fs::exists(gp7_urdf())) {                                                                 \
-    GTEST_SKIP() << "Motoman GP7 URDF not found at " << gp7_urdf() << " (real-data tests skip)"; \
-  }
+#define SKIP_WITHOUT_GP7() \
+  HAPSIM_SKIP_WITHOUT_DATA(fs::exists(gp7_urdf()), "Motoman GP7 URDF not found at " << gp7_urdf())
 
 // At q = 0 the GP7's joint origins (URDF) add up to tool0 at (0.04 + 0.44 + 0.08, 0,
 // 0.33 + 0.445 + 0.04) with rpy (π, −π/2, 0); base rotation and the shoulder turn it as a rigid

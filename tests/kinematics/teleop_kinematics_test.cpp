@@ -7,6 +7,7 @@
 #include "hapsim/kinematics/urdf_chain.h"
 
 #include "hapsim/core/error.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -118,10 +119,8 @@ TEST(SlaveFollower, ProceduralMotomanTracksTheMaster) {
 }
 
 TEST(SlaveFollower, Gp7TracksTheMaster) {
-  const auto urdf = std::filesystem::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7" / "gp7.urdf";
-  if (!std::filesystem::exists(urdf)) {
-    GTEST_SKIP() << "Motoman GP7 URDF not found at " << urdf << " (real-data tests skip)";
-  }
+  const auto urdf = test::data_path("motoman_gp7/gp7.urdf");
+  HAPSIM_SKIP_WITHOUT_DATA(std::filesystem::exists(urdf), "Motoman GP7 URDF not found at " << urdf);
   UrdfChainOptions o;
   o.load_collision_meshes = false;
   expect_tracks(load_urdf_chain(urdf, o));

@@ -3,6 +3,7 @@
 // Joint(origin, axis) then the joint origin frame), so the only thing shared with hapsim is
 // urdfdom's reading of the XML.
 #include "hapsim/kinematics/urdf_chain.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -60,10 +61,8 @@ TEST(KdlOracle, Gp7ForwardKinematicsAndJacobianAgree) {
 #ifndef HAPSIM_HAVE_KDL
   GTEST_SKIP() << "orocos-kdl not found at configure time";
 #else
-  const fs::path urdf = fs::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7" / "gp7.urdf";
-  if (!fs::exists(urdf)) {
-    GTEST_SKIP() << "Motoman GP7 URDF not found at " << urdf << " (real-data tests skip)";
-  }
+  const fs::path urdf = test::data_path("motoman_gp7/gp7.urdf");
+  HAPSIM_SKIP_WITHOUT_DATA(fs::exists(urdf), "Motoman GP7 URDF not found at " << urdf);
   UrdfChainOptions o;
   o.load_collision_meshes = false;
   const SerialChain ours = load_urdf_chain(urdf, o);

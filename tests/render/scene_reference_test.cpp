@@ -14,6 +14,7 @@
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/scene/teleop_setup.h"
 #include "hapsim/world/world.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -21,6 +22,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <numbers>
+#include <string_view>
 
 namespace hapsim {
 namespace {
@@ -32,8 +34,11 @@ std::filesystem::path reference_dir() {
   return std::filesystem::path(HAPSIM_SOURCE_DIR) / "tests" / "render" / "reference";
 }
 
+// Only "1" rewrites the pictures: any other value (0, empty) compares, so a stray
+// HAPSIM_UPDATE_REFERENCES=0 cannot turn these tests into passes that compared nothing.
 bool updating() {
-  return std::getenv("HAPSIM_UPDATE_REFERENCES") != nullptr;
+  const char* v = std::getenv("HAPSIM_UPDATE_REFERENCES");
+  return v != nullptr && std::string_view(v) == "1";
 }
 
 std::unique_ptr<SnapshotWriter> make_writer() {
@@ -175,10 +180,9 @@ std::unique_ptr<World> stepped_teleop(const SceneDescription& scene, int steps) 
 }
 
 TEST(SceneReference, Gp7DrawnFromItsVisualMeshesMatchesTheReference) {
-  const auto data = std::filesystem::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7";
-  if (!std::filesystem::exists(data / "gp7.urdf")) {
-    GTEST_SKIP() << "Motoman GP7 URDF not found in " << data << " (real-data tests skip)";
-  }
+  const auto data = test::data_path("motoman_gp7");
+  HAPSIM_SKIP_WITHOUT_DATA(std::filesystem::exists(data / "gp7.urdf"),
+                           "Motoman GP7 URDF not found in " << data);
   auto writer = make_writer();
   if (!writer) {
     GTEST_SKIP() << "no EGL context on this machine";

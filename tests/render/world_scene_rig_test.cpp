@@ -15,6 +15,7 @@
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/scene/teleop_setup.h"
 #include "render/gl_test_context.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -349,10 +350,9 @@ namespace hapsim {
 namespace {
 
 TEST(WorldSceneRig, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
-  const auto data = std::filesystem::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7";
-  if (!std::filesystem::exists(data / "gp7.urdf")) {
-    GTEST_SKIP() << "Motoman GP7 URDF not found in " << data << " (real-data tests skip)";
-  }
+  const auto data = test::data_path("motoman_gp7");
+  HAPSIM_SKIP_WITHOUT_DATA(std::filesystem::exists(data / "gp7.urdf"),
+                           "Motoman GP7 URDF not found in " << data);
   SceneLoadOptions o;
   o.data_dir = data;
   const SceneDescription scene =

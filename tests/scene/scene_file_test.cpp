@@ -8,6 +8,7 @@
 #include "hapsim/geometry/triangle_mesh.h"
 
 #include "support/temp_dir_test.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -682,10 +683,8 @@ TEST(ShippedScenes, KneeLoadsElevenSegmentsWithTissueMaterials) {
 }
 
 TEST(ShippedScenes, RealKneeLoadsAllPartsWhenTheDataIsPresent) {
-  const fs::path data = fs::path(HAPSIM_TEST_DATA_DIR) / "knee_vhf_left";
-  if (!fs::is_directory(data / "stl")) {
-    GTEST_SKIP() << "real knee data not found at " << data << " (tests with real data skip)";
-  }
+  const fs::path data = test::data_path("knee_vhf_left");
+  HAPSIM_SKIP_WITHOUT_DATA(fs::is_directory(data / "stl"), "real knee data not found at " << data);
   SceneLoadOptions options;
   options.data_dir = data;
   const SceneDescription s =

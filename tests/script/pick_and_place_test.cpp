@@ -8,6 +8,7 @@
 #include "hapsim/world/world.h"
 
 #include "hapsim/core/error.h"
+#include "support/test_data.h"
 
 #include <gtest/gtest.h>
 
@@ -102,10 +103,8 @@ TEST(PickAndPlace, ProceduralMotomanPlacesTheBallOnTheSheet) {
 }
 
 TEST(PickAndPlace, Gp7PlacesTheBallOnTheSheet) {
-  const auto urdf = std::filesystem::path(HAPSIM_TEST_DATA_DIR) / "motoman_gp7" / "gp7.urdf";
-  if (!std::filesystem::exists(urdf)) {
-    GTEST_SKIP() << "Motoman GP7 URDF not found at " << urdf << " (real-data tests skip)";
-  }
+  const auto urdf = test::data_path("motoman_gp7/gp7.urdf");
+  HAPSIM_SKIP_WITHOUT_DATA(std::filesystem::exists(urdf), "Motoman GP7 URDF not found at " << urdf);
   UrdfChainOptions o;
   o.load_collision_meshes = false;
   expect_pick_and_place(std::make_shared<const SerialChain>(load_urdf_chain(urdf, o)));
