@@ -45,6 +45,8 @@ struct CycleRecord {
   /// The teleoperation rig's step (when the world has a rig: has_teleop).
   bool has_teleop = false;
   TeleopStepResult teleop;
+  /// What the step cost, us: World::step in the real-time loop (never the device's read, which
+  /// for a served world is the lockstep wait); the inline run's read, step, safety and write.
   double cost_us = 0.0;
 };
 

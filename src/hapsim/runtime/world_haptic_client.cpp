@@ -4,6 +4,7 @@
 #include "hapsim/deform/virtual_sheet.h"
 
 #include <algorithm>
+#include <chrono>
 
 namespace hapsim {
 
@@ -89,7 +90,10 @@ const DeviceCommand& WorldHapticClient::step(const DeviceInput& input, double dt
   if (options_.observer != nullptr) {
     options_.observer->before_step(world_);
   }
+  const auto t0 = std::chrono::steady_clock::now();
   last_result_ = &world_.step(input, dt_s);
+  step_cost_us_ =
+      std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
   stepped_ = true;
   return last_result_->command;
 }
@@ -137,7 +141,7 @@ void WorldHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
   // numbers the steps it takes 0, 1, 2, ...).
   if (records_ && stepped_ && last_result_ != nullptr) {
     fill_cycle_record(scratch_record_, recorded_cycles_++, *cycle.input, *last_result_,
-                      *cycle.output, cycle.cost_us);
+                      *cycle.output, step_cost_us_);
     if (!records_->push(scratch_record_)) {
       dropped_records_.store(dropped_records_.load(std::memory_order_relaxed) + 1,
                              std::memory_order_relaxed);

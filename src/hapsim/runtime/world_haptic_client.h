@@ -115,6 +115,9 @@ class WorldHapticClient final : public HapticClient {
   bool soft_start_ = false;
   // Cycles that stepped the world so far: the records' numbering (haptic thread).
   std::uint64_t recorded_cycles_ = 0;
+  // World::step alone, this cycle: a record's cost (the loop's cycle also holds the device's read,
+  // which for a served world is the lockstep wait for the device host's state).
+  double step_cost_us_ = 0.0;
   DeviceCommand zero_command_;
   std::unique_ptr<TripleBuffer<WorldSnapshot>> snapshots_;
   std::unique_ptr<SpscRing<CycleRecord>> records_;
