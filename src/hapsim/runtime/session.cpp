@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -109,6 +110,8 @@ class SessionAccountant {
     }
     if (options.check_pop_through) {
       checks_ = make_proxy_checks(world);
+      proxy_inside_.assign(checks_.size() * desc.tools.size(), kOutside);
+      last_proxy_world_.assign(desc.tools.size(), Vec3::Constant(kNever));
     }
     for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
       if (desc.bodies[b].kind == BodyKind::kDynamic &&
@@ -173,18 +176,45 @@ class SessionAccountant {
         ++ts.contact_steps;
         force_sum_[t] += f;
       }
-      for (const ProxyCheck& c : checks_) {
+      // A proxy placed (the first step, or a jump: a reset, a device put down inside) inside a
+      // body started there: one event, said once, not a pop-through per step until it leaves.
+      const double radius = desc.tools[t].radius_m;
+      const bool placed = !checks_.empty() && (last_proxy_world_[t].x() == kNever ||
+                                               (tool.proxy_world - last_proxy_world_[t]).norm() >
+                                                   std::max(radius, kPlacementJump_m));
+      if (!checks_.empty()) {
+        last_proxy_world_[t] = tool.proxy_world;
+      }
+      for (std::size_t k = 0; k < checks_.size(); ++k) {
+        const ProxyCheck& c = checks_[k];
+        std::uint8_t& was = proxy_inside_[k * desc.tools.size() + t];
         const Vec3 p_body = c.X_body_world * tool.proxy_world;
-        const double radius = desc.tools[t].radius_m;
         if (c.bounds_body.exteriorDistance(p_body) > radius) {
+          was = kOutside;
           continue;
         }
         const SurfacePoint sp = c.bvh->closest_point(p_body);
+        const bool inside = sp.signed_distance < 0.0;
+        if (inside && (was == kStartedInside || (was == kOutside && placed))) {
+          if (was == kOutside) {
+            ++summary_.started_inside;
+            if (summary_.started_inside_first.empty()) {
+              const BodyDescription& body = desc.bodies[c.body];
+              char at[32];
+              std::snprintf(at, sizeof at, " at %.3f s", r.time_s);
+              summary_.started_inside_first = "tool '" + desc.tools[t].name + "' in " + body.name +
+                                              "/" + body.segments[c.segment].name + at;
+            }
+          }
+          was = kStartedInside;
+          continue;
+        }
         summary_.max_proxy_penetration_m =
             std::max(summary_.max_proxy_penetration_m, radius - sp.signed_distance);
-        if (sp.signed_distance < 0.0) {
-          ++summary_.pop_throughs;
+        if (inside && was == kOutside) {
+          ++summary_.pop_throughs;  // once per entry, however long it stays
         }
+        was = inside ? kPoppedThrough : kOutside;
       }
     }
     if (r.has_teleop) {
@@ -307,6 +337,16 @@ class SessionAccountant {
   SessionSummary summary_;
   std::vector<double> force_sum_;
   std::vector<ProxyCheck> checks_;
+  // Per check and tool: where the proxy was last step (a proxy inside after a placement is not a
+  // pop-through, and one inside for many steps is one).
+  static constexpr std::uint8_t kOutside = 0;
+  static constexpr std::uint8_t kPoppedThrough = 1;
+  static constexpr std::uint8_t kStartedInside = 2;
+  // Further than this in one step (5 m/s at 1 kHz, beyond a hand) the proxy was put there.
+  static constexpr double kPlacementJump_m = 0.005;
+  static constexpr double kNever = std::numeric_limits<double>::infinity();
+  std::vector<std::uint8_t> proxy_inside_;
+  std::vector<Vec3> last_proxy_world_;
   std::vector<double> cost_us_;
   std::uint64_t slave_collision_bodies_ = 0;  // a bit per body index (TeleopStepResult)
   // Per-segment touch flags of one step, so a tool-step counts once per segment.
@@ -728,6 +768,10 @@ std::string format_session_summary(const SessionSummary& s) {
                 s.pop_throughs, s.max_proxy_penetration_m * 1e3, s.max_force_limit_violations,
                 s.clamped_cycles, s.nonfinite_commands);
   out << line;
+  if (s.started_inside > 0) {
+    out << "started inside: " << s.started_inside << " time(s), first " << s.started_inside_first
+        << " (placed inside a body, not a pop-through: no force until it leaves)\n";
+  }
   if (s.dropped_contacts > 0) {
     out << "contacts dropped (buffer full): " << s.dropped_contacts << "\n";
   }

@@ -212,10 +212,17 @@ struct SessionSummary {
   double simulated_s = 0.0;
   double wall_s = 0.0;
   StepTimingUs step_us;
-  /// Steps at which a tool's proxy centre was inside a closed proxy segment, plus tools that
-  /// left a penalty segment through its far side (must be 0).
+  /// Times a tool's proxy centre went into a closed proxy segment (once per entry, not per step
+  /// inside), plus proxies lost and tools that left a penalty segment through its far side
+  /// (must be 0).
   std::size_t pop_throughs = 0;
-  /// Deepest the proxy sphere ever reached into a proxy segment, metres (tolerance-sized).
+  /// Times a tool's proxy was already inside a closed proxy segment when it was placed (the first
+  /// step, or a jump: a reset, a device placed inside): not a pop-through, said once.
+  std::size_t started_inside = 0;
+  /// The first of those: "tool 'tip' in block/block at 0.000 s".
+  std::string started_inside_first;
+  /// Deepest the proxy sphere ever reached into a proxy segment, metres (tolerance-sized; not
+  /// while it was placed inside).
   double max_proxy_penetration_m = 0.0;
   std::vector<ToolSummary> tools;
   std::vector<SegmentSummary> segments;

@@ -68,6 +68,7 @@ nlohmann::json session_summary_json(const SceneDescription& scene, const World& 
                   {"max", s.step_us.max},
                   {"mean", s.step_us.mean}};
   j["pop_throughs"] = s.pop_throughs;
+  j["started_inside"] = s.started_inside;
   j["max_proxy_penetration_m"] = s.max_proxy_penetration_m;
   j["max_force_limit_violations"] = s.max_force_limit_violations;
   j["clamped_cycles"] = s.clamped_cycles;
