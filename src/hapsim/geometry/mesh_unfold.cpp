@@ -64,14 +64,6 @@ bool folded_across(const TriangleMesh& mesh, const EdgeIndex& index, const Vec3&
   return !m.isZero() && is_fold(n, m);
 }
 
-}  // namespace
-
-std::size_t count_folded_edges(const TriangleMesh& mesh) {
-  return validate_mesh(mesh).folded_edges;
-}
-
-namespace {
-
 std::size_t flip_folds(TriangleMesh& mesh) {
   const double area2_limit = 1e-8 * mesh.bounds().diagonal().squaredNorm();
   EdgeIndex index(mesh);

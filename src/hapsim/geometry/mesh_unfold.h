@@ -19,7 +19,4 @@ namespace hapsim {
 /// collapses made.
 std::size_t unfold_edges(TriangleMesh& mesh);
 
-/// Number of folded manifold edges (as validate_mesh counts them).
-[[nodiscard]] std::size_t count_folded_edges(const TriangleMesh& mesh);
-
 }  // namespace hapsim
