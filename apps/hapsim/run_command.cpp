@@ -307,6 +307,7 @@ void run(const RunArgs& args) {
     load_options.data_dir = args.data_dir;
   }
   load_options.progress = progress;
+  load_options.device_trajectory_played = !trajectory && args.replay_path.empty();
   const Stopwatch load_watch;
   SceneDescription loaded = load_scene(args.scene, load_options);
   if (!args.method.empty() && loaded.world.bodies.empty()) {

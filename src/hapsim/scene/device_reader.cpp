@@ -277,8 +277,11 @@ void read_device(const SceneReader& r, const Json& j, const std::string& ptr,
                     "' (a script)");
   }
   if (j.contains("trajectory")) {
-    d.trajectory_file = r.existing_file(j["trajectory"], JsonReader::at(ptr, "trajectory"),
-                                        "a trajectory CSV path");
+    // Not needed when the command plays another (--device sim:FILE).
+    const std::string tp = JsonReader::at(ptr, "trajectory");
+    d.trajectory_file = r.options().device_trajectory_played
+                            ? r.existing_file(j["trajectory"], tp, "a trajectory CSV path")
+                            : r.path(j["trajectory"], tp, "a trajectory CSV path");
     return;
   }
   if (glove) {

@@ -50,6 +50,9 @@ struct SceneLoadOptions {
   ProgressFn progress;
   /// Detail caps (none by default).
   SceneDetailCaps detail_caps;
+  /// False when the command plays its own trajectory (`--device sim:FILE`): the device's
+  /// "trajectory" file is then not needed, its path kept unchecked.
+  bool device_trajectory_played = true;
 };
 
 /// Reads and parses `file`. Relative paths in the scene resolve against the file's folder.
