@@ -128,8 +128,8 @@ TEST(Cli, QueryKneeMethodReportsItsErrorAgainstExact) {
   std::size_t compared = 0;
   for (std::size_t i = 0; i < knee.size(); ++i) {
     const bool knee_answered = knee[i][10] != 4294967295.0;
-    if (exact[i][3] > 0.01 || !knee_answered) {
-      continue;  // beyond the 10 mm band, or not answered: not part of the distance error
+    if (std::abs(exact[i][3]) > 0.01 || !knee_answered) {
+      continue;  // beyond the 10 mm band (either side), or not answered: not in the error
     }
     ++compared;
     max_error = std::max(max_error, std::abs(knee[i][3] - exact[i][3]));
