@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <csignal>
 #include <fstream>
+#include <regex>
 
 #include <gtest/gtest.h>
 
@@ -30,6 +31,15 @@ const std::string kScenes = std::string(HAPSIM_SOURCE_DIR) + "/scenes/";
 
 std::size_t lines(const std::string& text) {
   return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
+
+// The number just before `label` in a command's summary ("2600 steps, ..."), or 0.
+std::uint64_t count_before(const std::string& text, const std::string& label) {
+  std::smatch m;
+  if (!std::regex_search(text, m, std::regex("([0-9]+)" + label))) {
+    return 0;
+  }
+  return std::stoull(m[1].str());
 }
 
 // With no simulation host on its session, `hapsim device --duration 1` gives up after that second
@@ -64,11 +74,13 @@ TEST(DeviceHostProcess, ABrokenPluginIsOneLineAndExitTwo) {
 TEST(DeviceHostProcess, TheExamplePluginDrivesAServedWorld) {
   ASSERT_TRUE(test::on_loopback_config());
   const auto device_json = hapsim::test::temp_path("plugin-device.json");
+  const auto serve_json = hapsim::test::temp_path("plugin-serve.json");
   const std::string net = " --session plugin-test --domain 77";
   // Serve runs until stopped after the device (60 s bounds a hang): a fixed 6 s could end before a
   // loaded machine's device had joined (5 models rendered, once, beside an ASan run).
-  BackgroundHapsim serve("serve " + kScenes + "knee_procedural.json --duration 60" + net,
-                         hapsim::test::temp_path("plugin-serve.log"));
+  BackgroundHapsim serve(
+      "serve " + kScenes + "knee_procedural.json --duration 60 --json " + serve_json.string() + net,
+      hapsim::test::temp_path("plugin-serve.log"));
   ASSERT_TRUE(serve.wait_for("dds ", 20s)) << serve.output();
   BackgroundHapsim device(std::string("device --device plugin:") + HAPSIM_EXAMPLE_DRIVER +
                               " --duration 3 --json " + device_json.string() + net,
@@ -77,13 +89,20 @@ TEST(DeviceHostProcess, TheExamplePluginDrivesAServedWorld) {
   serve.signal(SIGINT);
   EXPECT_EQ(serve.wait(), 130) << serve.output();  // 128 + SIGINT, its summary written
   EXPECT_NE(serve.output().find("device host  joined"), std::string::npos) << serve.output();
-  if (const std::string why = test::serve_too_slow_for_real_time(serve.output()); !why.empty()) {
-    GTEST_SKIP() << why;  // the counts below are rates: a model per state, 1 kHz
-  }
-  std::ifstream in(device_json);
-  const nlohmann::json d = nlohmann::json::parse(in);
-  EXPECT_GT(d["states_published"].get<int>(), 2500);
-  EXPECT_GT(d["models_rendered"].get<int>(), 2000);  // answers to this driver's states
+  const nlohmann::json d = nlohmann::json::parse(std::ifstream(device_json));
+  const nlohmann::json s = nlohmann::json::parse(std::ifstream(serve_json));
+  std::printf("%s\n%s\n", d.dump().c_str(), s["serve"].dump().c_str());
+  // Progress, not rates (a loaded machine rendered 1 621 models where 2 000 were asserted): the
+  // driver's states drove serve's world for many cycles, and the device rendered many of the
+  // models serve sent back. 3 s at 1 kHz would be 3 000 each; a tenth of it is a run that worked,
+  // none of it is one that did not.
+  const auto driven = s["serve"]["device_host_cycles"].get<std::uint64_t>();
+  EXPECT_GT(d["states_published"].get<std::uint64_t>(), 300u);
+  EXPECT_GT(driven, 300u);
+  EXPECT_GT(d["models_rendered"].get<std::uint64_t>(), 300u);  // answers to this driver's states
+  // A model per serve cycle at most: it cannot have rendered answers serve never published.
+  EXPECT_LE(d["models_rendered"].get<std::uint64_t>(),
+            s["serve"]["models_published"].get<std::uint64_t>());
   EXPECT_EQ(d["models"]["malformed"].get<int>(), 0);
 }
 #endif
@@ -112,8 +131,14 @@ TEST(DeviceHostProcess, ServeSendsTheLegacyForcePacketEveryCycle) {
   EXPECT_EQ(serve.wait(), 0) << serve.output();
   std::printf("%s", serve.output().c_str());
   const std::uint64_t valid = glove.count(LegacyPacketVerdict::kAccepted);
-  // One packet per cycle (loopback drops none; a slow poll only merges them).
-  EXPECT_GT(valid, 2000u);
+  // One packet per cycle, counted against serve's own cycles rather than a time (a loaded
+  // machine's serve may run fewer cycles in its 2.6 s): serve sent one every step, and the glove
+  // took every one sent (loopback drops none; a slow poll only merges them).
+  const std::uint64_t steps = count_before(serve.output(), " steps, ");
+  const std::uint64_t sent = count_before(serve.output(), " force packets sent");
+  EXPECT_GT(steps, 1000u);  // it ran (2 600 at 1 kHz)
+  EXPECT_EQ(sent, steps);
+  EXPECT_EQ(valid, sent);
   if (const std::string why = test::serve_too_slow_for_real_time(serve.output()); !why.empty()) {
     GTEST_SKIP() << why;
   }

@@ -31,6 +31,17 @@ inline ::testing::AssertionResult on_loopback_config() {
 /// and renders something else. Read from serve's summary ("N steps, S s simulated in W s wall");
 /// a release build keeps 1.0x. (Not the step cost: with a device host driving it, serve's step
 /// includes the wait for the device's state, 0.5 ms in release.)
+/// Serve's pace, simulated seconds per wall-clock second, from its summary ("N steps, S s
+/// simulated in W s wall"); 0 when the summary is missing.
+inline double serve_pace(const std::string& serve_output) {
+  static const std::regex kPace(R"(([0-9.]+) s simulated in ([0-9.]+) s wall)");
+  std::smatch m;
+  if (!std::regex_search(serve_output, m, kPace) || !(std::stod(m[2].str()) > 0.0)) {
+    return 0.0;
+  }
+  return std::stod(m[1].str()) / std::stod(m[2].str());
+}
+
 inline std::string serve_too_slow_for_real_time(const std::string& serve_output) {
   static const std::regex kPace(R"(([0-9.]+) s simulated in ([0-9.]+) s wall)");
   std::smatch m;

@@ -84,6 +84,12 @@ TEST(ServeProcess, PublishesGatedModelsFollowsADeviceHostAndCountsBadStates) {
                            (model.x0_world_m - Vec3(0.0, 0.0, 1.0)).norm() < 0.1 &&
                            model.device_sequence <= sent_sequence;
         answered_wrong += right ? 0 : 1;
+        if (!right && answered_wrong <= 3) {
+          ADD_FAILURE() << "wrong answer: model " << model.sequence << " for state "
+                        << model.device_sequence << " (sent " << sent_sequence << "), x0 "
+                        << model.x0_world_m.transpose() << ", f0 " << model.f0_world_n.transpose()
+                        << ", sim time " << model.sim_time_s;
+        }
       }
     });
   };
