@@ -3,6 +3,7 @@
 // still the load's one-line error, naming its JSON path.
 #include "apps/hapsim_process.h"
 
+#include <cstdlib>
 #include <fstream>
 #include <string>
 
@@ -39,6 +40,18 @@ TEST(DeviceTrajectoryOverride, SimFileDoesNotNeedTheScenesOwnTrajectory) {
   const auto own = test::run_hapsim("run " + scene.string() + " -q");
   EXPECT_EQ(own.exit_code, 2) << own.output;
   EXPECT_NE(own.output.find("/device/trajectory: no such file"), std::string::npos) << own.output;
+
+  // The viewer: its mouse and sim:FILE play no trajectory of the scene's.
+  if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "xvfb-run is missing: the viewer's half is not checked";
+  }
+  for (const std::string& device : {std::string("mouse"), "sim:" + other.string()}) {
+    const auto viewed =
+        test::run_hapsim_env("timeout 120 xvfb-run -a",
+                             "view " + scene.string() + " --device " + device + " --duration 0.3");
+    EXPECT_EQ(viewed.exit_code, 0) << device << ": " << viewed.output;
+    EXPECT_EQ(viewed.output.find("absent.csv"), std::string::npos) << viewed.output;
+  }
 }
 
 }  // namespace

@@ -134,6 +134,8 @@ std::unique_ptr<ViewerSession> make_session(const ViewerConfig& config,
   }
   SceneLoadOptions load;
   load.data_dir = config.data_dir;
+  // Only "sim" plays the scene's trajectory file (the mouse, sim:FILE and the 3D mouse do not).
+  load.device_trajectory_played = config.device == "sim";
   const SceneDescription scene = load_scene(config.scene, load);
   if (described != nullptr) {
     described->file = scene.file;
