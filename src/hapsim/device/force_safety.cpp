@@ -33,6 +33,11 @@ double clamp_scalar(double value, double lo, double hi, ClampReport& report, int
 
 }  // namespace
 
+double force_magnitude_n(const Vec3& f) noexcept {
+  const double max_abs = f.cwiseAbs().maxCoeff();
+  return max_abs > 0.0 ? max_abs * (f / max_abs).norm() : 0.0;
+}
+
 DeviceCommand clamp_command(const DeviceCommand& command, const DeviceProfile& profile,
                             ClampReport* report) noexcept {
   ClampReport local;
@@ -51,9 +56,7 @@ DeviceCommand clamp_command(const DeviceCommand& command, const DeviceProfile& p
     r.force_clamped = true;
     out.force_world_n = Vec3::Zero();
   } else {
-    // Scaled by the largest component first so a huge finite force cannot overflow the norm.
-    const double max_abs = f.cwiseAbs().maxCoeff();
-    const double norm = max_abs > 0.0 ? max_abs * (f / max_abs).norm() : 0.0;
+    const double norm = force_magnitude_n(f);
     if (norm > max_force_n) {
       out.force_world_n = f * (max_force_n / norm * kClampMargin);
       r.force_clamped = true;

@@ -1,11 +1,11 @@
-// Device safety (architecture.md#force-and-safety): a command never exceeds the device's rated limits, never carries a
-// NaN or inf, and ramps to zero within a bounded time when the simulation stalls or the device
-// link drops. Pure functions of their arguments (testable without threads or clocks), plus a
-// small per-cycle watchdog that strings them together for the haptic loop.
+// Device safety (architecture.md#force-and-safety): a command never exceeds the device's rated
+// limits, never carries a NaN or inf, and ramps to zero within a bounded time when the simulation
+// stalls or the device link drops. Pure functions of their arguments (testable without threads or
+// clocks), plus a small per-cycle watchdog that strings them together for the haptic loop.
 #pragma once
 
-#include "hapsim/core/device_profile.h"
 #include "hapsim/core/device_io.h"
+#include "hapsim/core/device_profile.h"
 
 #include <cstdint>
 
@@ -26,6 +26,11 @@ struct ClampReport {
     return nonfinite_count > 0 || force_clamped || fingers_clamped > 0 || joints_clamped > 0;
   }
 };
+
+/// |f| in newtons, scaled by the largest component first so a huge finite force cannot overflow:
+/// the magnitude clamp_command() limits. A check against the device's rating must use this one
+/// (the plain norm can read a few ulps above a force the clamp let through).
+[[nodiscard]] double force_magnitude_n(const Vec3& f) noexcept;
 
 /// haptic path: the command made safe for `profile`. A limit that is not finite and positive
 /// allows nothing (a broken profile fails safe).

@@ -71,7 +71,9 @@ bool exceeds_limits(const DeviceCommand& command, const DeviceProfile& profile) 
   if (!std::isfinite(command.force_world_n.squaredNorm())) {
     return true;
   }
-  if (command.force_world_n.norm() > profile.max_force_n) {
+  // The clamp's own magnitude: the plain norm read 12.000000000000002 N for a force the clamp
+  // let through on the 12 N omega.3, a violation that never was.
+  if (force_magnitude_n(command.force_world_n) > profile.max_force_n) {
     return true;
   }
   for (int f = 0; f < command.finger_count; ++f) {
