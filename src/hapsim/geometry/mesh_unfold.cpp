@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <unordered_map>
 #include <vector>
 
@@ -64,6 +65,28 @@ bool folded_across(const TriangleMesh& mesh, const EdgeIndex& index, const Vec3&
   return !m.isZero() && is_fold(n, m);
 }
 
+// Edge k of triangle t (a -> b, c opposite) and the triangle across it (b -> a, d opposite).
+struct EdgeQuad {
+  std::uint32_t a, b, c, d;
+  std::size_t other;  // the triangle across the edge
+};
+
+std::optional<EdgeQuad> quad_across(const TriangleMesh& mesh, const EdgeIndex& index, std::size_t t,
+                                    int k) {
+  const TriangleIndices& t1 = mesh.triangles[t];
+  const std::uint32_t a = t1[static_cast<std::size_t>(k)];
+  const std::uint32_t b = t1[static_cast<std::size_t>((k + 1) % 3)];
+  const long long o = index.find(b, a);
+  if (o < 0 || static_cast<std::size_t>(o) == t) {
+    return std::nullopt;
+  }
+  const TriangleIndices& t2 = mesh.triangles[static_cast<std::size_t>(o)];
+  const std::uint32_t d = t2[0] != a && t2[0] != b   ? t2[0]
+                          : t2[1] != a && t2[1] != b ? t2[1]
+                                                     : t2[2];
+  return EdgeQuad{a, b, t1[static_cast<std::size_t>((k + 2) % 3)], d, static_cast<std::size_t>(o)};
+}
+
 std::size_t flip_folds(TriangleMesh& mesh) {
   const double area2_limit = 1e-8 * mesh.bounds().diagonal().squaredNorm();
   EdgeIndex index(mesh);
@@ -73,19 +96,13 @@ std::size_t flip_folds(TriangleMesh& mesh) {
     std::size_t flips_this_pass = 0;
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
       for (int k = 0; k < 3; ++k) {
-        const TriangleIndices t1 = mesh.triangles[t];
-        const std::uint32_t a = t1[k];
-        const std::uint32_t b = t1[(k + 1) % 3];
-        const std::uint32_t c = t1[(k + 2) % 3];
-        const long long o = index.find(b, a);
-        if (o < 0 || static_cast<std::size_t>(o) == t) {
+        const std::optional<EdgeQuad> q = quad_across(mesh, index, t, k);
+        if (!q) {
           continue;
         }
-        const auto t2_index = static_cast<std::size_t>(o);
+        const auto [a, b, c, d, t2_index] = *q;
+        const TriangleIndices t1 = mesh.triangles[t];
         const TriangleIndices t2 = mesh.triangles[t2_index];
-        const std::uint32_t d = t2[0] != a && t2[0] != b   ? t2[0]
-                                : t2[1] != a && t2[1] != b ? t2[1]
-                                                           : t2[2];
         const Vec3 n1 = unit_normal(mesh, t1, area2_limit);
         const Vec3 n2 = unit_normal(mesh, t2, area2_limit);
         if (n1.isZero() || n2.isZero() || !is_fold(n1, n2) || c == d || index.find(c, d) >= 0 ||
@@ -140,23 +157,16 @@ std::size_t collapse_folds(TriangleMesh& mesh, const MeshReport& report_before) 
     const double area2_limit = 1e-8 * mesh.bounds().diagonal().squaredNorm();
     const EdgeIndex index(mesh);
     for (int k = 0; k < 3; ++k) {
-      const TriangleIndices t1 = mesh.triangles[t];
-      const std::uint32_t a = t1[k];
-      const std::uint32_t b = t1[(k + 1) % 3];
-      const std::uint32_t c = t1[(k + 2) % 3];
-      const long long o = index.find(b, a);
-      if (o < 0) {
+      const std::optional<EdgeQuad> q = quad_across(mesh, index, t, k);
+      if (!q) {
         continue;
       }
-      const Vec3 n1 = unit_normal(mesh, t1, area2_limit);
-      const Vec3 n2 = unit_normal(mesh, mesh.triangles[static_cast<std::size_t>(o)], area2_limit);
+      const auto [a, b, c, d, other] = *q;
+      const Vec3 n1 = unit_normal(mesh, mesh.triangles[t], area2_limit);
+      const Vec3 n2 = unit_normal(mesh, mesh.triangles[other], area2_limit);
       if (n1.isZero() || n2.isZero() || !is_fold(n1, n2)) {
         continue;
       }
-      const TriangleIndices& t2 = mesh.triangles[static_cast<std::size_t>(o)];
-      const std::uint32_t d = t2[0] != a && t2[0] != b   ? t2[0]
-                              : t2[1] != a && t2[1] != b ? t2[1]
-                                                         : t2[2];
       // The fold edge itself first, then the fins' other edges (a sliver's short side).
       const std::array<std::pair<std::uint32_t, std::uint32_t>, 10> candidates{
           {{a, b}, {b, a}, {c, a}, {c, b}, {a, c}, {b, c}, {d, a}, {d, b}, {a, d}, {b, d}}};
