@@ -17,9 +17,22 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace hapsim::bench {
 namespace {
+
+// The contact bench's rows for one landmark of the paper knee, one method, at `speeds`.
+std::vector<ContactRow> paper_knee_rows(const std::string& method, const std::string& landmark,
+                                        std::vector<double> speeds_mm_per_s) {
+  ContactBenchOptions options;
+  options.scenes = {default_scenes_dir() / "knee_paper.json"};
+  options.methods = {method};
+  options.landmarks = {landmark};
+  options.speeds_mm_per_s = std::move(speeds_mm_per_s);
+  return run_contact_bench(options);
+}
 
 TEST(ContactBench, ThePlatePushedThroughAtHandSpeedHoldsAndTheJsonHasEveryKey) {
   const std::filesystem::path json_path = test::temp_path("contact_bench.json");
@@ -44,12 +57,7 @@ TEST(ContactBench, ThePlatePushedThroughAtHandSpeedHoldsAndTheJsonHasEveryKey) {
 }
 
 TEST(ContactBench, ThePaperKneesPatellaDraggedAtHandSpeedKeepsTheBone) {
-  ContactBenchOptions options;
-  options.scenes = {default_scenes_dir() / "knee_paper.json"};
-  options.methods = {"exact"};
-  options.landmarks = {"patella"};
-  options.speeds_mm_per_s = {50.0, 500.0};
-  const std::vector<ContactRow> rows = run_contact_bench(options);
+  const std::vector<ContactRow> rows = paper_knee_rows("exact", "patella", {50.0, 500.0});
   ASSERT_EQ(rows.size(), 2u);
   for (const ContactRow& row : rows) {
     EXPECT_TRUE(row.error.empty()) << row.error;
@@ -63,12 +71,8 @@ TEST(ContactBench, ThePaperKneesPatellaDraggedAtHandSpeedKeepsTheBone) {
 // edges made points outside it read as inside, and the proxy lost the tendon 89 times at
 // 10 mm/s (32 at 50), each an 8 N step. Now it keeps it, with no step over ~1 N.
 TEST(ContactBench, ThePaperKneesTendonDraggedAtHandSpeedKeepsItWithoutSteps) {
-  ContactBenchOptions options;
-  options.scenes = {default_scenes_dir() / "knee_paper.json"};
-  options.methods = {"exact"};
-  options.landmarks = {"patellar tendon"};
-  options.speeds_mm_per_s = {10.0, 50.0, 500.0};
-  const std::vector<ContactRow> rows = run_contact_bench(options);
+  const std::vector<ContactRow> rows =
+      paper_knee_rows("exact", "patellar tendon", {10.0, 50.0, 500.0});
   ASSERT_EQ(rows.size(), 3u);
   for (const ContactRow& row : rows) {
     EXPECT_TRUE(row.error.empty()) << row.error;
@@ -82,12 +86,7 @@ TEST(ContactBench, ThePaperKneesTendonDraggedAtHandSpeedKeepsItWithoutSteps) {
 // the exact query, as the god-object needs; with the knee method's planes the patella drag lost
 // the proxy 827 times at 10 mm/s and 18 at 500 (2026-11-27).
 TEST(ContactBench, TheKneeMethodsPatellaDraggedAtHandSpeedKeepsTheBone) {
-  ContactBenchOptions options;
-  options.scenes = {default_scenes_dir() / "knee_paper.json"};
-  options.methods = {"knee"};
-  options.landmarks = {"patella"};
-  options.speeds_mm_per_s = {10.0, 500.0};
-  const std::vector<ContactRow> rows = run_contact_bench(options);
+  const std::vector<ContactRow> rows = paper_knee_rows("knee", "patella", {10.0, 500.0});
   ASSERT_EQ(rows.size(), 2u);
   for (const ContactRow& row : rows) {
     EXPECT_TRUE(row.error.empty()) << row.error;
