@@ -45,6 +45,25 @@ inline RunResult run_hapsim(const std::string& args) {
   return run_hapsim_env("", args);
 }
 
+/// Forks and runs `words` (words[0] the program), stdout and stderr to `log`; the child's pid
+/// (the caller waits for it).
+inline pid_t spawn_logged(std::vector<std::string> words, const std::filesystem::path& log) {
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    ::dup2(fd, 1);
+    ::dup2(fd, 2);
+    std::vector<char*> argv;
+    for (std::string& w : words) {
+      argv.push_back(w.data());
+    }
+    argv.push_back(nullptr);
+    ::execv(argv[0], argv.data());
+    ::_exit(127);
+  }
+  return pid;
+}
+
 /// `hapsim ARGS` running in the background (its own process), its output going to a file: for the
 /// multi-process tests, which start, kill and restart hosts.
 class BackgroundHapsim {
@@ -56,19 +75,7 @@ class BackgroundHapsim {
     for (std::string w; in >> w;) {
       words.push_back(w);
     }
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      std::vector<char*> argv;
-      for (std::string& w : words) {
-        argv.push_back(w.data());
-      }
-      argv.push_back(nullptr);
-      ::execv(argv[0], argv.data());
-      ::_exit(127);
-    }
+    pid_ = spawn_logged(std::move(words), log_);
   }
   BackgroundHapsim(const BackgroundHapsim&) = delete;
   BackgroundHapsim& operator=(const BackgroundHapsim&) = delete;

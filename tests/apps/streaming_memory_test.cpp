@@ -40,19 +40,7 @@ struct ChildRun {
 ChildRun run_measured(const std::vector<std::string>& args, const fs::path& log) {
   std::vector<std::string> words{HAPSIM_BIN_PATH};
   words.insert(words.end(), args.begin(), args.end());
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    ::dup2(fd, 1);
-    ::dup2(fd, 2);
-    std::vector<char*> argv;
-    for (std::string& w : words) {
-      argv.push_back(w.data());
-    }
-    argv.push_back(nullptr);
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
-  }
+  const pid_t pid = hapsim::test::spawn_logged(std::move(words), log);
   ChildRun run;
   int status = 0;
   rusage usage{};
