@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -197,6 +198,46 @@ TEST(GodObject, DraggedOverAConvexBoneWithFrictionTheContactNeverDrops) {
     // 2.5 mm deep at 4000 N/m: 10 N along the spring, a little less where friction tilts it.
     EXPECT_GT(least_force_n, 8.0) << speed_m_per_s << " m/s";
   }
+}
+
+// Sliding under dynamic friction the proxy trails the device by the cone's radius; the sliding
+// loop walks the surface only that far. A fingertip dragged 3 mm deep over a convex bone used to
+// walk all 16 strides (4 mm) every cycle for friction to pull it back: 100 us a step on the
+// knee. The force stays on the dynamic cone: its tangential part is mu_d times its normal part.
+TEST(GodObject, DraggedDeepOverABoneTheProxySlidesOnlyAsFarAsFrictionLetsIt) {
+  test::SolidSphere bone(0.025);
+  ContactMaterial m = wall_material(4000.0, 0.0);
+  m.static_friction = 0.2;  // equal: a steady slide, no stick-slip
+  m.dynamic_friction = 0.2;
+  QueryHint hint;
+  const std::array<ProxySurface, 1> surfaces{{{&bone, Iso3::Identity(), &m, false, &hint}}};
+  GodObject proxy;
+  const double r = 0.025 - 0.003;  // the device 3 mm inside the bone
+  proxy.reset(Vec3(0.0, 0.0, 0.05));
+  for (int i = 1; i <= 100; ++i) {
+    proxy.update(Vec3(0.0, 0.0, 0.05 + (r - 0.05) * i / 100.0), surfaces);
+  }
+  ASSERT_TRUE(proxy.in_contact());
+  const int cycles = static_cast<int>(0.8 * r / 0.05 / 1e-3);  // 0.8 rad at 50 mm/s
+  int most_iterations = 0;
+  for (int i = 1; i <= cycles; ++i) {
+    const double a = 0.8 * i / cycles;
+    const Vec3 device(r * std::sin(a), 0.0, r * std::cos(a));
+    proxy.update(device, surfaces);
+    ASSERT_TRUE(proxy.in_contact()) << "cycle " << i;
+    ASSERT_NEAR(proxy.proxy_world().norm(), 0.025, 2e-5) << "cycle " << i;
+    if (i < cycles / 4) {
+      continue;  // steady slip only: the first cycles leave the static cone
+    }
+    most_iterations = std::max(most_iterations, proxy.iterations_used());
+    const Vec3 f = proxy_force(proxy, surfaces, device, Vec3::Zero());
+    const Vec3 n = proxy.proxy_world().normalized();
+    const double f_normal = f.dot(n);
+    const double f_tangential = (f - f_normal * n).norm();
+    ASSERT_NEAR(f_tangential / f_normal, m.dynamic_friction, 0.005) << "cycle " << i;
+  }
+  // 50 um a cycle against 0.25 mm strides: one stride, and one or two more that find it done.
+  EXPECT_LE(most_iterations, 3);
 }
 
 // The static cone is anchored at where the proxy is: a device drifting inside it leaves the proxy

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hapsim {
 
@@ -168,6 +169,11 @@ void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface>
     cull_ = false;
     return;
   }
+  // Sliding under friction, the proxy trails the device by the dynamic cone's radius: walking it
+  // farther along the surface only for apply_friction to pull it back would spend every
+  // iteration (a finger dragged over bone 3 mm deep walked 16 strides, 4 mm, a cycle: 100 us).
+  const double slide_budget_m = slide_budget(previous, device_p_world, surfaces);
+  double slid_m = 0.0;
   while (iterations_used_ < params_.max_iterations) {
     ++iterations_used_;
     const Vec3 motion = project_onto_contacts(device_p_world - proxy_world_, contacts());
@@ -178,7 +184,14 @@ void GodObject::update(const Vec3& device_p_world, std::span<const ProxySurface>
       break;
     }
     // Free space up to the least clearance; in contact, short steps then push back out.
-    const double step = std::min(length, std::max(least, params_.max_substep_m));
+    double step = std::min(length, std::max(least, params_.max_substep_m));
+    if (contact_count_ > 0) {
+      step = std::min(step, slide_budget_m - slid_m);
+      if (!(step > 0.1 * params_.contact_tolerance_m)) {
+        break;  // slid as far as friction lets it this cycle
+      }
+      slid_m += step;
+    }
     proxy_world_ += motion * (step / length);
     least = resolve_penetration(surfaces, margin);
   }
@@ -232,6 +245,30 @@ bool GodObject::sticks(const Vec3& previous_proxy_world, const Vec3& device_p_wo
   const Vec3 offset = device_p_world - previous_proxy_world;
   const Vec3 tangential = offset - offset.dot(n) * n;
   return tangential.norm() <= material->static_friction * depth;
+}
+
+// haptic path
+double GodObject::slide_budget(const Vec3& previous_proxy_world, const Vec3& device_p_world,
+                               std::span<const ProxySurface> surfaces) const {
+  constexpr double kUnbounded = std::numeric_limits<double>::infinity();
+  if (contact_count_ == 0) {
+    return kUnbounded;
+  }
+  const ProxyContact& c = contacts_[0];
+  const ContactMaterial* material = surfaces[static_cast<std::size_t>(c.surface)].material;
+  if (material == nullptr || material->static_friction <= 0.0) {
+    return kUnbounded;
+  }
+  const Vec3& n = c.normal_world;
+  const double depth = (proxy_world_ - device_p_world).dot(n);
+  if (depth <= 0.0) {
+    return kUnbounded;
+  }
+  const Vec3 offset = device_p_world - previous_proxy_world;
+  const double t_len = (offset - offset.dot(n) * n).norm();
+  // apply_friction's goal (it still trims what a curved path overshoots), plus the tolerance so
+  // rounding never stops the slide short of it.
+  return std::max(0.0, t_len - material->dynamic_friction * depth) + params_.contact_tolerance_m;
 }
 
 // haptic path

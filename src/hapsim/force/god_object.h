@@ -88,6 +88,10 @@ class GodObject {
   /// proxy's position before this update moved it along the surface.
   [[nodiscard]] bool sticks(const Vec3& previous_proxy_world, const Vec3& device_p_world,
                             std::span<const ProxySurface> surfaces) const;
+  /// How far along the surface the proxy may slide this cycle: as far as the dynamic friction
+  /// cone of the first contact leaves it behind the device (unbounded without friction).
+  [[nodiscard]] double slide_budget(const Vec3& previous_proxy_world, const Vec3& device_p_world,
+                                    std::span<const ProxySurface> surfaces) const;
   void apply_friction(const Vec3& previous_proxy_world, const Vec3& device_p_world,
                       std::span<const ProxySurface> surfaces, double margin_m);
   /// A proxy left out of contact just off a surface the device is beyond (a friction step in a
