@@ -181,6 +181,40 @@ TEST(World, APauseForgetsWhichSideOfAPenaltyPlateTheToolCameFrom) {
   EXPECT_EQ(r.penalty_pop_throughs, 0);
 }
 
+// When the device's source changes (a device host takes over from the scene's script, or lets
+// go) the tool lands anywhere: its proxy starts afresh where the device now is. Dragged there
+// from the old contact instead, a proxy left on the block's top face with the device 1 m away
+// and below that face's plane slid along the face for tens of cycles, rendering the block's
+// force limit at a device nowhere near it (serve answered a host 1 m above the knee with 6 N).
+// A pause keeps the proxy: a device back inside the block still feels its face.
+TEST(World, RestartedToolsLandWhereTheDeviceIsAndFeelNothingFromWhereTheyWere) {
+  WorldDescription w = box_world(ContactResponse::kProxy, 0.02, BodyKind::kStatic, 0.0);
+  w.materials[0].contact.static_friction = 0.3;
+  w.materials[0].contact.dynamic_friction = 0.2;
+  World world(std::move(w));
+  const auto press = [&] {
+    for (int i = 0; i <= 30; ++i) {
+      world.step(at(Vec3(0.0, 0.0, 0.002 - 0.005 * i / 30.0)), 1e-3);  // to 3 mm in
+    }
+    ASSERT_GT(world.last_result().command.force_world_n.z(), 1.0);
+  };
+  press();
+  const Vec3 far_away(1.0, 0.0, -0.5);  // outside the block, below its top face's plane
+  world.restart_tools();
+  for (int i = 0; i < 3; ++i) {
+    const StepResult& r = world.step(at(far_away), 1e-3);
+    EXPECT_EQ(r.command.force_world_n, Vec3::Zero()) << "cycle " << i;
+    EXPECT_TRUE(r.contacts.empty()) << "cycle " << i;
+    EXPECT_TRUE(r.tools[0].proxy_world.isApprox(far_away, 1e-12)) << "cycle " << i;
+    EXPECT_EQ(r.penalty_pop_throughs, 0);
+  }
+  world.restart_tools();
+  press();
+  world.forget_tool_motion();  // a pause: the proxy stays on the face
+  const StepResult& r = world.step(at(Vec3(0.0, 0.0, -0.002)), 1e-3);
+  EXPECT_NEAR(r.command.force_world_n.z(), 500.0 * 0.002, 500.0 * 2e-5);
+}
+
 // A glove reading with a non-finite finger angle is unusable: the fingertips are held where they
 // were and nothing is pushed (never a NaN position or force).
 TEST(World, AGloveAngleThatIsNotFiniteHoldsTheHand) {

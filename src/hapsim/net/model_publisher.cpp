@@ -45,7 +45,7 @@ void rendered_push_per_tool(const DeviceCommand& rendered, std::span<const int> 
 // haptic path
 void LocalModelPublisher::before_step(World& world) noexcept {
   if (device_.take_source_switch()) {
-    world.forget_tool_motion();
+    world.restart_tools();  // a 1 m teleport: never drag the proxies across the body
   }
   // SPEC §8: the tissue gives way to what the device host rendered, while it drives the tools.
   if (device_.host_driving()) {

@@ -1,6 +1,6 @@
 // The simulation host's side of each haptic cycle (`hapsim serve`): before the world steps, it
-// makes the world forget the tools' motion when the input's source changed (a device host joined
-// or went silent: the tools jump, and no velocity or stick point should survive that); after the
+// restarts the world's tools when the input's source changed (a device host joined or went
+// silent: the tools jump, and no proxy, velocity or stick point should survive that); after the
 // step, it builds each tool's local contact model (world/local_model_builder.h) and writes it on
 // the session's LocalModel topic, answering the device state the step used. Allocation-free.
 #pragma once

@@ -60,7 +60,7 @@ class RemoteDevice final : public Device {
   bool wait_for_host(double timeout_s, const std::atomic<bool>* stop = nullptr);
 
   /// haptic path: true once after the input's source changed (host joined or went silent): the
-  /// tools jump, so the world should forget their motion.
+  /// tools jump, so the world should restart them (World::restart_tools).
   bool take_source_switch() noexcept {
     const bool switched = switched_;
     switched_ = false;

@@ -119,6 +119,11 @@ void World::forget_tool_motion() noexcept {
   }
 }
 
+void World::restart_tools() noexcept {
+  forget_tool_motion();
+  state_.tools_placed = false;  // place_tools resets each proxy at its tool
+}
+
 // haptic path
 void World::set_rendered_push(std::span<const double> push_n) noexcept {
   const std::size_t n = std::min(push_n.size(), state_.rendered_push_n.size());

@@ -51,6 +51,11 @@ class World {
   /// haptic path. The next step takes the tools' positions as new, with no velocity from where
   /// they were (after a pause, the device may have moved far: no damping spike).
   void forget_tool_motion() noexcept;
+  /// haptic path. The next step's tool positions are a new start, as at the first step: the
+  /// device's source changed (a device host took over from the scene's script, or let go), so
+  /// the tools land anywhere. Their proxies are placed where the devices now are, not dragged
+  /// there from their old contacts across whatever lies between; no motion, side or dent is kept.
+  void restart_tools() noexcept;
   /// haptic path. SPEC §8, for the next step only: the push each tool's device actually rendered
   /// (N, one per tool; NaN or a missing entry: not known). A sheet a tool presses takes that
   /// push instead of the step's own force: when the device is on another host rendering a local
