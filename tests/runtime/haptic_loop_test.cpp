@@ -694,6 +694,41 @@ TEST(HapticLoop, StopRequestEndsAnEndlessLoop) {
   loop.stop();  // idempotent
 }
 
+// Asked to stop mid-press (Ctrl-C, SIGTERM), the loop fades the force out over the ramp's
+// duration at its own rate, never up, and ends at zero: dropped in one cycle from 6 N it was a
+// jolt in the hand.
+TEST(HapticLoop, StoppingMidPressFadesTheForceOutOverTheRampTime) {
+  LoggingDevice device(device_profile("omega3"));
+  const double f0 = 6.0;
+  ConstantForceClient client(Vec3(0, 0, f0));
+  const HapticLoopOptions options;  // until stopped
+  HapticLoop loop(device, client, options);
+  loop.start();
+  while (loop.status().cycles < 50) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  loop.stop();
+  std::vector<double> haptic;
+  for (const auto& write : device.writes()) {
+    if (write.haptic) {
+      haptic.push_back(write.force_n);
+    }
+  }
+  // The last cycle's force (f0, or less when a loaded machine's gap cut it), then the fade: k/n
+  // of the way down at the k-th of the ramp's n cycles, the last one the zero.
+  const auto n =
+      static_cast<std::size_t>(std::lround(options.ramp.ramp_duration_s / options.period_s));
+  ASSERT_GT(haptic.size(), n + 40);
+  const std::size_t fade_begin = haptic.size() - n;
+  const double from_n = haptic[fade_begin - 1];
+  ASSERT_GT(from_n, 0.0);
+  EXPECT_LE(from_n, f0);
+  for (std::size_t k = 1; k <= n; ++k) {
+    EXPECT_NEAR(haptic[fade_begin + k - 1], from_n * static_cast<double>(n - k) / n, 1e-9) << k;
+  }
+  EXPECT_EQ(device.writes().back().force_n, 0.0);
+}
+
 TEST(HapticLoop, EndingByItselfLeavesTheDeviceAtZeroBeforeAnyoneWaits) {
   LoggingDevice device(device_profile("omega3"));
   ConstantForceClient client(Vec3(0, 0, 4.0));

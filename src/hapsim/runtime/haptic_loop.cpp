@@ -194,6 +194,8 @@ void HapticLoop::haptic_thread_main() noexcept {
   bool was_healthy = true;
   std::int64_t previous_wake_ns = 0;
   const std::int64_t start_ns = s.start_ns.load();
+  DeviceCommand last_out;  // the haptic thread's newest write: where the end's fade starts
+  last_out.finger_count = device_.profile().finger_count;
   clock.start();
 
   for (std::uint64_t i = 0; !stop_requested_.load(std::memory_order_acquire) &&
@@ -267,6 +269,7 @@ void HapticLoop::haptic_thread_main() noexcept {
     if (try_write(out, &resume)) {
       s.last_written.write_slot() = {out, resume.ceiling()};
       s.last_written.publish();
+      last_out = out;
     }
     const std::int64_t c1 = monotonic_ns();
     const double cost_us = 1e-3 * static_cast<double>(c1 - c0);
@@ -287,6 +290,22 @@ void HapticLoop::haptic_thread_main() noexcept {
   if (faults_after_first_cycle >= 0) {
     const long faults = thread_page_faults();
     s.haptic_page_faults.store(faults >= 0 ? faults - faults_after_first_cycle : -1);
+  }
+  // Ending (asked to stop, or its cycles done): the last force fades out over the ramp's
+  // duration at the loop's rate, as the watchdog's ramp does for a stall, instead of dropping to
+  // zero in one cycle (a jolt in the hand when Ctrl-C ends a press). The heartbeat and the last
+  // written command go on, so the supervisor sees a loop winding down, not a stall.
+  const int fade_cycles =
+      static_cast<int>(std::ceil(options_.ramp.ramp_duration_s / options_.period_s - 1e-9));
+  for (int k = 1; k < fade_cycles && command_magnitude_n(last_out) > 0.0; ++k) {
+    (void)clock.wait_next();
+    const DeviceCommand faded =
+        scaled_command(last_out, 1.0 - static_cast<double>(k) / static_cast<double>(fade_cycles));
+    s.heartbeat_ns.store(monotonic_ns(), std::memory_order_release);
+    if (try_write(faded)) {
+      s.last_written.write_slot() = {faded, resume.ceiling()};
+      s.last_written.publish();
+    }
   }
   // Leave the device pushing nothing before anyone can stop watching it (the caller may not
   // reach wait() for a while). The supervisor's ramp base becomes zero too.

@@ -19,7 +19,8 @@
 // since its own previous write (ResumeCeiling), and a gap beyond the grace cuts its force to what
 // the supervisor's ramp would have left by then, so a whole-process freeze (SIGSTOP, a VM pause),
 // after which either thread may run first, restarts the force from zero too. When the loop ends
-// (max_cycles or stop()), the haptic thread's last write is a zero command.
+// (max_cycles or stop()), the haptic thread fades its last force out over ramp.ramp_duration_s
+// (no jolt when Ctrl-C ends a press) and its last write is a zero command.
 #pragma once
 
 #include "hapsim/device/device.h"
