@@ -547,6 +547,10 @@ std::vector<CollisionRow> run_collision_bench(const CollisionBenchOptions& optio
       const double build_ms = build_watch.elapsed_ms();
       done += 1.0;
       for (std::size_t w = 0; w < options.workloads.size(); ++w) {
+        if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed)) {
+          compute_ratios(rows);
+          return rows;
+        }
         progress(mesh_name + ": " + to_string(options.workloads[w]) + " " + method_name);
         Timing timing = time_queries(*method, points[w], warmup);
         CollisionRow row;

@@ -14,6 +14,7 @@
 #include "hapsim/core/types.h"
 #include "hapsim/geometry/triangle_mesh.h"
 
+#include <atomic>
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
@@ -131,6 +132,9 @@ struct CollisionBenchOptions {
   std::optional<std::filesystem::path> data_dir;
   /// Called with a label ("bumpy-100k: build fcl") and a fraction of the whole run.
   ProgressFn progress;
+  /// Set (by SIGINT or SIGTERM) to end the bench after the row under way: the rows done are
+  /// returned. Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 /// Runs every (mesh, workload, method) and returns the rows, ratios filled in.

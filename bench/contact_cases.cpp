@@ -201,6 +201,9 @@ std::vector<ContactRow> run_contact_bench(const ContactBenchOptions& options) {
     for (const std::string& method : methods) {
       for (const Landmark* lm : landmarks) {
         for (const double speed : options.speeds_mm_per_s) {
+          if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed)) {
+            return rows;
+          }
           report_progress(options.progress,
                           file.stem().string() + " / " + method + " / " + lm->name,
                           static_cast<double>(rows.size()) / total);

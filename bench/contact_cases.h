@@ -11,6 +11,7 @@
 
 #include "hapsim/core/progress.h"
 
+#include <atomic>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -33,6 +34,9 @@ struct ContactBenchOptions {
   double press_n = 4.0;
   double max_depth_mm = 15.0;
   ProgressFn progress;
+  /// Set (by SIGINT or SIGTERM) to end the bench after the row under way: the rows done are
+  /// returned. Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct ContactRow {

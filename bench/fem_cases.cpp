@@ -691,6 +691,9 @@ FemBenchResult run_fem_bench(const FemBenchOptions& options) {
   std::size_t done = 0;
   for (const std::size_t target : options.tet_counts) {
     for (const FemElasticity elasticity : options.elasticities) {
+      if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed)) {
+        return result;
+      }
       FemBlockSpec spec;
       spec.cells = fem_block_cells(spec.size_m, target);
       spec.elasticity = elasticity;

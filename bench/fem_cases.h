@@ -29,6 +29,7 @@
 #include "hapsim/deform/fem_body.h"
 #include "hapsim/world/world_description.h"
 
+#include <atomic>
 #include <nlohmann/json.hpp>
 
 #include <array>
@@ -168,6 +169,9 @@ struct FemBenchOptions {
   double depth_m = kFemPalpationDepthM;
   bool measure_error = true;
   ProgressFn progress;
+  /// Set (by SIGINT or SIGTERM) to end the bench after the row under way: the rows done are
+  /// returned. Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct FemBenchRow {

@@ -326,6 +326,9 @@ PassivityResult run_passivity_sweep(const PassivityOptions& options) {
   std::size_t done = 0;
   for (const DeviceProfile* profile : profiles) {
     for (const Surface& surface : surfaces) {
+      if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed)) {
+        return result;
+      }
       const auto port_stiffness = [&](double k) {
         return surface.port_stiffness
                    ? surface.port_stiffness(*surface.build(*profile, k), surface.line, k)

@@ -16,6 +16,7 @@
 
 #include "hapsim/core/progress.h"
 
+#include <atomic>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
@@ -74,6 +75,9 @@ struct PassivityOptions {
   /// Bisection steps on the stiffness for the Z-width (0: no Z-width).
   int bisection_steps = 8;
   ProgressFn progress;
+  /// Set (by SIGINT or SIGTERM) to end the bench after the row under way: the rows done are
+  /// returned. Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct PassivityRow {

@@ -68,7 +68,11 @@ std::vector<StepRow> run_step_bench(const StepBenchOptions& options) {
       SessionOptions session;
       session.dt_s = scene.run.dt_s;
       session.duration_s = options.duration_s > 0.0 ? options.duration_s : setup.duration_s;
+      session.stop = options.stop;
       const SessionSummary s = run_session(*setup.world, *setup.device, session);
+      if (s.interrupted) {
+        return rows;  // cut short: not a row
+      }
 
       StepRow row;
       row.case_name = c.name;

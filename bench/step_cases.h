@@ -10,6 +10,7 @@
 
 #include "hapsim/core/progress.h"
 
+#include <atomic>
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
@@ -42,6 +43,9 @@ struct StepBenchOptions {
   /// Simulated seconds per run; 0: the whole palpation script.
   double duration_s = 0.0;
   ProgressFn progress;
+  /// Set (by SIGINT or SIGTERM) to end the bench at once: the rows done are returned
+  /// (the run under way is dropped). Not owned; may be null.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct StepRow {

@@ -61,6 +61,20 @@ std::string join(const std::vector<std::string>& names) {
   return out;
 }
 
+// A bench cut short by SIGINT or SIGTERM (each runner ends after the row under way): says so
+// under the table of the rows it did, and sets the exit status 128 + the signal (130, 143). The
+// JSON holds those rows (and, where it is an object, "stopped_by").
+bool said_if_stopped(std::size_t rows) {
+  if (!stop_requested().load(std::memory_order_relaxed)) {
+    return false;
+  }
+  std::printf("stopped      by %s after %zu row(s): the table holds those\n", stop_signal_name(),
+              rows);
+  std::fflush(stdout);
+  exit_status() = with_signal_status(exit_status());
+  return true;
+}
+
 void run_collision(const BenchArgs& args) {
   bench::CollisionBenchOptions options;
   options.quick = args.quick;
@@ -113,6 +127,7 @@ void run_collision(const BenchArgs& args) {
     printer(label, fraction);
   };
   const Stopwatch watch;
+  options.stop = &install_stop_signals();
   const std::vector<bench::CollisionRow> rows = bench::run_collision_bench(options);
   std::cout << bench::format_table(rows);
 
@@ -141,6 +156,7 @@ void run_collision(const BenchArgs& args) {
   if (mismatched != 0) {
     exit_status() = 1;
   }
+  said_if_stopped(rows.size());
 }
 
 struct StepArgs {
@@ -177,10 +193,12 @@ void run_step(const StepArgs& args) {
   options.progress = [&printer](std::string_view label, double fraction) {
     printer(label, fraction);
   };
+  options.stop = &install_stop_signals();
   const std::vector<bench::StepRow> rows = bench::run_step_bench(options);
   std::cout << bench::format_step_table(rows);
   std::cout << "step = device read + collision + force + deformation + safety + write, timed per "
                "cycle; ratios < 1: faster than the exact-query baseline\n";
+  said_if_stopped(rows.size());
   if (json_out) {
     commit_output(*json_out, "--json", bench::step_rows_to_json(rows).dump(2) + '\n');
     std::cout << "wrote " << args.json_path << '\n';
@@ -217,6 +235,7 @@ void run_contact(const ContactArgs& args) {
     printer(label, fraction);
   };
   const Stopwatch watch;
+  options.stop = &install_stop_signals();  // 8 minutes for the whole sweep
   const std::vector<bench::ContactRow> rows = bench::run_contact_bench(options);
   std::printf(
       "A fingertip pressed over each landmark until it pushes back %.1f N (at most %.0f mm past "
@@ -235,12 +254,14 @@ void run_contact(const ContactArgs& args) {
   }
   std::printf("%zu rows in %.1f s: %zu pop-throughs in all, worst step p99 %.1f us, load %.2f\n",
               rows.size(), watch.elapsed_s(), pops, worst_p99_us, load_average());
+  const bool stopped = said_if_stopped(rows.size());
   if (json_out) {
     std::cout << std::flush;
     json_out.write({{"rows", bench::contact_rows_to_json(rows)},
                     {"press_n", args.press_n},
                     {"max_depth_mm", args.max_depth_mm},
-                    {"load_average", load_average()}});
+                    {"load_average", load_average()},
+                    {"stopped_by", stopped ? stop_signal_name() : ""}});
   }
 }
 
@@ -271,6 +292,7 @@ void run_passivity(const PassivityArgs& args) {
     printer(label, fraction);
   };
   const Stopwatch watch;
+  options.stop = &install_stop_signals();
   const bench::PassivityResult result = bench::run_passivity_sweep(options);
   char setup[400];
   std::snprintf(setup, sizeof setup,
@@ -286,9 +308,12 @@ void run_passivity(const PassivityArgs& args) {
   std::cout << bench::format_passivity_table(result);
   std::snprintf(setup, sizeof setup, "%zu runs in %.1f s\n", result.rows.size(), watch.elapsed_s());
   std::cout << setup;
+  const bool stopped = said_if_stopped(result.rows.size());
   if (json_out) {
     std::cout << std::flush;
-    json_out.write(bench::passivity_to_json(result));
+    nlohmann::json j = bench::passivity_to_json(result);
+    j["stopped_by"] = stopped ? stop_signal_name() : "";
+    json_out.write(j);
   }
 }
 
@@ -349,6 +374,7 @@ void run_fem(const FemArgs& args) {
     printer(label, fraction);
   };
   const Stopwatch watch;
+  options.stop = &install_stop_signals();
   const bench::FemBenchResult result = bench::run_fem_bench(options);
   const double load_after = load_average();
   const bench::FemBlockSpec& b = result.block;
@@ -369,8 +395,10 @@ void run_fem(const FemArgs& args) {
   std::snprintf(setup, sizeof setup, "%zu rows in %.1f s; load average %.2f before, %.2f after\n",
                 result.rows.size(), watch.elapsed_s(), load_before, load_after);
   std::cout << setup;
+  const bool stopped = said_if_stopped(result.rows.size());
   if (json_out) {
     nlohmann::json j = bench::fem_bench_to_json(result);
+    j["stopped_by"] = stopped ? stop_signal_name() : "";
     j["machine"] = {{"load_average_before", load_before},
                     {"load_average_after", load_after},
                     {"hardware_threads", sysconf(_SC_NPROCESSORS_ONLN)},

@@ -14,6 +14,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -119,6 +121,30 @@ TEST(ContactBench, ALandmarkNoSceneHasIsRefused) {
   options.scenes = {default_scenes_dir() / "thin_plate.json"};
   options.landmarks = {"patella"};
   EXPECT_THROW((void)run_contact_bench(options), Error);
+}
+
+// Ctrl-C during a long sweep (the whole one takes 8 minutes) ends it after the row under way:
+// the table and the JSON hold the rows done, both say what stopped it, and the exit is 130.
+TEST(ContactBench, SigintEndsTheSweepWithTheRowsDoneInTheTableAndTheJson) {
+  const std::filesystem::path json_path = test::temp_path("contact_bench_sigint.json");
+  std::filesystem::remove(json_path);
+  // Six slow drags over the plate (0.1 mm/s: 10 minutes of simulated time in all), so the
+  // signal arrives with rows left to run however fast the machine.
+  test::BackgroundHapsim bench(
+      "bench contact --scenes " + (default_scenes_dir() / "thin_plate.json").string() +
+          " --methods exact --speeds 0.1,0.1,0.1,0.1,0.1,0.1 --json " + json_path.string(),
+      test::temp_path("contact_bench_sigint.log"));
+  // The second row has begun (its progress line: 1 of 6 done).
+  ASSERT_TRUE(bench.wait_for("17%", std::chrono::minutes(5))) << bench.output();
+  bench.signal(SIGINT);
+  EXPECT_EQ(bench.wait(), 130) << bench.output();
+  EXPECT_NE(bench.output().find("stopped      by SIGINT after"), std::string::npos)
+      << bench.output();
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_GE(j.at("rows").size(), 1u);
+  EXPECT_LT(j.at("rows").size(), 6u);
+  EXPECT_EQ(j.at("stopped_by").get<std::string>(), "SIGINT");
 }
 
 }  // namespace
