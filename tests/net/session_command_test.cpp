@@ -71,6 +71,29 @@ TEST(SessionCommand, OnlyTheNamedFieldsChange) {
   EXPECT_EQ(c.static_friction, 0.4);
 }
 
+// A flood of made-up issuers (anyone on the network can publish commands) must not lock out a
+// live issuer's Pause: with the table full, each newcomer evicts the issuer heard from least
+// recently, so the live one, if evicted, is heard again as new. Memory stays bounded.
+TEST(SessionCommand, TwoThousandFakeIssuersDoNotBlockAPause) {
+  CommandGate gate(kHash, kServe, kMaterials);  // 1024 issuers remembered
+  SessionCommand out;
+  SessionCommand pause;
+  pause.kind = SessionCommandKind::kPause;
+  const std::uint64_t live = 0xC0FFEE;
+  ASSERT_EQ(gate.admit(encode_session_command(pause, live, 1, kHash, kServe), out),
+            SampleVerdict::kAccepted);
+  for (std::uint64_t fake = 1; fake <= 2000; ++fake) {
+    ASSERT_EQ(gate.admit(encode_session_command(material_command(), fake, 1, kHash, kServe), out),
+              SampleVerdict::kAccepted)
+        << fake;
+  }
+  EXPECT_EQ(gate.evicted_issuers(), 2001u - 1024u);
+  out = SessionCommand{};
+  EXPECT_EQ(gate.admit(encode_session_command(pause, live, 2, kHash, kServe), out),
+            SampleVerdict::kAccepted);
+  EXPECT_EQ(out.kind, SessionCommandKind::kPause);
+}
+
 TEST(SessionCommand, EachBadCommandHasItsVerdictAndIsCounted) {
   CommandGate gate(kHash, kServe, kMaterials, CommandLimits{.max_issuers = 2});
   SessionCommand out;
@@ -84,7 +107,12 @@ TEST(SessionCommand, EachBadCommandHasItsVerdictAndIsCounted) {
   EXPECT_EQ(admit(good(1, 5)), SampleVerdict::kOutOfOrder);  // a duplicate
   EXPECT_EQ(admit(good(1, 4)), SampleVerdict::kOutOfOrder);  // an older one
   EXPECT_EQ(admit(good(2, 1)), SampleVerdict::kAccepted);    // another issuer counts its own
-  EXPECT_EQ(admit(good(3, 1)), SampleVerdict::kOutOfRange);  // one issuer too many
+  // One issuer too many takes the place of the one heard from least recently (issuer 1), whose
+  // order is forgotten: its old command is news again.
+  EXPECT_EQ(admit(good(3, 1)), SampleVerdict::kAccepted);
+  EXPECT_EQ(gate.evicted_issuers(), 1u);
+  EXPECT_EQ(admit(good(2, 1)), SampleVerdict::kOutOfOrder);  // issuer 2 is remembered
+  EXPECT_EQ(admit(good(1, 4)), SampleVerdict::kAccepted);    // issuer 1 was not
   EXPECT_EQ(admit(encode_session_command(pause, 1, 9, kHash ^ 1U, kServe)),
             SampleVerdict::kOtherScene);
   EXPECT_EQ(admit(encode_session_command(pause, 1, 9, kHash, kServe + 1)),
@@ -125,9 +153,9 @@ TEST(SessionCommand, EachBadCommandHasItsVerdictAndIsCounted) {
   EXPECT_EQ(admit(good(1, 10)), SampleVerdict::kOutOfOrder);
   EXPECT_EQ(admit(good(1, 11)), SampleVerdict::kAccepted);
 
-  EXPECT_EQ(gate.count(SampleVerdict::kAccepted), 4u);
-  EXPECT_EQ(gate.count(SampleVerdict::kOutOfOrder), 3u);
-  EXPECT_EQ(gate.count(SampleVerdict::kOutOfRange), 3u);
+  EXPECT_EQ(gate.count(SampleVerdict::kAccepted), 6u);
+  EXPECT_EQ(gate.count(SampleVerdict::kOutOfOrder), 4u);
+  EXPECT_EQ(gate.count(SampleVerdict::kOutOfRange), 2u);
   EXPECT_EQ(gate.count(SampleVerdict::kMalformed), 7u);
   EXPECT_EQ(gate.count(SampleVerdict::kOtherScene), 1u);
   EXPECT_EQ(gate.count(SampleVerdict::kStale), 1u);

@@ -1,5 +1,6 @@
 #include "hapsim/net/session_command.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -133,11 +134,10 @@ SampleVerdict CommandGate::check(const hapsim_msg_Command& m) const noexcept {
   }
   const auto newest = newest_per_issuer_.find(m.issuer_id);
   if (newest == newest_per_issuer_.end()) {
-    return newest_per_issuer_.size() >= limits_.max_issuers ? SampleVerdict::kOutOfRange
-                                                            : SampleVerdict::kAccepted;
+    return SampleVerdict::kAccepted;  // a new issuer (admit makes room for it)
   }
-  return m.command_sequence > newest->second ? SampleVerdict::kAccepted
-                                             : SampleVerdict::kOutOfOrder;
+  return m.command_sequence > newest->second.newest_sequence ? SampleVerdict::kAccepted
+                                                             : SampleVerdict::kOutOfOrder;
 }
 
 SampleVerdict CommandGate::admit(const hapsim_msg_Command& message, SessionCommand& out) {
@@ -146,7 +146,18 @@ SampleVerdict CommandGate::admit(const hapsim_msg_Command& message, SessionComma
   if (verdict != SampleVerdict::kAccepted) {
     return verdict;
   }
-  newest_per_issuer_[message.issuer_id] = message.command_sequence;
+  ++admitted_;
+  if (!newest_per_issuer_.contains(message.issuer_id) &&
+      newest_per_issuer_.size() >= std::max<std::size_t>(1, limits_.max_issuers)) {
+    // Full: the issuer heard from least recently makes room (a scan of at most max_issuers, off
+    // the haptic path: commands come from people).
+    const auto oldest = std::min_element(
+        newest_per_issuer_.begin(), newest_per_issuer_.end(),
+        [](const auto& a, const auto& b) { return a.second.last_heard < b.second.last_heard; });
+    newest_per_issuer_.erase(oldest);
+    ++evicted_issuers_;
+  }
+  newest_per_issuer_[message.issuer_id] = {message.command_sequence, admitted_};
   out = SessionCommand{};
   out.kind = static_cast<SessionCommandKind>(message.kind);
   if (out.kind == SessionCommandKind::kSetMaterial) {
@@ -213,8 +224,6 @@ std::string CommandGate::explain(const hapsim_msg_Command& m, SampleVerdict verd
       return name + ": the command was meant for an earlier start of this host";
     case SampleVerdict::kOutOfOrder:
       return name + ": not newer than this issuer's last command";
-    case SampleVerdict::kOutOfRange:
-      return name + ": too many issuers (" + std::to_string(limits_.max_issuers) + ")";
     default:
       return name;
   }

@@ -69,8 +69,10 @@ struct CommandLimits {
   double max_force_n = 1e3;
   double max_damping_n_s_per_m = 1e4;
   double max_friction = 10.0;
-  /// Issuers remembered for ordering; a new one beyond this is refused (a flood of made-up
-  /// issuers must not grow the host's memory).
+  /// Issuers remembered for ordering (a flood of made-up issuers must not grow the host's
+  /// memory). A new one beyond this takes the place of the one heard from least recently: a
+  /// flood cannot lock out a live issuer's Pause or Reset (it is heard again as a new issuer),
+  /// at the price of forgetting the order of the one evicted.
   std::size_t max_issuers = 1024;
 };
 
@@ -81,9 +83,9 @@ class CommandGate {
               CommandLimits limits = {});
 
   /// The verdict on `message`, counted: malformed (an unknown kind or field, a non-finite value
-  /// set, a material the scene does not have), out of range (a negative or too large value, one
-  /// issuer too many), other scene, stale (meant for another start of the host), out of order
-  /// (not newer than the issuer's newest accepted). On kAccepted `out` holds the command.
+  /// set, a material the scene does not have), out of range (a negative or too large value),
+  /// other scene, stale (meant for another start of the host), out of order (not newer than the
+  /// issuer's newest accepted). On kAccepted `out` holds the command.
   SampleVerdict admit(const hapsim_msg_Command& message, SessionCommand& out);
 
   /// Why `message` got `verdict`, in words for the issuer ("out of range: stiffness 1e+09 N/m is
@@ -91,6 +93,8 @@ class CommandGate {
   [[nodiscard]] std::string explain(const hapsim_msg_Command& message, SampleVerdict verdict) const;
 
   [[nodiscard]] const VerdictCounts& counts() const noexcept { return counts_; }
+  /// Issuers forgotten to make room for a new one (limits.max_issuers).
+  [[nodiscard]] std::uint64_t evicted_issuers() const noexcept { return evicted_issuers_; }
   [[nodiscard]] std::uint64_t count(SampleVerdict verdict) const noexcept {
     return counts_[static_cast<std::size_t>(verdict)];
   }
@@ -102,7 +106,13 @@ class CommandGate {
   std::uint64_t serve_id_;
   std::size_t material_count_;
   CommandLimits limits_;
-  std::unordered_map<std::uint64_t, std::uint64_t> newest_per_issuer_;
+  struct IssuerOrder {
+    std::uint64_t newest_sequence = 0;
+    std::uint64_t last_heard = 0;  ///< admit() calls so far when it was last accepted
+  };
+  std::unordered_map<std::uint64_t, IssuerOrder> newest_per_issuer_;
+  std::uint64_t admitted_ = 0;
+  std::uint64_t evicted_issuers_ = 0;
   VerdictCounts counts_{};
 };
 
