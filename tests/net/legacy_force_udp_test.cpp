@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <arpa/inet.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -60,8 +61,21 @@ TEST(LegacyForceUdp, ReceiverBindsLoopbackUnlessTold) {
   LegacyForceUdpReceiver receiver("0");
   EXPECT_EQ(receiver.bound().host, "127.0.0.1");
   EXPECT_NE(receiver.bound().port, 0);
-  LegacyForceUdpReceiver explicit_any("0.0.0.0:0");
+  EXPECT_EQ(receiver.peer().host, "127.0.0.1");  // its own machine's datagrams only
+  // Every interface: only with the force host named, or anyone on the network could push force.
+  LegacyForceUdpReceiver explicit_any("0.0.0.0:0@127.0.0.1");
   EXPECT_EQ(explicit_any.bound().host, "0.0.0.0");
+  EXPECT_EQ(explicit_any.peer().host, "127.0.0.1");
+  try {
+    LegacyForceUdpReceiver open_to_all("0.0.0.0:0");
+    FAIL() << "bound every interface without a force host";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind("--legacy-force-bind: '0.0.0.0:0': ", 0), 0U) << what;
+    EXPECT_NE(what.find("0.0.0.0:0@HOST"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+  }
+  EXPECT_THROW(LegacyForceUdpReceiver("0@"), Error);
   // A port someone holds: one line, naming the option.
   try {
     LegacyForceUdpReceiver twice(std::to_string(receiver.bound().port));
@@ -146,6 +160,61 @@ TEST(LegacyForceUdp, ShortAndLongDatagramsAreCountedNotApplied) {
   EXPECT_EQ(device.count(LegacyPacketVerdict::kAccepted), 0U);
   EXPECT_FALSE(device.newest_received_s().has_value());
   EXPECT_EQ(device.status().health, DeviceHealth::kStale);
+}
+
+// Sends `count` valid packets (1 N on the first finger) to `port` from a socket bound to
+// `source_ip` (every 127/8 address is this machine's loopback).
+void send_from(const char* source_ip, std::uint16_t port, int count) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_in from{};
+  from.sin_family = AF_INET;
+  ASSERT_EQ(::inet_pton(AF_INET, source_ip, &from.sin_addr), 1);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&from), sizeof from), 0) << source_ip;
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(port);
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  const LegacyForcePacket packet = encode_legacy_force({1.0, 0.0, 0.0, 0.0}, 4.0).packet;
+  for (int i = 0; i < count; ++i) {
+    ASSERT_EQ(::sendto(fd, packet.data(), packet.size(), 0, reinterpret_cast<const sockaddr*>(&to),
+                       sizeof to),
+              static_cast<ssize_t>(packet.size()));
+  }
+  ::close(fd);
+}
+
+// Anyone who reaches the port can send a well-formed packet: the glove takes force only from its
+// force host, and counts the others (issue 32). Spoofed packets from another address (127.0.0.2)
+// are dropped before they are read; the force host's own (127.0.0.1) are rendered.
+TEST(LegacyForceUdp, PacketsFromAnotherSenderAreCountedAndIgnored) {
+  auto receiver = std::make_unique<LegacyForceUdpReceiver>("0");
+  const std::uint16_t port = receiver->bound().port;
+  LegacyGloveDevice device(device_profile("rutgers_master"), std::move(receiver));
+  send_from("127.0.0.2", port, 5);
+  double t = 0.0;
+  for (int i = 0; i < 200 && device.count(LegacyPacketVerdict::kOtherSender) < 5; ++i) {
+    (void)device.read(t);
+    t += 1e-3;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_EQ(device.count(LegacyPacketVerdict::kOtherSender), 5U);
+  EXPECT_EQ(device.count(LegacyPacketVerdict::kAccepted), 0U);
+  EXPECT_FALSE(device.newest_received_s().has_value());
+  send_from("127.0.0.1", port, 1);
+  read_until(device, 6, t);
+  EXPECT_EQ(device.count(LegacyPacketVerdict::kAccepted), 1U);
+  EXPECT_EQ(device.newest_finger_force_n()[0], 1.0);
+
+  // Told to take another host's packets, it takes those only.
+  auto other = std::make_unique<LegacyForceUdpReceiver>("0@127.0.0.2");
+  const std::uint16_t other_port = other->bound().port;
+  LegacyGloveDevice told(device_profile("rutgers_master"), std::move(other));
+  send_from("127.0.0.1", other_port, 2);
+  send_from("127.0.0.2", other_port, 1);
+  read_until(told, 3, t);
+  EXPECT_EQ(told.count(LegacyPacketVerdict::kOtherSender), 2U);
+  EXPECT_EQ(told.count(LegacyPacketVerdict::kAccepted), 1U);
 }
 
 TEST(LegacyForceUdp, SendAndPollAllocateNothing) {

@@ -22,6 +22,8 @@ const char* legacy_verdict_name(LegacyPacketVerdict verdict) noexcept {
       return "long";
     case LegacyPacketVerdict::kOutOfRange:
       return "out of range";
+    case LegacyPacketVerdict::kOtherSender:
+      return "other sender";
   }
   return "unknown";
 }

@@ -32,8 +32,11 @@ enum class LegacyPacketVerdict : std::uint8_t {
   kShort,       ///< fewer than 16 bytes
   kLong,        ///< more than 16 bytes
   kOutOfRange,  ///< a value below 0 or above 10 000
+  /// From a host other than the force host the source was told to take packets from (dropped by
+  /// the source before it is read: anyone on the network can send a datagram).
+  kOtherSender,
 };
-inline constexpr std::size_t kLegacyPacketVerdicts = 4;
+inline constexpr std::size_t kLegacyPacketVerdicts = 5;
 using LegacyPacketCounts = std::array<std::uint64_t, kLegacyPacketVerdicts>;
 
 [[nodiscard]] const char* legacy_verdict_name(LegacyPacketVerdict verdict) noexcept;

@@ -73,6 +73,7 @@ DeviceInput LegacyGloveDevice::read(double time_s) noexcept {
       const std::size_t seen = *length < buffer_.size() ? *length : buffer_.size();
       (void)receive_datagram(std::span<const std::byte>(buffer_.data(), seen), time_s);
     }
+    counts_[static_cast<std::size_t>(LegacyPacketVerdict::kOtherSender)] = source_->other_senders();
   }
 
   // A NaN host time compares false everywhere: such a read is never fresh.

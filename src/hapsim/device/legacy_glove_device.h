@@ -35,6 +35,9 @@ class LegacyPacketSource {
   /// when none is pending. Never throws.
   [[nodiscard]] virtual std::optional<std::size_t> receive(
       std::span<std::byte> buffer) noexcept = 0;
+  /// Datagrams dropped so far for coming from a sender other than the force host (a source that
+  /// cannot tell senders apart drops none). Never throws.
+  [[nodiscard]] virtual std::uint64_t other_senders() const noexcept { return 0; }
 
  protected:
   LegacyPacketSource() = default;

@@ -164,8 +164,11 @@ bool LegacyForceUdpSender::send_command(const DeviceCommand& command,
   return send_fingers(fingers, finger_max_n);
 }
 
-LegacyForceUdpReceiver::LegacyForceUdpReceiver(std::string_view bind_spec,
-                                               std::string_view option) {
+LegacyForceUdpReceiver::LegacyForceUdpReceiver(std::string_view spec, std::string_view option) {
+  const std::size_t at = spec.find('@');
+  const std::string_view bind_spec = spec.substr(0, at);
+  const std::string_view peer_spec =
+      at == std::string_view::npos ? std::string_view{} : spec.substr(at + 1);
   const UdpEndpoint wanted = parse_udp_endpoint(bind_spec, option, "127.0.0.1", true);
   const Resolved r = resolve(wanted, true, bind_spec, option);
   fd_ = open_udp_socket(r.family, bind_spec, option);
@@ -184,6 +187,57 @@ LegacyForceUdpReceiver::LegacyForceUdpReceiver(std::string_view bind_spec,
                 sizeof port, NI_NUMERICHOST | NI_NUMERICSERV);
   bound_.host = host;
   bound_.port = static_cast<std::uint16_t>(std::atoi(port));
+
+  if (at != std::string_view::npos) {
+    // "HOST" or "HOST:PORT" ("[IPV6]:PORT"): a bare name or address is any port of that host.
+    const bool has_port = peer_spec.rfind("]:") != std::string_view::npos ||
+                          (peer_spec.find(':') != std::string_view::npos &&
+                           peer_spec.find(':') == peer_spec.rfind(':') && peer_spec.front() != '[');
+    if (has_port) {
+      peer_ = parse_udp_endpoint(peer_spec, option);
+    } else if (!peer_spec.empty()) {
+      const bool bracketed = peer_spec.front() == '[' && peer_spec.back() == ']';
+      peer_.host = std::string(bracketed ? peer_spec.substr(1, peer_spec.size() - 2) : peer_spec);
+    }
+    if (peer_.host.empty()) {
+      ::close(fd_);
+      throw Error(std::string(option), single_quoted(spec) + ": name the force host after '@'");
+    }
+    peer_address_ = resolve(peer_, false, spec, option).address;
+  } else if (r.family == AF_INET &&
+             (ntohl(reinterpret_cast<const sockaddr_in&>(r.address).sin_addr.s_addr) >> 24) ==
+                 127) {
+    peer_ = {bound_.host, 0};  // loopback: this machine's own datagrams only
+    peer_address_ = r.address;
+  } else if (r.family == AF_INET6 &&
+             IN6_IS_ADDR_LOOPBACK(&reinterpret_cast<const sockaddr_in6&>(r.address).sin6_addr)) {
+    peer_ = {bound_.host, 0};
+    peer_address_ = r.address;
+  } else {
+    ::close(fd_);
+    throw Error(std::string(option),
+                single_quoted(spec) + ": bound to " + bound_.host +
+                    ", it would take force packets from anyone on the network; name the force "
+                    "host: " +
+                    std::string(bind_spec) + "@HOST");
+  }
+}
+
+// haptic path
+bool LegacyForceUdpReceiver::from_peer(const sockaddr_storage& source) const noexcept {
+  if (source.ss_family == AF_INET && peer_address_.ss_family == AF_INET) {
+    const auto& s = reinterpret_cast<const sockaddr_in&>(source);
+    const auto& p = reinterpret_cast<const sockaddr_in&>(peer_address_);
+    return s.sin_addr.s_addr == p.sin_addr.s_addr &&
+           (peer_.port == 0 || ntohs(s.sin_port) == peer_.port);
+  }
+  if (source.ss_family == AF_INET6 && peer_address_.ss_family == AF_INET6) {
+    const auto& s = reinterpret_cast<const sockaddr_in6&>(source);
+    const auto& p = reinterpret_cast<const sockaddr_in6&>(peer_address_);
+    return std::memcmp(&s.sin6_addr, &p.sin6_addr, sizeof s.sin6_addr) == 0 &&
+           (peer_.port == 0 || ntohs(s.sin6_port) == peer_.port);
+  }
+  return false;
 }
 
 LegacyForceUdpReceiver::~LegacyForceUdpReceiver() {
@@ -192,10 +246,20 @@ LegacyForceUdpReceiver::~LegacyForceUdpReceiver() {
 
 // haptic path
 std::optional<std::size_t> LegacyForceUdpReceiver::receive(std::span<std::byte> buffer) noexcept {
-  while (true) {
+  // A flood from another sender is dropped a bounded number at a time: the cycle must not spin.
+  constexpr int kMaxDroppedPerCall = 64;
+  for (int dropped = 0; dropped < kMaxDroppedPerCall;) {
     // MSG_TRUNC: the datagram's real length even when it did not fit, so a long one is seen as
     // long; MSG_DONTWAIT: nothing pending is an answer, not a wait.
-    const ssize_t n = ::recv(fd_, buffer.data(), buffer.size(), MSG_DONTWAIT | MSG_TRUNC);
+    sockaddr_storage source{};
+    socklen_t source_length = sizeof source;
+    const ssize_t n = ::recvfrom(fd_, buffer.data(), buffer.size(), MSG_DONTWAIT | MSG_TRUNC,
+                                 reinterpret_cast<sockaddr*>(&source), &source_length);
+    if (n >= 0 && !from_peer(source)) {
+      ++other_senders_;  // dropped: the force comes from the force host only
+      ++dropped;
+      continue;
+    }
     if (n >= 0) {
       ++datagrams_;
       return static_cast<std::size_t>(n);
@@ -208,6 +272,7 @@ std::optional<std::size_t> LegacyForceUdpReceiver::receive(std::span<std::byte> 
     }
     return std::nullopt;
   }
+  return std::nullopt;
 }
 
 std::unique_ptr<LegacyGloveDevice> open_legacy_glove_udp(std::string_view bind_spec,

@@ -6,8 +6,10 @@
 // Both sockets are non-blocking and set up entirely in their constructors (name resolution,
 // bind), so send() and receive() are one system call each, allocate nothing and never wait.
 // The receiver binds to loopback unless given an interface address (SPEC §8: services bind to
-// loopback unless told otherwise). A malformed HOST:PORT, an unknown host or a failed bind is one
-// hapsim::Error line naming the option.
+// loopback unless told otherwise), and takes datagrams only from its force host: anyone who can
+// reach the port could otherwise push force into the glove. Datagrams from any other sender are
+// dropped and counted (LegacyPacketVerdict::kOtherSender). A malformed HOST:PORT, an unknown host
+// or a failed bind is one hapsim::Error line naming the option.
 #pragma once
 
 #include "hapsim/core/device_io.h"
@@ -78,7 +80,10 @@ class LegacyForceUdpReceiver final : public LegacyPacketSource {
  public:
   /// `bind_spec`: "PORT" binds 127.0.0.1:PORT; "ADDRESS:PORT" binds that interface's address
   /// ("0.0.0.0:PORT" every interface: only when told). PORT 0 takes an ephemeral port (see
-  /// bound()). Throws hapsim::Error(option, one line).
+  /// bound()). "…@HOST" or "…@HOST:PORT" names the force host, the only sender taken (any port
+  /// of it unless one is given); without it a loopback bind takes its own address's datagrams
+  /// only, and any other bind is refused (it would take force from anyone on the network).
+  /// Throws hapsim::Error(option, one line).
   explicit LegacyForceUdpReceiver(std::string_view bind_spec,
                                   std::string_view option = "--legacy-force-bind");
   ~LegacyForceUdpReceiver() override;
@@ -96,12 +101,20 @@ class LegacyForceUdpReceiver final : public LegacyPacketSource {
   [[nodiscard]] std::uint64_t datagrams() const noexcept { return datagrams_; }
   /// recv() errors other than "nothing pending".
   [[nodiscard]] std::uint64_t errors() const noexcept { return errors_; }
+  /// The force host datagrams are taken from (port 0: any port of it).
+  [[nodiscard]] const UdpEndpoint& peer() const noexcept { return peer_; }
+  [[nodiscard]] std::uint64_t other_senders() const noexcept override { return other_senders_; }
 
  private:
+  [[nodiscard]] bool from_peer(const sockaddr_storage& source) const noexcept;
+
   UdpEndpoint bound_;
+  UdpEndpoint peer_;
+  sockaddr_storage peer_address_{};
   int fd_ = -1;
   std::uint64_t datagrams_ = 0;
   std::uint64_t errors_ = 0;
+  std::uint64_t other_senders_ = 0;
 };
 
 /// The `legacy-glove` device (`hapsim device --device legacy-glove`): a LegacyGloveDevice fed by
