@@ -10,9 +10,10 @@
 # with matplotlib (scripts/setup.sh installs them). tests/apps/doc_images_test.cpp runs it and
 # compares each picture with the committed one (docs/testing.md, "Documentation pictures").
 #
-# The viewer runs in real time: its screenshot is the last frame before --duration, so each
-# duration ends inside a stretch where the scene's script holds still (a held press, the ball at
-# rest), and a loaded machine that draws that frame a few hundred ms late draws the same picture.
+# The viewer runs in real time: its screenshot is the last frame drawn before --duration, which
+# on a loaded machine may be seconds old. So each screenshot is of a scene holding still for the
+# last 3 s or more (a press held by cutting the scene's script there, the ball at rest at the end
+# of the pick-and-place), and a frame drawn late draws the same picture.
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -40,33 +41,52 @@ WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
 
 # --- The viewer (one virtual X server for all of them; 1280x720, panels shown) -------------------
-# `viewer NAME SCENE SECONDS [ARGS...]`: the scene's own script (--device sim) for SECONDS, the
-# last frame to NAME.png.
+# `viewer NAME SCENE SECONDS [ARGS...]`: the viewer for SECONDS, its last frame to NAME.png.
+# `held SCENE CUT [DATA]`: the scene's own script up to CUT seconds as a trajectory CSV (every
+# 5 ms); played with --device sim:FILE the device then stays where the script was at CUT.
 viewer_shots() {
   set -euo pipefail
+  cd "$WORK" # the trajectories by their bare names: the panels show them, the same every run
   viewer() {
     local name="$1" scene="$2" seconds="$3"
     shift 3
-    "$HAPSIM" view "$scene" --device sim --duration "$seconds" --no-vsync --size 1280x720 \
+    "$HAPSIM" view "$scene" --duration "$seconds" --no-vsync --size 1280x720 \
       --screenshot "$OUT/$name.png" "$@" >"$WORK/$name.log" 2>&1 ||
       { cat "$WORK/$name.log" >&2; echo "make-doc-images: $name failed" >&2; return 1; }
   }
-  # The default scene (the FEM knee): the fingertip holds its first press, over the lateral
-  # collateral ligament, from 1.45 s to 1.9 s.
-  viewer viewer-knee "$S/knee.json" 1.85
+  held() {
+    PYTHONPATH="$PYMODULE" "$PYTHON" - "$@" <<'PY'
+import sys
+import hapsim
+scene, cut = sys.argv[1], float(sys.argv[2])
+world = hapsim.World(scene, data_dir=sys.argv[3] if len(sys.argv) > 3 else None)
+rows = [world.script_input(k * 0.005) for k in range(int(round(cut / 0.005)) + 1)]
+fingers, joints = len(rows[0].finger_rad), len(rows[0].joint_rad)
+print(",".join(["t", "x", "y", "z", "qw", "qx", "qy", "qz"] + [f"f{i}" for i in range(fingers)]
+               + [f"j{i}" for i in range(joints)] + ["buttons"]))
+for k, d in enumerate(rows):
+    values = [k * 0.005, *d.p_world, *d.q_world, *d.finger_rad, *d.joint_rad]
+    print(",".join(f"{v:.17g}" for v in values) + f",{d.buttons}")
+PY
+  }
+  # The default scene (the FEM knee): its script cut at 1.7 s, the fingertip in its first press,
+  # over the lateral collateral ligament, and held there.
+  held "$S/knee.json" 1.7 >knee-lcl-press.csv
+  viewer viewer-knee "$S/knee.json" 4.5 --device sim:knee-lcl-press.csv
   # The pick-and-place at its end: the ball let go on the sheet (8.5 s), the arm back up and
   # still from 9.5 s.
-  viewer viewer-teleop "$S/teleop.json" 10
+  viewer viewer-teleop "$S/teleop.json" 12.5 --device sim
   if [ -f "$DATA/motoman_gp7/gp7.urdf" ]; then
-    viewer viewer-teleop-gp7 "$S/teleop_gp7.json" 10 --data "$DATA/motoman_gp7"
+    viewer viewer-teleop-gp7 "$S/teleop_gp7.json" 12.5 --device sim --data "$DATA/motoman_gp7"
   else
     echo "skipped viewer-teleop-gp7: no Motoman GP7 URDF in $DATA/motoman_gp7 (set HAPSIM_DATA)"
   fi
-  # The full-resolution VHF knee: five fingertips hold their first press, over the LCL and the
-  # fibular head, from 1.25 s to 1.8 s, seen from the front and the lateral side.
+  # The full-resolution VHF knee: its script cut at 1.6 s, the five fingertips in their first
+  # press, over the LCL and the fibular head, held there; seen from the front and lateral side.
   if [ -d "$DATA/knee_vhf_left" ]; then
-    viewer viewer-knee-vhf "$S/knee_vhf.json" 1.75 --data "$DATA/knee_vhf_left" \
-      --camera -0.40,0.22,0.08,-0.02,0.0,0.0,36
+    held "$S/knee_vhf.json" 1.6 "$DATA/knee_vhf_left" >knee-vhf-lcl-press.csv
+    viewer viewer-knee-vhf "$S/knee_vhf.json" 4.5 --device sim:knee-vhf-lcl-press.csv \
+      --data "$DATA/knee_vhf_left" --camera -0.40,0.22,0.08,-0.02,0.0,0.0,36
   else
     echo "skipped viewer-knee-vhf: no VHF knee in $DATA/knee_vhf_left (set HAPSIM_DATA)"
   fi
@@ -108,7 +128,7 @@ offscreen() {
 }
 
 # The viewer mostly waits for its clock, the rest mostly computes: the two run side by side.
-export HAPSIM OUT WORK S DATA
+export HAPSIM OUT WORK S DATA PYTHON PYMODULE
 offscreen &
 offscreen_pid=$!
 status=0
