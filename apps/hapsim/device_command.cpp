@@ -301,19 +301,35 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
   std::optional<Silence> pending_silence;  // silent, force not yet reported at zero
   std::vector<Silence> silences;
   bool above_said = false;  // --say-force-above: said once per rise, again after a fall below
+  // Another simulation host on the session (a second serve, or the followed one restarted):
+  // followed only once the one joined first has gone silent, never while it answers.
+  std::optional<net::SceneInfoSample> other;
+  std::uint64_t other_said = serve_id;
+  std::uint64_t other_hosts = 0;
   while (loop.running() && !stop.load(std::memory_order_relaxed)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
     if (auto fresh = take_said(info_in); fresh && fresh->serve_id != serve_id) {
-      serve_id = fresh->serve_id;
-      std::printf("simulation   host restarted: %s (hash %016" PRIx64 ")%s\n",
-                  fresh->scene_file.c_str(), fresh->scene_hash,
-                  fresh->scene_hash != info->scene_hash ? ", another scene" : "");
-      std::fflush(stdout);
-      client.set_scene(served_scene(*fresh, finger_map));
+      other = std::move(fresh);
     }
     const net::DeviceHostStatus s = client.status();
     const std::int64_t now_ns = monotonic_ns();
     const bool alive = s.last_model_ns != 0 && now_ns - s.last_model_ns < kSilentAfter_ns;
+    if (other && !alive) {
+      serve_id = other->serve_id;
+      std::printf("simulation   host restarted: %s (hash %016" PRIx64 ")%s\n",
+                  other->scene_file.c_str(), other->scene_hash,
+                  other->scene_hash != info->scene_hash ? ", another scene" : "");
+      std::fflush(stdout);
+      client.set_scene(served_scene(*other, finger_map));
+      other.reset();
+    } else if (other && other->serve_id != other_said) {
+      other_said = other->serve_id;
+      ++other_hosts;
+      std::printf("simulation   another host on the session (%s, hash %016" PRIx64
+                  ") at %.3f s: not followed while the one joined first answers\n",
+                  other->scene_file.c_str(), other->scene_hash, host_s(now_ns));
+      std::fflush(stdout);
+    }
     if (alive && !sim_alive) {
       ++joins;
       std::printf("simulation   host %s at %.3f s: rendering its local models\n",
@@ -390,6 +406,7 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     j["round_trip_us"] = {
         {"p50", s.round_trip_us.p50}, {"p99", s.round_trip_us.p99}, {"max", s.round_trip_us.max}};
     j["simulation_joins"] = joins;
+    j["other_simulation_hosts"] = other_hosts;  // seen while the followed one answered
     j["silences"] = nlohmann::json::array();
     for (const Silence& silence : silences) {
       j["silences"].push_back({{"since_s", silence.since_s},

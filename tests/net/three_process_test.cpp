@@ -217,5 +217,42 @@ TEST(ThreeProcesses, KillingServeFadesTheForceAndTheDeviceRendersAgainWhenItRetu
   EXPECT_NE(serve->output().find("device host  joined"), std::string::npos);
 }
 
+// A second `hapsim serve` on the session (another scene) while the first answers the device:
+// the device host reports it and keeps following the first (its models refused as from another
+// host), instead of being captured by it (it once took the device to 12 N and cut the first serve
+// off for good).
+TEST(ThreeProcesses, ASecondServeOnTheSessionDoesNotCaptureTheDeviceHost) {
+  ASSERT_TRUE(test::on_loopback_config());
+  const auto device_json = hapsim::test::temp_path("device-second-serve.json");
+  const std::string net = " --session second-serve --domain 79";
+  BackgroundHapsim first("serve " + kScene + net + " --duration 120",
+                         hapsim::test::temp_path("serve-first.log"));
+  ASSERT_TRUE(first.wait_for("dds ", 60s)) << first.output();
+  BackgroundHapsim device("device --duration 120" + net + " --json " + device_json.string(),
+                          hapsim::test::temp_path("device-second-serve.log"));
+  ASSERT_TRUE(device.wait_for("host answering", 60s)) << device.output();
+  BackgroundHapsim second("serve " + std::string(HAPSIM_SOURCE_DIR) + "/scenes/csg_block.json" +
+                              net + " --duration 120",
+                          hapsim::test::temp_path("serve-second.log"));
+  ASSERT_TRUE(device.wait_for("another host on the session", 60s)) << device.output();
+  // Both serves publish for a while (the second, another scene, runs its own script: it refuses
+  // the device's states): its models keep arriving at the device and keep being refused.
+  ASSERT_TRUE(second.wait_for("dds ", 60s)) << second.output();
+  std::this_thread::sleep_for(1s);
+  device.signal(SIGTERM);
+  EXPECT_EQ(device.wait(), 143) << device.output();
+  second.signal(SIGTERM);
+  first.signal(SIGTERM);
+  EXPECT_EQ(second.wait(), 143) << second.output();
+  EXPECT_EQ(first.wait(), 143) << first.output();
+
+  const nlohmann::json d = read_json(device_json);
+  EXPECT_EQ(d["other_simulation_hosts"].get<int>(), 1) << d.dump(2);
+  EXPECT_GT(d["models"]["other host"].get<int>(), 10) << d.dump(2);
+  EXPECT_EQ(d["simulation_joins"].get<int>(), 1);  // never went over to the second
+  EXPECT_EQ(d["silences"].size(), 0u);             // the first kept answering throughout
+  EXPECT_EQ(device.output().find("host restarted"), std::string::npos) << device.output();
+}
+
 }  // namespace
 }  // namespace hapsim::net

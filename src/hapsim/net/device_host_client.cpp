@@ -109,14 +109,15 @@ void DeviceHostClient::apply_scene() noexcept {
     p.reset();
   }
   raw_models_ = {};
+  followed_writer_ = 0;  // whoever serves the new scene
   scene_changes_.fetch_add(1, std::memory_order_relaxed);
 }
 
 // haptic path
 void DeviceHostClient::take_models(double now_s, std::int64_t now_ns) noexcept {
   if (!link_) {
-    models_in_.take([&](const hapsim_msg_LocalModel& m, const dds_sample_info_t&) {
-      admit_model(m, now_s, now_ns);
+    models_in_.take([&](const hapsim_msg_LocalModel& m, const dds_sample_info_t& info) {
+      admit_model(m, now_s, now_ns, info.publication_handle);
     });
     return;
   }
@@ -126,18 +127,32 @@ void DeviceHostClient::take_models(double now_s, std::int64_t now_ns) noexcept {
     link_lost_.fetch_add(link_->send(m, link_s) ? 0 : 1, std::memory_order_relaxed);
   });
   const std::size_t delivered = link_->deliver(
-      link_s, [&](const hapsim_msg_LocalModel& m) { admit_model(m, now_s, now_ns); });
+      link_s, [&](const hapsim_msg_LocalModel& m) { admit_model(m, now_s, now_ns, 0); });
   link_delivered_.fetch_add(delivered, std::memory_order_relaxed);
 }
 
 // haptic path
 void DeviceHostClient::admit_model(const hapsim_msg_LocalModel& m, double now_s,
-                                   std::int64_t now_ns) noexcept {
+                                   std::int64_t now_ns, dds_instance_handle_t writer) noexcept {
+  // The followed host answers until it has been silent as long as a model takes to fade out.
+  const LocalModelRenderOptions& render = options_.render;
+  const auto silent_ns =
+      static_cast<std::int64_t>((render.stale_after_s + render.fade_time_s) * 1e9);
+  if (writer != 0 && followed_writer_ != 0 && writer != followed_writer_ &&
+      now_ns - followed_seen_ns_ < silent_ns) {
+    verdicts_[static_cast<std::size_t>(SampleVerdict::kOtherHost)].fetch_add(
+        1, std::memory_order_relaxed);
+    return;
+  }
   LocalContactModel model;
   const SampleVerdict verdict = gate_.admit(m, sequence_, model);
   verdicts_[static_cast<std::size_t>(verdict)].fetch_add(1, std::memory_order_relaxed);
   if (verdict != SampleVerdict::kAccepted) {
     return;
+  }
+  if (writer != 0) {
+    followed_writer_ = writer;
+    followed_seen_ns_ = now_ns;
   }
   if (model.device_sequence == 0) {
     models_not_ours_.fetch_add(1, std::memory_order_relaxed);

@@ -120,7 +120,9 @@ class DeviceHostClient final : public HapticClient {
 
   void apply_scene() noexcept;
   void take_models(double now_s, std::int64_t now_ns) noexcept;
-  void admit_model(const hapsim_msg_LocalModel& m, double now_s, std::int64_t now_ns) noexcept;
+  /// `writer`: the DDS writer the model came from (0: not known, as through the link shim).
+  void admit_model(const hapsim_msg_LocalModel& m, double now_s, std::int64_t now_ns,
+                   dds_instance_handle_t writer) noexcept;
   [[nodiscard]] Vec3 tool_force(std::size_t tool, const Vec3& p_device_m, double now_s) noexcept;
 
   DeviceHostOptions options_;
@@ -152,6 +154,11 @@ class DeviceHostClient final : public HapticClient {
   std::array<std::int64_t, kHistory> state_sent_ns_{};
   std::array<bool, kHistory> answered_{};
   std::uint64_t sequence_ = 0;
+  /// The simulation host followed: the writer of the first model accepted for the current scene,
+  /// until it is silent for the renderer's fade (0: none yet). Another writer's models meanwhile
+  /// are refused (kOtherHost): a second serve on the session cannot take the device over.
+  dds_instance_handle_t followed_writer_ = 0;
+  std::int64_t followed_seen_ns_ = 0;
   Vec3 p_previous_m_ = Vec3::Zero();
   Vec3 v_m_per_s_ = Vec3::Zero();
   DeviceCommand command_;

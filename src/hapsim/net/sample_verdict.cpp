@@ -18,6 +18,8 @@ const char* verdict_name(SampleVerdict verdict) noexcept {
       return "out of order";
     case SampleVerdict::kStale:
       return "stale";
+    case SampleVerdict::kOtherHost:
+      return "other host";
   }
   return "?";
 }

@@ -17,8 +17,11 @@ enum class SampleVerdict : std::uint8_t {
   kOtherDevice,
   kOutOfOrder,  ///< not newer than the newest accepted for its key (late, duplicated, reordered)
   kStale,       ///< too old by the receiver's own count (never by another host's clock)
+  /// From a host other than the one the receiver follows (a second `hapsim serve` on the
+  /// session while the first still answers).
+  kOtherHost,
 };
-inline constexpr std::size_t kSampleVerdicts = 7;
+inline constexpr std::size_t kSampleVerdicts = 8;
 
 [[nodiscard]] const char* verdict_name(SampleVerdict verdict) noexcept;
 
