@@ -66,6 +66,10 @@ struct DeviceArgs {
 
 // A simulation host with no model for this long is silent (its models come every millisecond).
 constexpr std::int64_t kSilentAfter_ns = 200'000'000;
+// Another simulation host is followed only after the one followed has been silent this long: a
+// restarted serve takes seconds to load anyway, and a loaded machine can starve the DDS receive
+// thread for a few hundred ms (seen: 200 ms with both cores busy) without the host being gone.
+constexpr std::int64_t kOtherHostAfter_ns = 1'000'000'000;
 
 // "--finger-map 0:2,1:3": the scene's finger 0 drives the device's finger 2, and so on; fingers
 // not named keep their number.
@@ -194,6 +198,7 @@ struct Silence {
   double since_s = 0.0;         ///< host clock, from the device's start
   double force_before_n = 0.0;  ///< rendered with the last model
   double zero_after_ms = 0.0;
+  std::uint64_t zero_after_cycles = 0;  ///< the same in the device loop's cycles
 };
 
 void run_device(const DeviceArgs& args, JsonOutput& json_out) {
@@ -314,7 +319,7 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     const net::DeviceHostStatus s = client.status();
     const std::int64_t now_ns = monotonic_ns();
     const bool alive = s.last_model_ns != 0 && now_ns - s.last_model_ns < kSilentAfter_ns;
-    if (other && !alive) {
+    if (other && (s.last_model_ns == 0 || now_ns - s.last_model_ns >= kOtherHostAfter_ns)) {
       serve_id = other->serve_id;
       std::printf("simulation   host restarted: %s (hash %016" PRIx64 ")%s\n",
                   other->scene_file.c_str(), other->scene_hash,
@@ -337,7 +342,7 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
       std::fflush(stdout);
       pending_silence.reset();
     } else if (!alive && sim_alive) {
-      pending_silence = Silence{host_s(s.last_model_ns), s.force_at_last_model_n, 0.0};
+      pending_silence = Silence{host_s(s.last_model_ns), s.force_at_last_model_n, 0.0, 0};
     }
     sim_alive = alive;
     if (!std::isnan(args.say_force_above_n)) {
@@ -353,6 +358,8 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
       // The force reached zero: how long after the last model arrived.
       pending_silence->zero_after_ms =
           std::max(0.0, static_cast<double>(s.last_force_ns - s.last_model_ns) * 1e-6);
+      pending_silence->zero_after_cycles =
+          s.last_force_cycle > s.last_model_cycle ? s.last_force_cycle - s.last_model_cycle : 0;
       std::printf(
           "simulation   host silent since %.3f s: force %.3f N went to zero %.0f ms after "
           "its last model; the device loop keeps running and waits for it\n",
@@ -411,7 +418,8 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     for (const Silence& silence : silences) {
       j["silences"].push_back({{"since_s", silence.since_s},
                                {"force_before_n", silence.force_before_n},
-                               {"force_zero_after_ms", silence.zero_after_ms}});
+                               {"force_zero_after_ms", silence.zero_after_ms},
+                               {"force_zero_after_cycles", silence.zero_after_cycles}});
     }
     if (*stop_signal_name() != '\0') {
       j["stopped_by"] = stop_signal_name();

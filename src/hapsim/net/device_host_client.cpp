@@ -174,6 +174,7 @@ void DeviceHostClient::admit_model(const hapsim_msg_LocalModel& m, double now_s,
   }
   models_accepted_.fetch_add(1, std::memory_order_relaxed);
   last_model_ns_.store(now_ns, std::memory_order_relaxed);
+  last_model_cycle_.store(sequence_, std::memory_order_relaxed);
   took_model_ = true;
 }
 
@@ -260,6 +261,7 @@ const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_
   raise_to(peak_force_n_, largest_n);
   if (largest_n > 0.0) {
     last_force_ns_.store(now_ns, std::memory_order_relaxed);
+    last_force_cycle_.store(sequence_, std::memory_order_relaxed);
   }
   cycles_.fetch_add(1, std::memory_order_relaxed);
   return command_;
@@ -294,6 +296,8 @@ DeviceHostStatus DeviceHostClient::status() const noexcept {
   }
   s.last_model_ns = last_model_ns_.load(std::memory_order_relaxed);
   s.last_force_ns = last_force_ns_.load(std::memory_order_relaxed);
+  s.last_model_cycle = last_model_cycle_.load(std::memory_order_relaxed);
+  s.last_force_cycle = last_force_cycle_.load(std::memory_order_relaxed);
   s.force_n = force_n_.load(std::memory_order_relaxed);
   s.force_at_last_model_n = force_at_last_model_n_.load(std::memory_order_relaxed);
   s.peak_force_n = peak_force_n_.load(std::memory_order_relaxed);

@@ -87,6 +87,10 @@ struct DeviceHostStatus {
   double force_n = 0.0;  ///< what this cycle rendered (largest over tools)
   /// What the cycle that took the newest model rendered (largest over tools).
   double force_at_last_model_n = 0.0;
+  /// The same two moments as cycles of the device loop (this client's steps): how long a fade
+  /// took counted in cycles, not in a duration a loaded machine stretches.
+  std::uint64_t last_model_cycle = 0;
+  std::uint64_t last_force_cycle = 0;
   double peak_force_n = 0.0;  ///< over the run
   std::uint64_t rate_limited_cycles = 0;
   std::uint64_t scene_changes = 0;
@@ -172,6 +176,8 @@ class DeviceHostClient final : public HapticClient {
   std::array<std::atomic<std::uint64_t>, kSampleVerdicts> verdicts_{};
   std::atomic<std::int64_t> last_model_ns_{0};
   std::atomic<std::int64_t> last_force_ns_{0};
+  std::atomic<std::uint64_t> last_model_cycle_{0};
+  std::atomic<std::uint64_t> last_force_cycle_{0};
   std::atomic<double> force_n_{0.0};
   std::atomic<double> force_at_last_model_n_{0.0};
   bool took_model_ = false;  ///< this cycle accepted a model (haptic thread)
