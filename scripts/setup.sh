@@ -33,6 +33,9 @@ HAPSIM_PACKAGES=(
   # the network layer (net/): find_package(CycloneDDS) for libddsc and its headers, and idlc
   # (cyclonedds-tools) that idlc_generate runs at build time on the topics' IDL
   cyclonedds-dev cyclonedds-tools
+  # secure sessions (net/security_keys): find_package(OpenSSL) for keys, X.509 and S/MIME
+  # signatures; Cyclone's own security plugins (libddsc0debian) already depend on libssl3
+  libssl-dev
   # tests and benchmarks: find_package(GTest) with GMock, find_package(benchmark), and
   # find_package(ZLIB) for the golden run traces (tests/golden/*.trace.gz)
   libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev

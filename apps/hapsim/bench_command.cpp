@@ -882,6 +882,10 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::Range(1.0, 600.0));
   network->add_option("--scene", network_args->dds_args.scene,
                       "--dds: the scene served (default scenes/knee_procedural.json)");
+  network->add_flag(
+      "--secure", network_args->dds_args.secure_compare,
+      "--dds: only the probe, plain and then with DDS Security (domain and domain+1): "
+      "round trip and a participant's join time, each way");
   network->add_option("--domain", network_args->dds_args.domain, "--dds: DDS domain id")
       ->check(CLI::Range(0, 232));
   network->callback([network_args] { run_network(*network_args); });

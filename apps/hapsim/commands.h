@@ -50,5 +50,7 @@ void add_polygonize_command(CLI::App& app);
 void add_tetrahedralize_command(CLI::App& app);
 void add_sheet_profile_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
+/// `hapsim keys` (keys_command.cpp): a secure session's keys.
+void add_keys_command(CLI::App& app);
 
 }  // namespace hapsim::app

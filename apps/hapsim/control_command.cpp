@@ -230,7 +230,7 @@ void add_control_command(CLI::App& app) {
   cmd->add_option("--dynamic-friction", args->dynamic_friction, "Dynamic friction coefficient");
   cmd->add_option("--timeout", args->timeout_s,
                   "Seconds to wait for the host and for the command to show (default 5)");
-  add_dds_options(cmd, args->dds);
+  add_dds_options(cmd, args->dds, net::SecurityRole::kInstructor);
   cmd->callback([args] {
     (void)net::session_partition(args->dds.session);  // a bad name is one line before anything runs
     control(*args);

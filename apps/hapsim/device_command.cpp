@@ -476,7 +476,7 @@ void add_device_command(CLI::App& app) {
                   "(for an operator or a script watching the device host)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--json", args->json_path, "Write the summary as JSON");
-  add_dds_options(cmd, args->dds);
+  add_dds_options(cmd, args->dds, net::SecurityRole::kDevice);
   cmd->callback([args] {
     (void)net::session_partition(args->dds.session);
     run_device(*args);

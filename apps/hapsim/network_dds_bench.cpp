@@ -6,6 +6,8 @@
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/device_state_codec.h"
 #include "hapsim/net/participant.h"
+#include "hapsim/net/security_config.h"
+#include "hapsim/net/security_key_dir.h"
 #include "hapsim/net/served_scene.h"
 #include "hapsim/net/topic_reader.h"
 #include "hapsim/net/topic_writer.h"
@@ -145,22 +147,52 @@ DdsRun run_once(const NetworkDdsArgs& args, int viewers, const std::filesystem::
 // plays the device (the served scene's script at 1 kHz), writes each state and waits on a waitset
 // for the model that answers it, timing write to arrival on its own clock. Serve steps in
 // lockstep with it (its default), so what is left is transport both ways and one step.
-LatencyPercentilesUs probe_round_trip(const NetworkDdsArgs& args,
-                                      const std::filesystem::path& dir) {
-  const std::string session = "bench-dds-probe-" + std::to_string(::getpid());
-  Child serve(
-      {"serve", args.scene, "--wait-for-device", "--duration", std::to_string(args.duration_s),
-       "--session", session, "--domain", std::to_string(args.domain)},
-      dir / "serve-probe.log");
-  net::DdsDomain domain(args.domain, HAPSIM_DEFAULT_DDS_CONFIG);
-  net::Participant participant(args.domain, session);
+// `secure`: serve and this probe with DDS Security (keys made in dir for the probe's session),
+// on domain + 1. `join_ms`: how long a second participant of this process then takes from its
+// creation to the served scene (discovery, with --secure the handshake, and the sample).
+LatencyPercentilesUs probe_round_trip(const NetworkDdsArgs& args, const std::filesystem::path& dir,
+                                      bool secure = false, double* join_ms = nullptr) {
+  const std::string session =
+      std::string(secure ? "bench-dds-secure-" : "bench-dds-probe-") + std::to_string(::getpid());
+  const int domain_id = args.domain + (secure ? 1 : 0);
+  const std::filesystem::path keys = dir / ("keys-" + session);
+  std::vector<std::string> serve_args{"serve",
+                                      args.scene,
+                                      "--wait-for-device",
+                                      "--duration",
+                                      std::to_string(args.duration_s),
+                                      "--session",
+                                      session,
+                                      "--domain",
+                                      std::to_string(domain_id)};
+  net::DdsNetwork network;
+  if (secure) {
+    std::filesystem::remove_all(keys);
+    (void)net::SecurityKeyDir::init(keys, session, {"device"});
+    serve_args.insert(serve_args.end(), {"--secure", keys.string()});
+    network.security = net::cyclone_security_xml(keys, "device", session);
+    network.security_label = "identity device of " + keys.string();
+  }
+  const std::filesystem::path log = dir / (secure ? "serve-secure-probe.log" : "serve-probe.log");
+  Child serve(serve_args, log);
+  net::DdsDomain domain(domain_id, HAPSIM_DEFAULT_DDS_CONFIG, network);
+  net::Participant participant(domain_id, session);
   net::LoanedReader<hapsim_msg_SceneInfo> info_in(participant);
   net::TopicReader<hapsim_msg_LocalModel> models(participant);
   net::TopicWriter<hapsim_msg_DeviceState> states(participant);
   const std::optional<net::SceneInfoSample> info = net::wait_for_scene_info(info_in, 30.0);
   if (!info) {
-    throw CommandError("bench network --dds: serve did not come up (" +
-                       (dir / "serve-probe.log").string() + ")");
+    throw CommandError("bench network --dds: serve did not come up (" + log.string() + ")");
+  }
+  if (join_ms != nullptr) {
+    const auto t0 = std::chrono::steady_clock::now();
+    net::Participant again(domain_id, session);
+    net::LoanedReader<hapsim_msg_SceneInfo> again_in(again);
+    if (!net::wait_for_scene_info(again_in, 30.0)) {
+      throw CommandError("bench network --dds: a second participant never saw the scene");
+    }
+    *join_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   }
   RunSetup setup = net::build_served_scene(*info, DeviceChoice::scene_script());
   const dds_entity_t waitset = dds_create_waitset(participant.participant());
@@ -252,6 +284,28 @@ void run_network_dds(const NetworkDdsArgs& args) {
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("hapsim_bench_dds_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
+  if (args.secure_compare) {
+    nlohmann::json out;
+    for (const bool secure : {false, true}) {
+      std::printf("[dds] serve + this process as a probe device, %s, %.1f s ...\n",
+                  secure ? "DDS Security" : "plain", args.duration_s);
+      std::fflush(stdout);
+      double join_ms = 0.0;
+      const LatencyPercentilesUs p = probe_round_trip(args, dir, secure, &join_ms);
+      std::printf(
+          "%-8s network round trip p50 %.0f us, p99 %.0f us, max %.0f us over %llu "
+          "states; a new participant joined in %.1f ms\n",
+          secure ? "secure" : "plain", p.p50, p.p99, p.max,
+          static_cast<unsigned long long>(p.count), join_ms);
+      out[secure ? "secure" : "plain"] = {
+          {"round_trip_us", {{"p50", p.p50}, {"p99", p.p99}, {"max", p.max}, {"count", p.count}}},
+          {"join_ms", join_ms}};
+    }
+    if (json_out) {
+      json_out.write(out);
+    }
+    return;
+  }
   nlohmann::json rows = nlohmann::json::array();
   for (const int viewers : {0, args.viewers}) {
     std::printf("[dds] serve + device%s, %.1f s of %s ...\n",

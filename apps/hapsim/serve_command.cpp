@@ -32,8 +32,10 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
@@ -68,6 +70,7 @@ struct ServeArgs {
   double lockstep_us = 800.0;
   std::string link_shim;
   std::string json_path;
+  bool insecure = false;  // plain DDS on a network interface, said out loud
 };
 
 // Longest a served run may be asked to last; "until stopped" is this long.
@@ -280,6 +283,15 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
               args.scene.c_str(), tools, hash, args.rate_hz);
   std::printf("dds          domain %d, session '%s' (partition %s), config %s\n", args.dds.domain,
               args.dds.session.c_str(), participant.partition().c_str(), domain.config().c_str());
+  if (domain.secure()) {
+    std::printf(
+        "security     SECURE: DDS Security as identity '%s' of %s (authenticated, access "
+        "controlled per role, encrypted)\n",
+        args.dds.identity_name().c_str(), args.dds.secure_dir.c_str());
+  } else {
+    std::printf("security     PLAIN: no --secure, anyone who reaches %s may join the session\n",
+                args.dds.interface.empty() ? "this machine's loopback" : "this network");
+  }
   std::fflush(stdout);
 
   const std::atomic<bool>& stop = install_stop_signals();
@@ -352,6 +364,7 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
         session_summary_json(setup.scene, world, summary, "device host or " + setup.device_name);
     j["serve"] = {{"session", args.dds.session},
                   {"domain", args.dds.domain},
+                  {"secure", domain.secure()},
                   {"scene_hash", hash},
                   {"models_published", publisher.published()},
                   {"views_published", monitor.views_published()},
@@ -415,9 +428,27 @@ void add_serve_command(CLI::App& app) {
                   "HOST:PORT every cycle, for an old force host");
   cmd->add_option("--json", args->json_path,
                   "Write the summary as JSON (the keys of hapsim run --json, plus 'serve')");
-  add_dds_options(cmd, args->dds);
+  add_dds_options(cmd, args->dds, net::SecurityRole::kServe);
+  cmd->add_flag("--insecure", args->insecure,
+                "Serve plain DDS on a network interface other than lo (refused without it: use "
+                "--secure DIR)");
   cmd->callback([args] {
     (void)net::session_partition(args->dds.session);  // a bad name is one line before anything runs
+    // Plain DDS off this machine only when said (an interface's bad name is the domain's line).
+    const std::string& itf = args->dds.interface;
+    const bool named = std::all_of(itf.begin(), itf.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '.' || c == ':' || c == '-' ||
+             c == '_';
+    });
+    if (!args->dds.secure() && !itf.empty() && named && itf != "lo" && !args->insecure) {
+      throw CommandError("--interface " + itf +
+                         ": serving plain DDS off this machine needs --insecure (or --secure DIR: "
+                         "docs/security.md)");
+    }
+    if (args->dds.secure() && args->insecure) {
+      throw CommandError("--insecure: --secure " + args->dds.secure_dir +
+                         " is given too (choose one; HAPSIM_SECURE_DIR counts as --secure)");
+    }
     serve(*args);
   });
 }

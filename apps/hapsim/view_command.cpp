@@ -58,6 +58,11 @@ void view(const ViewArgs& args) {
   o.config.domain = args.dds.domain;
   o.config.interface = args.dds.interface;
   o.config.peers = args.dds.peers;
+  if (args.connect && args.dds.secure()) {
+    const net::DdsNetwork network = args.dds.network();  // checked here: one line, exit 2
+    o.config.security = network.security;
+    o.config.security_label = network.security_label;
+  }
   o.config.scene = args.scene;
   o.config.data_dir = args.data_dir;
   o.config.device = args.device;
@@ -143,7 +148,7 @@ void add_view_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   cmd->add_flag("--connect", args->connect,
                 "Draw the world a simulation host serves (hapsim serve) instead of running one");
-  add_dds_options(cmd, args->dds);
+  add_dds_options(cmd, args->dds, net::SecurityRole::kViewer);
   cmd->add_option("--data", args->data_dir, "Real-data folder for scenes that use one");
   cmd->add_option("--device", args->device,
                   "mouse (the viewer's probe), sim (the scene's script), sim:FILE (a trajectory "

@@ -179,7 +179,7 @@ void add_watch_command(CLI::App& app) {
       "watch",
       "A viewer of a served world with no window: report what the simulation host serves "
       "(hapsim serve), and draw it offscreen with --snapshot");
-  add_dds_options(cmd, args->dds);
+  add_dds_options(cmd, args->dds, net::SecurityRole::kViewer);
   cmd->add_option("--data", args->data_dir, "The scene's data folder (default: the host's)");
   cmd->add_option("--duration", args->duration_s, "Seconds to watch (default: until stopped)")
       ->check(positive_seconds());

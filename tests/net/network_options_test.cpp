@@ -1,7 +1,7 @@
 // The distributed commands' network options: loopback unless --interface names another; a name
-// that is not one, a --peer without an interface, and a choice made both in CYCLONEDDS_URI and on
-// the command line are each one line and exit 2, before anything is sent (serve and device;
-// view --connect shares the options and the domain code).
+// that is not one and a --peer without an interface are each one line and exit 2, before anything
+// is sent (serve and device; view --connect shares the options and the domain code); an interface
+// named while CYCLONEDDS_URI is set is merged into the user's config.
 #include "apps/hapsim_process.h"
 
 #include <gtest/gtest.h>
@@ -35,10 +35,34 @@ TEST(NetworkOptions, BadChoicesAreOneLineAndExitTwo) {
     EXPECT_NE(bad_shim.output.find("--link-shim: unknown key 'latency'"), std::string::npos)
         << bad_shim.output;
   }
-  // ctest sets CYCLONEDDS_URI: a second choice on the command line is refused, not merged.
-  const auto both = hapsim::test::run_hapsim("serve " + kScene + " --interface lo --duration 0.1");
+}
+
+TEST(NetworkOptions, AnInterfaceIsMergedWithTheUsersConfig) {
+  // The user's own config (no interface of its own) with --interface and --peer added to it
+  // (issue 32; they used to be refused together).
+  const auto user = hapsim::test::write_file(
+      "user-cyclonedds.xml",
+      "<CycloneDDS><Domain id=\"any\"><General><AllowMulticast>false</AllowMulticast></General>"
+      "<SharedMemory><Enable>false</Enable></SharedMemory></Domain></CycloneDDS>");
+  const auto both = hapsim::test::run_hapsim_env(
+      "env CYCLONEDDS_URI=file://" + user.string(),
+      "serve " + kScene + " --interface lo --peer 127.0.0.2 --duration 0.2 --domain 82");
+  EXPECT_EQ(both.exit_code, 0) << both.output;
+  EXPECT_NE(both.output.find("user-cyclonedds.xml on interface lo, 1 peer(s)"), std::string::npos)
+      << both.output;
+}
+
+TEST(NetworkOptions, PlainServeOffThisMachineNeedsInsecure) {
+  const auto refused = run_without_uri("serve " + kScene + " --interface eth9 --duration 0.1");
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("--interface eth9: serving plain DDS off this machine needs "
+                                "--insecure"),
+            std::string::npos)
+      << refused.output;
+  const auto both = run_without_uri("serve " + kScene + " --secure /nonexistent --insecure");
   EXPECT_EQ(both.exit_code, 2) << both.output;
-  EXPECT_NE(both.output.find("CYCLONEDDS_URI is set too"), std::string::npos) << both.output;
+  EXPECT_NE(both.output.find("--insecure: --secure /nonexistent is given too"), std::string::npos)
+      << both.output;
 }
 
 TEST(NetworkOptions, AnInterfaceNamedRunsOnItWithTheShippedConfig) {

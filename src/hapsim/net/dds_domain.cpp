@@ -37,28 +37,10 @@ DdsDomain::DdsDomain(dds_domainid_t domain, const std::filesystem::path& default
                      const DdsNetwork& network) {
   const char* uri = std::getenv("CYCLONEDDS_URI");
   const bool user_config = uri != nullptr && *uri != '\0';
-  if (!network.interface.empty() && user_config) {
-    throw Error("--interface", "CYCLONEDDS_URI is set too: choose the network in one place");
-  }
   if (network.interface.empty() && !network.peers.empty()) {
     throw Error("--peer", "give --interface too (the peers are reached through it)");
   }
-  if (user_config) {
-    config_ = std::string("CYCLONEDDS_URI=") + uri;
-    return;
-  }
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(default_config, ec)) {
-    throw Error(default_config.string(), "no such Cyclone DDS config (set CYCLONEDDS_URI)");
-  }
-  if (network.interface.empty()) {
-    config_ = default_config.string();
-    const std::string file_uri = "file://" + std::filesystem::absolute(default_config).string();
-    domain_ = DdsEntity(
-        check_dds(dds_create_domain(domain, file_uri.c_str()), "creating domain from " + config_));
-    return;
-  }
-  if (!plain(network.interface)) {
+  if (!network.interface.empty() && !plain(network.interface)) {
     throw Error("--interface",
                 "'" + network.interface + "' is not an interface name (letters, digits, . : - _)");
   }
@@ -69,15 +51,50 @@ DdsDomain::DdsDomain(dds_domainid_t domain, const std::filesystem::path& default
     }
     peers += "<Peer address=\"" + peer + "\"/>";
   }
-  std::ifstream in(default_config);
-  std::string xml{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  replace_once(xml, "<NetworkInterface name=\"lo\"",
-               "<NetworkInterface name=\"" + network.interface + "\"", default_config);
-  replace_once(xml, "<Peer address=\"127.0.0.1\"/>", peers, default_config);
-  config_ = default_config.string() + " on interface " + network.interface +
-            (network.peers.empty() ? "" : ", " + std::to_string(network.peers.size()) + " peer(s)");
-  domain_ = DdsEntity(check_dds(dds_create_domain(domain, xml.c_str()),
-                                "creating domain on interface " + network.interface));
+  const std::string on_interface =
+      network.interface.empty()
+          ? std::string()
+          : " on interface " + network.interface +
+                (network.peers.empty() ? ""
+                                       : ", " + std::to_string(network.peers.size()) + " peer(s)");
+  secure_ = !network.security.empty();
+  const std::string secured = secure_ ? ", DDS Security (" + network.security_label + ")" : "";
+  // Cyclone reads a comma-separated list of files and XML fragments, later ones adding to and
+  // overriding earlier ones: the user's config or ours first, then the network, then security.
+  std::string sources;
+  if (user_config) {
+    config_ = std::string("CYCLONEDDS_URI=") + uri + on_interface + secured;
+    if (network.interface.empty() && !secure_) {
+      return;  // Cyclone reads CYCLONEDDS_URI itself when the first participant joins
+    }
+    sources = uri;
+    if (!network.interface.empty()) {
+      sources += ",<CycloneDDS><Domain id=\"any\"><General><Interfaces><NetworkInterface name=\"" +
+                 network.interface + "\"/></Interfaces></General><Discovery><Peers>" + peers +
+                 "</Peers></Discovery></Domain></CycloneDDS>";
+    }
+  } else {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(default_config, ec)) {
+      throw Error(default_config.string(), "no such Cyclone DDS config (set CYCLONEDDS_URI)");
+    }
+    config_ = default_config.string() + on_interface + secured;
+    if (network.interface.empty()) {
+      sources = "file://" + std::filesystem::absolute(default_config).string();
+    } else {
+      std::ifstream in(default_config);
+      std::string xml{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+      replace_once(xml, "<NetworkInterface name=\"lo\"",
+                   "<NetworkInterface name=\"" + network.interface + "\"", default_config);
+      replace_once(xml, "<Peer address=\"127.0.0.1\"/>", peers, default_config);
+      sources = xml;
+    }
+  }
+  if (secure_) {
+    sources += "," + network.security;
+  }
+  domain_ = DdsEntity(
+      check_dds(dds_create_domain(domain, sources.c_str()), "creating domain from " + config_));
 }
 
 }  // namespace hapsim::net

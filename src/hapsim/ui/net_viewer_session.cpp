@@ -36,7 +36,8 @@ class NetViewerSession final : public ViewerSession {
  public:
   explicit NetViewerSession(const ViewerConfig& config)
       : session_(config.session),
-        domain_(config.domain, HAPSIM_DEFAULT_DDS_CONFIG, {config.interface, config.peers}),
+        domain_(config.domain, HAPSIM_DEFAULT_DDS_CONFIG,
+                {config.interface, config.peers, config.security, config.security_label}),
         participant_(config.domain, config.session),
         info_in_(participant_),
         views_in_(participant_) {
@@ -69,7 +70,13 @@ class NetViewerSession final : public ViewerSession {
     o.force_full_scale_n = readout_.bar_full_scale_n;
     view_->set_options(o);
     view_->update(snapshot_);
-    commands_.emplace(participant_, info_);
+    try {
+      commands_.emplace(participant_, info_);
+    } catch (const Error&) {
+      // A secure session's viewer identity may not publish commands (its permissions): the
+      // buttons then do nothing; an instructor's identity sends them.
+      commands_.reset();
+    }
     device_name_ = "simulation host '" + session_ + "'";
     title_ =
         std::filesystem::path(info_.scene_file).filename().string() + " — connected to " + session_;
@@ -82,7 +89,8 @@ class NetViewerSession final : public ViewerSession {
       restarted_other_scene_ = info->scene_hash != info_.scene_hash;
       info_.serve_id = info->serve_id;
       if (!restarted_other_scene_) {
-        commands_->retarget(*info);  // Pause and Reset go to the host that runs now
+        if (commands_)
+          commands_->retarget(*info);  // Pause and Reset go to the host that runs now
       }
     }
     bool fresh = false;
@@ -160,12 +168,12 @@ class NetViewerSession final : public ViewerSession {
     }
     net::SessionCommand c;
     c.kind = paused ? net::SessionCommandKind::kPause : net::SessionCommandKind::kResume;
-    commands_sent_ += commands_->send(c) ? 1 : 0;
+    commands_sent_ += commands_ && commands_->send(c) ? 1 : 0;
   }
   void reset() override {
     net::SessionCommand c;
     c.kind = net::SessionCommandKind::kReset;
-    commands_sent_ += commands_->send(c) ? 1 : 0;
+    commands_sent_ += commands_ && commands_->send(c) ? 1 : 0;
   }
   void set_knee_overlays(bool influence_spheres, bool contact_vertices) override {
     WorldSceneOptions o = view_->options();

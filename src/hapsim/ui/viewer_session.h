@@ -39,6 +39,10 @@ struct ViewerConfig {
   /// Not loopback: the interface and the unicast peers (net/dds_domain.h).
   std::string interface;
   std::vector<std::string> peers;
+  /// A secure session (`--secure DIR`): the checked Cyclone <Security> fragment and what it is
+  /// (net/security_config.h); empty: plain DDS.
+  std::string security;
+  std::string security_label;
   double connect_timeout_s = 20.0;
 
   bool operator==(const ViewerConfig&) const = default;
