@@ -87,6 +87,27 @@ TEST(StopSignalProcess, SigintStopsWatchDeviceAndServeWithTheirSummaryAndJson) {
   EXPECT_GT(s["serve"]["device_host_cycles"].get<int>(), 0);
 }
 
+// A paused serve steps no cycle, so it makes no cycle record; SIGINT was looked for only when a
+// record came, and a paused serve kept running after Ctrl-C. It stops, with its JSON, exit 130.
+TEST(StopSignalProcess, SigintStopsAPausedServe) {
+  ASSERT_TRUE(test::on_loopback_config());
+  const std::string net = " --session stop-paused --domain 82";
+  const auto serve_json = hapsim::test::temp_path("stop-paused-serve.json");
+  BackgroundHapsim serve("serve " + kScene + " --duration 600 --json " + serve_json.string() + net,
+                         hapsim::test::temp_path("stop-paused-serve.log"));
+  ASSERT_TRUE(serve.wait_for("dds ", 60s)) << serve.output();
+  // It returns once a view state shows the world paused.
+  const hapsim::test::RunResult pause =
+      hapsim::test::run_hapsim("control pause" + net + " --timeout 60");
+  ASSERT_EQ(pause.exit_code, 0) << pause.output << serve.output();
+  serve.signal(SIGINT);
+  ASSERT_TRUE(serve.wait_for("published    ", 60s)) << "a paused serve ignored SIGINT\n"
+                                                    << serve.output();
+  EXPECT_EQ(serve.wait(), 130) << serve.output();
+  const nlohmann::json j = read_json(serve_json);
+  EXPECT_EQ(j["stopped_by"], "SIGINT");
+}
+
 TEST(StopSignalProcess, SigtermBeforeAHostJoinedStillWritesTheJson) {
   ASSERT_TRUE(test::on_loopback_config());
   const auto device_json = hapsim::test::temp_path("stop-early-device.json");

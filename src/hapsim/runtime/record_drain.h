@@ -6,15 +6,23 @@
 #include "hapsim/core/spsc_ring.h"
 #include "hapsim/runtime/haptic_loop.h"
 
+#include <atomic>
 #include <chrono>
 #include <thread>
 
 namespace hapsim {
 
+/// `stop` (may be null), once set, asks the loop to stop at the next poll: checked every poll,
+/// not per record, since a paused world steps no cycle and so makes no record (a paused serve
+/// once ignored SIGINT).
 template <class Record, class Consume>
-void drain_until_stopped(const HapticLoop& loop, SpscRing<Record>& ring, Consume&& consume,
+void drain_until_stopped(HapticLoop& loop, SpscRing<Record>& ring, Consume&& consume,
+                         const std::atomic<bool>* stop = nullptr,
                          std::chrono::milliseconds poll = std::chrono::milliseconds(5)) {
   for (;;) {
+    if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
+      loop.request_stop();
+    }
     // Read before draining: a record pushed before the loop stopped is drained below.
     const bool running = loop.running();
     while (const Record* r = ring.front()) {

@@ -464,19 +464,19 @@ SessionSummary run_realtime(World& world, Device& device, const SessionOptions& 
   std::size_t accounted = 0;
   const auto wall_start = std::chrono::steady_clock::now();
   loop.start();
-  drain_until_stopped(loop, records, [&](const CycleRecord& r) {
-    if (options.stop != nullptr && options.stop->load(std::memory_order_relaxed)) {
-      loop.request_stop();
-    }
-    accountant.account(r);
-    if (options.on_record) {
-      options.on_record(r);
-    }
-    if (++accounted % progress_every == 0) {
-      report_progress(options.progress, "run (real time)",
-                      static_cast<double>(accounted) / static_cast<double>(steps));
-    }
-  });
+  drain_until_stopped(
+      loop, records,
+      [&](const CycleRecord& r) {
+        accountant.account(r);
+        if (options.on_record) {
+          options.on_record(r);
+        }
+        if (++accounted % progress_every == 0) {
+          report_progress(options.progress, "run (real time)",
+                          static_cast<double>(accounted) / static_cast<double>(steps));
+        }
+      },
+      options.stop);
   loop.wait();
   hand_back.reset();
   const double wall_s =
