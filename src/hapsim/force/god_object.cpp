@@ -227,72 +227,61 @@ void GodObject::settle_onto_nearest(const Vec3& device_p_world,
 }
 
 // haptic path
-bool GodObject::sticks(const Vec3& previous_proxy_world, const Vec3& device_p_world,
-                       std::span<const ProxySurface> surfaces) const {
+std::optional<GodObject::FrictionCone> GodObject::friction_cone(
+    const Vec3& previous_proxy_world, const Vec3& device_p_world,
+    std::span<const ProxySurface> surfaces) const {
   if (contact_count_ == 0) {
-    return false;
+    return std::nullopt;
   }
   const ProxyContact& c = contacts_[0];
   const ContactMaterial* material = surfaces[static_cast<std::size_t>(c.surface)].material;
   if (material == nullptr || material->static_friction <= 0.0) {
-    return false;
+    return std::nullopt;
   }
-  const Vec3& n = c.normal_world;
+  const Vec3 n = c.normal_world;
   const double depth = (proxy_world_ - device_p_world).dot(n);
   if (depth <= 0.0) {
-    return false;
+    return std::nullopt;
   }
   const Vec3 offset = device_p_world - previous_proxy_world;
   const Vec3 tangential = offset - offset.dot(n) * n;
-  return tangential.norm() <= material->static_friction * depth;
+  return FrictionCone{n, tangential, tangential.norm(), material->static_friction * depth,
+                      material->dynamic_friction * depth};
+}
+
+// haptic path
+bool GodObject::sticks(const Vec3& previous_proxy_world, const Vec3& device_p_world,
+                       std::span<const ProxySurface> surfaces) const {
+  const auto cone = friction_cone(previous_proxy_world, device_p_world, surfaces);
+  return cone && cone->tangential_m <= cone->static_radius_m;
 }
 
 // haptic path
 double GodObject::slide_budget(const Vec3& previous_proxy_world, const Vec3& device_p_world,
                                std::span<const ProxySurface> surfaces) const {
-  constexpr double kUnbounded = std::numeric_limits<double>::infinity();
-  if (contact_count_ == 0) {
-    return kUnbounded;
+  const auto cone = friction_cone(previous_proxy_world, device_p_world, surfaces);
+  if (!cone) {
+    return std::numeric_limits<double>::infinity();
   }
-  const ProxyContact& c = contacts_[0];
-  const ContactMaterial* material = surfaces[static_cast<std::size_t>(c.surface)].material;
-  if (material == nullptr || material->static_friction <= 0.0) {
-    return kUnbounded;
-  }
-  const Vec3& n = c.normal_world;
-  const double depth = (proxy_world_ - device_p_world).dot(n);
-  if (depth <= 0.0) {
-    return kUnbounded;
-  }
-  const Vec3 offset = device_p_world - previous_proxy_world;
-  const double t_len = (offset - offset.dot(n) * n).norm();
   // apply_friction's goal (it still trims what a curved path overshoots), plus the tolerance so
   // rounding never stops the slide short of it.
-  return std::max(0.0, t_len - material->dynamic_friction * depth) + params_.contact_tolerance_m;
+  return std::max(0.0, cone->tangential_m - cone->dynamic_radius_m) + params_.contact_tolerance_m;
 }
 
 // haptic path
 void GodObject::apply_friction(const Vec3& previous_proxy_world, const Vec3& device_p_world,
                                std::span<const ProxySurface> surfaces, double margin_m) {
-  if (contact_count_ == 0) {
+  // Copied out of the contacts: the scans below overwrite them.
+  const auto cone = friction_cone(previous_proxy_world, device_p_world, surfaces);
+  if (!cone) {
     return;
   }
-  const ProxyContact& c = contacts_[0];
-  const ContactMaterial* material = surfaces[static_cast<std::size_t>(c.surface)].material;
-  if (material == nullptr || material->static_friction <= 0.0) {
-    return;
-  }
-  const Vec3 n = c.normal_world;  // a copy: the scans below overwrite the contacts
-  const double depth = (proxy_world_ - device_p_world).dot(n);
-  if (depth <= 0.0) {
-    return;
-  }
-  const Vec3 offset = device_p_world - previous_proxy_world;
-  const Vec3 tangential = offset - offset.dot(n) * n;
-  const double t_len = tangential.norm();
+  const Vec3& n = cone->normal_world;
+  const Vec3& tangential = cone->tangential_world;
+  const double t_len = cone->tangential_m;
   const Vec3 moved = proxy_world_ - previous_proxy_world;
   const Vec3 moved_t = moved - moved.dot(n) * n;
-  if (t_len <= material->static_friction * depth) {
+  if (t_len <= cone->static_radius_m) {
     proxy_world_ -= moved_t;  // stick: inside the friction cone the proxy keeps its place
   } else {
     // Slip: the proxy trails the device by the dynamic friction cone's radius. Friction only
@@ -300,7 +289,7 @@ void GodObject::apply_friction(const Vec3& previous_proxy_world, const Vec3& dev
     // and far ahead), moving it the rest of the way here would be a jump nobody traced, through
     // whatever lies between (it crossed the patellar tendon's edge and left the proxy 2 mm off
     // every surface, the device 15 mm deep).
-    const Vec3 goal_t = tangential - tangential * (material->dynamic_friction * depth / t_len);
+    const Vec3 goal_t = tangential - tangential * (cone->dynamic_radius_m / t_len);
     const double moved_len = moved_t.norm();
     const double goal_len = goal_t.norm();
     if (goal_len < moved_len) {

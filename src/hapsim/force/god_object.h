@@ -16,6 +16,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 
 namespace hapsim {
@@ -84,6 +85,19 @@ class GodObject {
   double scan(std::span<const ProxySurface> surfaces, double margin_m);
   /// Pushes the proxy out of any surface it penetrates, along that surface's normal.
   double resolve_penetration(std::span<const ProxySurface> surfaces, double margin_m);
+  /// The first contact's friction seen from the proxy's position before this update moved it
+  /// along the surface: its normal, the device's offset in the tangent plane, and the static and
+  /// dynamic cones' radii at the device's depth. None without a contact, friction or depth.
+  struct FrictionCone {
+    Vec3 normal_world;
+    Vec3 tangential_world;
+    double tangential_m;
+    double static_radius_m;
+    double dynamic_radius_m;
+  };
+  [[nodiscard]] std::optional<FrictionCone> friction_cone(
+      const Vec3& previous_proxy_world, const Vec3& device_p_world,
+      std::span<const ProxySurface> surfaces) const;
   /// Whether the device is inside the static friction cone of the first contact, seen from the
   /// proxy's position before this update moved it along the surface.
   [[nodiscard]] bool sticks(const Vec3& previous_proxy_world, const Vec3& device_p_world,
