@@ -113,7 +113,7 @@ def main():
         if finger_force[:, k].max() > 0.0:
             top.plot(t, finger_force[:, k], lw=1.4, label=f"{name} (peak {finger_force[:, k].max():.2f} N)")
     top.set_ylabel("finger actuator force (N)")
-    top.set_title("Glove palpation scripted in Python on the knee (patella and patellar tendon)")
+    top.set_title("Glove palpation scripted in Python on the knee (vastus medialis)")
     top.grid(alpha=0.3)
     top.legend(fontsize=8, loc="center left")
     bottom.plot(t, np.degrees(flex[:, 0]), lw=1.2, label="index MCP flexion")

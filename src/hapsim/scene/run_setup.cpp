@@ -123,7 +123,9 @@ RunSetup make_run_setup(SceneDescription scene, const DeviceChoice& choice,
         device_length_s = sim->duration_end_s();
         warn_if_out_of_reach(scene, *r.world, *sim, device_length_s, trajectory);
         r.script_start = sim->read(0.0);  // also the device's first read again
-        r.device_name = "simulated " + r.profile->name +
+        // The "simulated" profile is not said twice ("simulated simulated").
+        r.device_name = (r.profile->name == "simulated" ? std::string("simulated device")
+                                                        : "simulated " + r.profile->name) +
                         (trajectory                   ? " playing " + trajectory->string()
                          : scene.device.has_palpation ? " (palpation script)"
                                                       : " (scene trajectory)");
