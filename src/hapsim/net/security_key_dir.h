@@ -34,7 +34,8 @@ enum class SecurityRole { kServe, kDevice, kViewer, kInstructor };
 [[nodiscard]] std::string governance_xml();
 
 /// The permissions document of one identity (unsigned text): its role's topics in partition
-/// hapsim.SESSION on domains 0-230 (the most DDS Security's documents name), everything else denied.
+/// hapsim.SESSION on domains 0-230 (the most DDS Security's documents name), everything else
+/// denied.
 [[nodiscard]] std::string permissions_xml(const std::string& subject_rfc2253, SecurityRole role,
                                           std::string_view session);
 
