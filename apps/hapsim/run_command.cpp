@@ -407,11 +407,10 @@ void run(const RunArgs& args) {
   // has been written yet.)
   const std::atomic<bool>& stop = install_stop_signals();
   // The recorder is flushed every 100 ms of the run, off the haptic thread (session.cpp): a
-  // killed run keeps all but its last 100 ms. 8192 frames of buffer: slack for a slow disk.
+  // killed run keeps all but its last 100 ms.
   std::unique_ptr<SessionRecorder> recorder;
   if (!record_path.empty()) {
-    recorder = std::make_unique<SessionRecorder>(record_path, world->content_hash(), 8192,
-                                                 SessionRecorder::Overflow::kDrop, args.scene);
+    recorder = make_session_recorder(record_path, *world, args.scene);
   }
 
   std::unique_ptr<SnapshotSink> snapshots;
@@ -460,13 +459,7 @@ void run(const RunArgs& args) {
   SessionSummary summary = run_session(*world, *device, options);
   const int stopped_by = stop.load() ? stop_signal_number().load() : 0;
   if (recorder) {
-    try {
-      recorder->close();
-    } catch (const Error& e) {  // a full disk: the summary and the JSON are still written
-      if (summary.recording_error.empty()) {
-        summary.recording_error = e.what();
-      }
-    }
+    finish_session_recording(*recorder, summary);
   }
   std::cout << format_session_summary(summary);
   if (stopped_by != 0) {

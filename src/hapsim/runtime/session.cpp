@@ -575,6 +575,23 @@ SessionSummary run_session(World& world, Device& device, const SessionOptions& o
   return summary;
 }
 
+std::unique_ptr<SessionRecorder> make_session_recorder(const std::filesystem::path& path,
+                                                       const World& world,
+                                                       const std::filesystem::path& scene_file) {
+  return std::make_unique<SessionRecorder>(path, world.content_hash(), 8192,
+                                           SessionRecorder::Overflow::kDrop, scene_file);
+}
+
+void finish_session_recording(SessionRecorder& recorder, SessionSummary& summary) {
+  try {
+    recorder.close();
+  } catch (const Error& e) {  // a full disk: the summary and the JSON are still written
+    if (summary.recording_error.empty()) {
+      summary.recording_error = e.what();
+    }
+  }
+}
+
 std::optional<FemSummary> fem_summary(const World& world) {
   const FemCoupling* fem = world.fem();
   if (fem == nullptr) {

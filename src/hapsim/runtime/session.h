@@ -15,7 +15,9 @@
 
 #include <atomic>
 #include <cstddef>
+#include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -255,6 +257,19 @@ struct SessionSummary {
 /// Runs `world` with `device` for options.duration_s. Throws hapsim::Error on bad options.
 [[nodiscard]] SessionSummary run_session(World& world, Device& device,
                                          const SessionOptions& options);
+
+/// The recorder a command's `--record FILE` writes a session through (`hapsim run`, `hapsim
+/// serve`): the header names `world`'s content hash and `scene_file`; 8192 frames of buffer
+/// (slack for a slow disk) whose overflow is dropped and counted, never a blocking write on the
+/// haptic thread; run_session() flushes it every 100 ms of the session, off the haptic thread.
+/// Throws hapsim::Error when the file cannot be created.
+[[nodiscard]] std::unique_ptr<SessionRecorder> make_session_recorder(
+    const std::filesystem::path& path, const World& world, const std::filesystem::path& scene_file);
+
+/// After run_session(): writes the recording's last block and closes it. A write that fails (a
+/// full disk) becomes summary.recording_error, unless the run already set one: the summary says
+/// it in one line ("recording STOPPED early: …") and run_failures() fails the run with it.
+void finish_session_recording(SessionRecorder& recorder, SessionSummary& summary);
 
 /// The real-time figures of a finished loop; `dropped_records`: records its consumer missed.
 [[nodiscard]] RealtimeSummary realtime_summary(const HapticLoopStatus& status,
