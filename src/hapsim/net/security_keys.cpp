@@ -252,6 +252,12 @@ std::string smime_sign(const std::string& text, const KeyPair& signer) {
 
 std::string smime_verify(const std::string& smime, const std::string& ca_pem,
                          const std::string& where) {
+  std::string signer;
+  return smime_verify(smime, ca_pem, where, signer);
+}
+
+std::string smime_verify(const std::string& smime, const std::string& ca_pem,
+                         const std::string& where, std::string& signer_cert_pem) {
   Bio in = memory_bio(smime);
   BIO* content_raw = nullptr;
   Pkcs7 p7(SMIME_read_PKCS7(in.get(), &content_raw));
@@ -265,7 +271,31 @@ std::string smime_verify(const std::string& smime, const std::string& ca_pem,
   if (PKCS7_verify(p7.get(), nullptr, store.get(), content.get(), out.get(), PKCS7_TEXT) != 1) {
     throw Error(where, ssl_reason("signature does not verify against the session's CA"));
   }
+  // The signer PKCS7_verify has just checked (the one certificate PKCS7_sign put in).
+  STACK_OF(X509)* signers = PKCS7_get0_signers(p7.get(), nullptr, 0);
+  if (signers == nullptr || sk_X509_num(signers) != 1) {
+    sk_X509_free(signers);
+    throw Error(where, ssl_reason("not signed by exactly one certificate"));
+  }
+  signer_cert_pem = cert_text(sk_X509_value(signers, 0));
+  sk_X509_free(signers);
   return bio_text(out.get());
+}
+
+Subject certificate_subject(const std::string& cert_pem) {
+  Cert cert = read_cert(cert_pem);
+  const auto field = [&](int nid) {
+    char text[256] = {};
+    X509_NAME_get_text_by_NID(X509_get_subject_name(cert.get()), nid, text, sizeof text);
+    return std::string(text);
+  };
+  const std::string org = field(NID_organizationName);
+  const std::string prefix = "hapsim session ";
+  Subject s;
+  s.session = org.rfind(prefix, 0) == 0 ? org.substr(prefix.size()) : std::string();
+  s.role = field(NID_organizationalUnitName);
+  s.name = field(NID_commonName);
+  return s;
 }
 
 std::string make_crl(const KeyPair& ca, const std::vector<std::string>& revoked_serials_hex) {

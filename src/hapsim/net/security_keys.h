@@ -56,6 +56,15 @@ struct Subject {
 [[nodiscard]] std::string smime_verify(const std::string& smime, const std::string& ca_pem,
                                        const std::string& where);
 
+/// As above, and the certificate of the document's signer (PEM) in `signer_cert_pem`, for the
+/// caller's own checks of who signed (a signed recording's signer must be a serve identity).
+[[nodiscard]] std::string smime_verify(const std::string& smime, const std::string& ca_pem,
+                                       const std::string& where, std::string& signer_cert_pem);
+
+/// The certificate's subject: `session` from O ("hapsim session NAME"; empty when O is not of
+/// that form), OU as `role`, CN as `name`.
+[[nodiscard]] Subject certificate_subject(const std::string& cert_pem);
+
 /// A CRL signed by `ca` listing `revoked_serials_hex` (valid 10 years: Cyclone refuses an
 /// expired one).
 [[nodiscard]] std::string make_crl(const KeyPair& ca,
