@@ -4,6 +4,8 @@
 // grasp and collisions), the scorer fed every cycle; with --report, DIR gets assessment.json,
 // forces.csv and picture.png (the end of the session, landmarks marked) and the HTML report of
 // python/hapsim/assessment_report.py (the contract: docs/assessment.md, "Report").
+// With --verify, every recording's signature (FILE.sig, written by a secure serve:
+// net/recording_signature.h) is checked against the session's keys before anything is scored.
 #include "checked_output.h"
 #include "commands.h"
 #include "json_output.h"
@@ -12,6 +14,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/core/printable_text.h"
 #include "hapsim/device/recording.h"
+#include "hapsim/net/recording_signature.h"
 #include "hapsim/render/assessment_markers.h"
 #include "hapsim/render/force_scale.h"
 #include "hapsim/render/snapshot_writer.h"
@@ -25,6 +28,7 @@
 #include <sys/wait.h>
 
 #include <algorithm>
+#include <cinttypes>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -54,6 +58,8 @@ struct AssessArgs {
   std::string report_dir;
   std::string data_dir;
   bool summary = false;
+  bool verify = false;
+  std::string secure_dir;  // --secure DIR or HAPSIM_SECURE_DIR: the keys --verify checks against
 };
 
 // Whether `path` (canonical) lies in `root` or a folder below it.
@@ -280,8 +286,49 @@ fs::path make_folder(const fs::path& dir) {
   return dir;
 }
 
+// --verify: each recording's signature, before anything is scored. A refused recording is one
+// line naming it and why; false when any was refused.
+bool verify_signatures(const AssessArgs& args) {
+  if (args.secure_dir.empty()) {
+    throw CommandError(
+        "--verify: give the session's key directory with --secure DIR (or HAPSIM_SECURE_DIR)");
+  }
+  std::error_code ec;
+  if (!fs::is_directory(args.secure_dir, ec)) {
+    throw CommandError("--secure " + args.secure_dir + ": no such key directory");
+  }
+  const net::SecurityKeyDir keys(args.secure_dir);
+  // The directory's own files once, not once per recording.
+  (void)keys.session();
+  (void)net::read_text_file(keys.identity_ca());
+  (void)net::read_text_file(keys.crl());
+  bool all = true;
+  for (const std::string& recording : args.recordings) {
+    try {
+      const net::RecordingStatement s = net::verify_recording_signature(recording, keys);
+      std::printf(
+          "verified     %s: signed by serve identity '%s' of session '%s' at %s; a device "
+          "host drove %" PRIu64 " of its %" PRIu64 " cycles\n",
+          printable_text(recording).c_str(), printable_text(s.identity, 64).c_str(),
+          printable_text(s.session, 64).c_str(), printable_text(s.signed_at, 40).c_str(),
+          s.device_host_cycles, s.cycles);
+    } catch (const Error& e) {
+      std::fflush(stdout);
+      std::fprintf(stderr, "hapsim: refused: %s\n", e.what());
+      all = false;
+    }
+  }
+  std::fflush(stdout);
+  return all;
+}
+
 void assess(const AssessArgs& args) {
   JsonOutput json_out(args.json_path);
+  if (args.verify && !verify_signatures(args)) {
+    json_out.write_failure("a recording's signature did not verify");
+    exit_status() = 2;
+    return;
+  }
   if (args.recordings.size() > 1 && !args.summary) {
     throw CommandError("several recordings: give --summary (and --report DIR) to assess a series");
   }
@@ -349,6 +396,14 @@ void add_assess_command(CLI::App& app) {
   cmd->add_flag("--summary", args->summary,
                 "Several recordings as a series: DIR/session-NN/ each, and a learning curve");
   cmd->add_option("--data", args->data_dir, "Real-data folder for scenes that use one");
+  cmd->add_flag("--verify", args->verify,
+                "Score only recordings signed by a secure serve of the session (FILE.sig, "
+                "hapsim serve --secure DIR --record FILE): refuse, before scoring, an unsigned, "
+                "altered or cut recording or one signed by a revoked or non-serve identity");
+  cmd->add_option("--secure", args->secure_dir,
+                  "With --verify: the session's key directory (hapsim keys init; its "
+                  "identity_ca.pem, crl.pem and session)")
+      ->envname("HAPSIM_SECURE_DIR");
   cmd->callback([args] { assess(*args); });
 }
 

@@ -9,6 +9,9 @@
 // At the end it prints the same summary as `hapsim run` (contacts and peak force per segment,
 // forces per tool, safety) plus what went over the network, and --json writes it with the same
 // keys as `hapsim run --json`, so a served run and a one-process run compare key by key.
+// --record FILE records every stepped cycle as `hapsim run --record` does (the same recorder,
+// flushed every 100 ms off the haptic thread); with --secure the finished recording is signed
+// (FILE.sig, net/recording_signature.h) so `hapsim assess --verify` can tell it is this serve's.
 #include "commands.h"
 #include "dds_options.h"
 #include "json_output.h"
@@ -20,6 +23,7 @@
 #include "hapsim/net/link_shim_spec.h"
 #include "hapsim/net/model_publisher.h"
 #include "hapsim/net/participant.h"
+#include "hapsim/net/recording_signature.h"
 #include "hapsim/net/remote_device.h"
 #include "hapsim/net/scene_hash.h"
 #include "hapsim/net/scene_info.h"
@@ -70,6 +74,7 @@ struct ServeArgs {
   double lockstep_us = 800.0;
   std::string link_shim;
   std::string json_path;
+  std::string record_path;
   bool insecure = false;  // plain DDS on a network interface, said out loud
 };
 
@@ -213,6 +218,25 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   if (world.rig() != nullptr) {
     throw CommandError(args.scene + ": a teleoperation rig is not served over the network yet");
   }
+  // A recording replays at the scene's run.dt_s (hapsim run --replay): serve must step at it.
+  if (!args.record_path.empty() && std::abs(args.rate_hz * setup.scene.run.dt_s - 1.0) > 1e-9) {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  ": a recording replays at the scene's run.dt_s, %g s: serve it at --rate %g, "
+                  "not %g",
+                  setup.scene.run.dt_s, 1.0 / setup.scene.run.dt_s, args.rate_hz);
+    throw CommandError("--record " + args.record_path + text);
+  }
+  // Opened before anything is served, so a bad path fails first; flushed every 100 ms off the
+  // haptic thread by run_session, as `hapsim run --record` is.
+  std::unique_ptr<SessionRecorder> recorder;
+  if (!args.record_path.empty()) {
+    try {
+      recorder = make_session_recorder(args.record_path, world, args.scene);
+    } catch (const Error& e) {
+      throw CommandError("--record " + args.record_path + ": " + e.detail());
+    }
+  }
   const std::uint64_t hash = net::scene_hash(world.content_hash());
   const std::uint64_t serve_id = net::draw_serve_id();
   const auto device_id = static_cast<std::uint16_t>(args.device_id);
@@ -223,6 +247,12 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   }
 
   net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
+  // A secure serve signs what it records, as its identity: its key is checked now, not after the
+  // session.
+  std::optional<net::RecordingSigner> signer;
+  if (!args.record_path.empty() && args.dds.secure()) {
+    signer.emplace(net::SecurityKeyDir(args.dds.secure_dir), args.dds.identity_name());
+  }
   net::Participant participant(args.dds.domain, args.dds.session);
   net::RemoteDevice remote(participant, device_id, hash, *setup.device);
   double lockstep_s = args.lockstep_us * 1e-6;
@@ -295,27 +325,60 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   std::fflush(stdout);
 
   const std::atomic<bool>& stop = install_stop_signals();
+  // The recording's end (and, secure, its signature), however the session ended: false (with
+  // one line said) when either was not written in full.
+  const auto finish_recording = [&](SessionSummary& summary) {
+    if (!recorder) {
+      return true;
+    }
+    finish_session_recording(*recorder, summary);
+    std::printf("recorded     %s (%zu frames)\n", args.record_path.c_str(),
+                recorder->frames_written());
+    bool ok = summary.recording_error.empty();
+    if (!ok) {
+      std::printf("FAILED: the recording stopped early: %s\n", summary.recording_error.c_str());
+    }
+    if (signer) {
+      try {
+        const net::RecordingStatement signed_as =
+            signer->sign(args.record_path, summary.steps, remote.cycles_driven());
+        std::printf("signed       %s (identity '%s' of session '%s', sha256 %.16s...)\n",
+                    net::recording_signature_path(args.record_path).c_str(),
+                    signed_as.identity.c_str(), signed_as.session.c_str(),
+                    signed_as.sha256_hex.c_str());
+      } catch (const Error& e) {
+        std::printf("FAILED: the recording's signature was not written: %s\n", e.what());
+        ok = false;
+      }
+    }
+    std::fflush(stdout);
+    return ok;
+  };
   if (args.wait_for_device) {
     std::printf("waiting      for a device host (hapsim device --session %s)\n",
                 args.dds.session.c_str());
     std::fflush(stdout);
     if (!remote.wait_for_host(kUntilStopped_s, &stop)) {
       std::printf("stopped      before a device host joined\n");
+      SessionSummary nothing;
+      const bool recorded = finish_recording(nothing);
       json_out.write_failure("stopped by " + std::string(stop_signal_name()) +
                              " before a device host joined");
-      exit_status() = stopped_by_signal_status();
+      exit_status() = recorded ? stopped_by_signal_status() : 2;
       return;
     }
   }
 
   SessionOptions options;
-  options.dt_s = 1.0 / args.rate_hz;
+  // Recorded: exactly the scene's step (checked above to be 1 / --rate), as a replay takes it.
+  options.dt_s = recorder ? setup.scene.run.dt_s : 1.0 / args.rate_hz;
   options.duration_s = std::isnan(args.duration_s) ? kUntilStopped_s : args.duration_s;
   options.realtime = true;
   options.observer = &publisher;
   options.on_snapshots = [&monitor](TripleBuffer<WorldSnapshot>* s) { monitor.set_snapshots(s); };
   options.on_client = [&monitor](WorldHapticClient* c) { monitor.set_client(c); };
   options.stop = &stop;
+  options.recorder = recorder.get();
   monitor.start();
   SessionSummary summary;
   try {
@@ -326,7 +389,11 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   }
   monitor.stop();
 
+  if (recorder) {
+    finish_session_recording(*recorder, summary);  // before the summary, which says a failure
+  }
   std::cout << format_session_summary(summary);
+  const bool recorded = finish_recording(summary);
   const net::VerdictCounts verdicts = remote.verdicts();
   std::printf("published    %" PRIu64 " local models (%" PRIu64 " refused by DDS), %" PRIu64
               " view states\n",
@@ -378,11 +445,22 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
       j["serve"]["commands"][verdict] = commands[v];
     }
     j["serve"]["refused_material_changes"] = monitor.refused_material_changes();
-    j["ok"] = summary.pop_throughs == 0 && summary.max_force_limit_violations == 0;
+    if (recorder) {
+      j["serve"]["recording"] = args.record_path;
+      j["serve"]["recording_frames"] = recorder->frames_written();
+      if (signer) {
+        j["serve"]["recording_signature"] =
+            net::recording_signature_path(args.record_path).string();
+      }
+    }
+    j["ok"] = summary.pop_throughs == 0 && summary.max_force_limit_violations == 0 && recorded;
     if (*stop_signal_name() != '\0') {
       j["stopped_by"] = stop_signal_name();
     }
     json_out.write(j);
+  }
+  if (!recorded) {
+    exit_status() = 2;  // an output was not written, as `hapsim run --record` says it
   }
   exit_status() = with_signal_status(exit_status());
 }
@@ -428,6 +506,10 @@ void add_serve_command(CLI::App& app) {
                   "HOST:PORT every cycle, for an old force host");
   cmd->add_option("--json", args->json_path,
                   "Write the summary as JSON (the keys of hapsim run --json, plus 'serve')");
+  cmd->add_option("--record", args->record_path,
+                  "Record every stepped cycle to FILE (as hapsim run --record; replays with "
+                  "hapsim run --replay, scored by hapsim assess); with --secure also FILE.sig, "
+                  "signed by this serve's identity (hapsim assess --verify)");
   add_dds_options(cmd, args->dds, net::SecurityRole::kServe);
   cmd->add_flag("--insecure", args->insecure,
                 "Serve plain DDS on a network interface other than lo (refused without it: use "
