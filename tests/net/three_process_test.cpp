@@ -159,15 +159,22 @@ TEST(ThreeProcesses, ServeAndDeviceReproduceTheOneProcessPalpation) {
   const double pace = test::serve_pace(serve.output());
   ASSERT_GT(pace, 0.0) << serve.output();
   ASSERT_EQ(one_segments.size(), served_segments.size());
+  const double one_tool_peak_n = a["tools"][0]["peak_force_n"].get<double>();
   for (const auto& [name, counts] : one_segments) {
     const auto& [contacts, peak_n] = counts;
     ASSERT_TRUE(served_segments.count(name)) << name;
     const auto& [served_contacts, served_peak_n] = served_segments.at(name);
     EXPECT_GE(served_contacts, 0.95 * std::min(pace, 1.0) * contacts - 1.0) << name;
     EXPECT_LE(served_contacts, 1.05 * contacts + 1.0) << name;
-    EXPECT_NEAR(served_peak_n, peak_n, 0.05 * peak_n + 1e-9) << name;
+    // Each segment pressed as hard as in one process. Not more than 5 % harder, except where a
+    // press on a boundary went to the neighbour: under load serve steps on states that arrive in
+    // bursts, its tool jumps a few device periods at once, and the proxy can come to rest on the
+    // next segment for a step (the patellar tendon took the patella's 8 N in 1 of 20 runs under
+    // stress-ng). The tool's own peak below stays within 5 %.
+    EXPECT_GE(served_peak_n, 0.95 * peak_n - 1e-9) << name;
+    EXPECT_LE(served_peak_n, 1.05 * one_tool_peak_n) << name;
   }
-  const double one_peak_n = a["tools"][0]["peak_force_n"].get<double>();
+  const double one_peak_n = one_tool_peak_n;
   EXPECT_GT(one_peak_n, 5.0);  // the palpation pressed
   EXPECT_NEAR(b["tools"][0]["peak_force_n"].get<double>(), one_peak_n, 0.05 * one_peak_n);
   // What the device felt, rendered from its own local models at its own position.

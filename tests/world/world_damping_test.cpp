@@ -6,6 +6,7 @@
 // tool's path, not from the world's reported depth.
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/world/world.h"
+#include "hapsim/world/world_stages.h"
 
 #include <gtest/gtest.h>
 
@@ -132,6 +133,46 @@ TEST(WorldDamping, ProxyEntryAtConstantSpeedFeelsKxPlusCv) {
       expect_damped_entry(ContactResponse::kProxy, kPenetrationCapFirst, tolerance_n);
   EXPECT_GT(depth_cap.linear, 100);
   EXPECT_GT(depth_cap.penetration_capped, 50);
+}
+
+// A served world steps on a remote device's states, which after a stall arrive in bursts: here
+// the device's input holds for nine steps, then moves ten periods' motion at once, its own time
+// stamps saying so. The damping feels the device's speed (c·v on the step that moves, nothing
+// while it holds), not ten times it from differencing over one step.
+TEST(WorldDamping, InputsInBurstsFeelTheDevicesSpeedByTheirOwnTimeStamps) {
+  World world(block_world(ContactResponse::kPenalty, kPenetrationCapFirst));
+  constexpr int kBurst = 10;
+  int moving_steps_checked = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const int device_period = (i / kBurst) * kBurst;  // the newest state the device got through
+    const double z = 0.001 - kSpeed * kDt * device_period;
+    if (z < -kMaxPenetration) {
+      break;
+    }
+    DeviceInput in;
+    in.time_s = kDt * device_period;
+    in.p_world = Vec3(0.001, 0.002, z);
+    const Vec3 f = world.step(in, kDt).tools[0].force_world_n;
+    const double depth = -z;
+    if (depth <= 0.0 || i < kBurst) {
+      continue;
+    }
+    const bool moved = i % kBurst == 0;
+    const double expected = kStiffness * depth + (moved ? kDamping * kSpeed : 0.0);
+    EXPECT_NEAR(f.z(), expected, 1e-9) << "step " << i << (moved ? " (moved)" : " (held)");
+    moving_steps_checked += moved ? 1 : 0;
+  }
+  EXPECT_GT(moving_steps_checked, 10);
+}
+
+TEST(WorldDamping, InputMotionTimeIsTheStampsDifferenceOnlyWhenItSaysMore) {
+  EXPECT_EQ(stage::input_motion_time_s(0.010, 0.000, kDt), 0.010);  // ten periods in one step
+  EXPECT_DOUBLE_EQ(stage::input_motion_time_s(0.0105, 0.010, kDt), 0.0005);  // a fast device
+  EXPECT_EQ(stage::input_motion_time_s(0.3 + kDt, 0.3, kDt), kDt);  // the step's clock: its dt
+  EXPECT_EQ(stage::input_motion_time_s(0.0, 0.0, kDt), kDt);        // no stamps (Python)
+  EXPECT_EQ(stage::input_motion_time_s(1.0, 2.0, kDt), kDt);        // a clock gone back
+  EXPECT_EQ(stage::input_motion_time_s(1.0, 0.5, kDt), kDt);        // a gap: a jump
+  EXPECT_EQ(stage::input_motion_time_s(std::nan(""), 0.5, kDt), kDt);
 }
 
 }  // namespace

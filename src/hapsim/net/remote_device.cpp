@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <thread>
 
@@ -95,13 +96,25 @@ DeviceInput RemoteDevice::read(double time_s) noexcept {
   previous_time_s_ = time_s;
   if (driving) {
     input = host_state_.input;
-    input.time_s = time_s;
+    // The input keeps the host's own clock, shifted to read as this loop's time when the host
+    // joined: after a stall (here or there) one step may take several of the host's periods of
+    // motion, and the world differences the tool's velocity over the input's time, not over its
+    // step (stage::input_motion_time_s). Only differences of the host's clock are used.
+    // Anchored afresh when a host joins or its clock went back (a host restarted within the
+    // timeout numbers its time from zero again).
+    if (switched_ || !std::isfinite(host_time_offset_s_) ||
+        host_state_.input.time_s < host_time_last_s_) {
+      host_time_offset_s_ = time_s - host_state_.input.time_s;
+    }
+    host_time_last_s_ = host_state_.input.time_s;
     // A cycle without a new state (late, lost) moves the device on at its reported velocity
     // instead of holding it: held, then caught up, it would jump two cycles at once, and the
     // world's velocity (and damping force) with it. A few cycles at most, then it holds.
     missed_states_ = fresh ? 0 : std::min(missed_states_ + 1, kMaxDeadReckoned);
+    const double reckoned_s = dt_s * missed_states_;
+    input.time_s = host_state_.input.time_s + host_time_offset_s_ + reckoned_s;
     if (missed_states_ > 0 && host_state_.v_world_m_per_s.allFinite()) {
-      input.p_world += host_state_.v_world_m_per_s * (dt_s * missed_states_);
+      input.p_world += host_state_.v_world_m_per_s * reckoned_s;
     }
     cycles_driven_.fetch_add(1, std::memory_order_relaxed);
   }

@@ -15,6 +15,7 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <limits>
 #include <memory>
 
 namespace hapsim::net {
@@ -107,6 +108,9 @@ class RemoteDevice final : public Device {
   static constexpr int kMaxDeadReckoned = 3;
   int missed_states_ = 0;
   double previous_time_s_ = 0.0;
+  /// This loop's time less the host's, when the host joined (its states' time on this clock).
+  double host_time_offset_s_ = std::numeric_limits<double>::quiet_NaN();
+  double host_time_last_s_ = 0.0;  ///< the newest host state's own time
   dds_entity_t waitset_ = 0;
   DeviceStateSample host_state_;
   std::int64_t host_seen_ns_;

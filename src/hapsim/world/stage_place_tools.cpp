@@ -221,6 +221,19 @@ void place_rig(const WorldModel& model, RigState& rig, WorldState& state, const 
 }  // namespace
 
 // haptic path
+double input_motion_time_s(double input_time_s, double input_time_previous_s,
+                           double dt_s) noexcept {
+  const double elapsed_s = input_time_s - input_time_previous_s;
+  // Equal to the step within rounding (a local device read on the loop's clock, a script, a
+  // replay of either): the step's own dt, so those velocities keep their bits.
+  if (!std::isfinite(elapsed_s) || elapsed_s <= 0.0 || std::abs(elapsed_s - dt_s) <= 0.01 * dt_s ||
+      elapsed_s > kMaxInputMotionTime_s) {
+    return dt_s;
+  }
+  return elapsed_s;
+}
+
+// haptic path
 void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& input,
                  double dt_s) noexcept {
   const WorldDescription& d = model.description();
@@ -267,10 +280,13 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
       tool.proxy.reset(p_world);
       tool.proxy_surface_last_step = -1;
     }
-    tool.v_world = tool.has_previous && dt_s > 0.0 ? Vec3((p_world - tool.p_previous_world) / dt_s)
-                                                   : Vec3::Zero();
+    const double motion_s = input_motion_time_s(input.time_s, tool.input_time_previous_s, dt_s);
+    tool.v_world = tool.has_previous && motion_s > 0.0
+                       ? Vec3((p_world - tool.p_previous_world) / motion_s)
+                       : Vec3::Zero();
     tool.moved_m = tool.has_previous ? (p_world - tool.p_previous_world).norm() : kInf;
     tool.p_previous_world = p_world;
+    tool.input_time_previous_s = input.time_s;
     tool.has_previous = true;
     tool.p_world = p_world;
   }

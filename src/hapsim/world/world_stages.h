@@ -44,6 +44,15 @@ namespace stage {
 
 void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& input,
                  double dt_s) noexcept;
+/// Longest input time a tool's velocity is differenced over; a longer gap is a jump.
+inline constexpr double kMaxInputMotionTime_s = 0.1;
+/// How long the device took for the motion between two inputs, by the input's own time stamps:
+/// a served world steps on a remote device's states, and after a stall on either side one step
+/// holds several of the device's periods of motion; differenced over the step (dt_s) it would be
+/// a velocity, and a damping force, many times the device's. dt_s when the stamps say nothing
+/// better (equal to the step within 1 %, not increasing, or more than kMaxInputMotionTime_s).
+[[nodiscard]] double input_motion_time_s(double input_time_s, double input_time_previous_s,
+                                         double dt_s) noexcept;
 void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) noexcept;
 /// Dynamic bodies against every other body's segments (detection and response in one: a body's
 /// contacts are found and answered where they are found; stage_body_contacts.cpp).

@@ -282,6 +282,7 @@ struct ToolRuntime {
   Vec3 v_world = Vec3::Zero();  ///< place stage: finite-difference velocity (zero after a jump)
   double moved_m = kInf;        ///< place stage: distance since last step (inf: no last step)
   Vec3 p_previous_world = Vec3::Zero();
+  double input_time_previous_s = 0.0;  ///< the device input's own time stamp last step
   bool has_previous = false;
 };
 
