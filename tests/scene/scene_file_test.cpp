@@ -128,6 +128,30 @@ TEST_F(SceneFileTest, BaseSceneLoadsExactlyAsWritten) {
   EXPECT_EQ(s.world.name, "scene");  // the file's stem when /world/name is absent
 }
 
+// Several users in one world: each tool names the device host that moves it; hosts are numbered
+// in the order they first appear, and one-user scenes keep their content hash.
+TEST_F(SceneFileTest, ToolsBoundToNamedDeviceHostsGetTheirDeviceIndex) {
+  const SceneDescription one = load_scene(write("one.json", base().dump()));
+  EXPECT_TRUE(one.world.device_hosts.empty());
+  EXPECT_EQ(one.world.tools[0].device, 0);
+  Json j = base();
+  j["tools"][0]["device_host"] = "trainee";
+  j["tools"].push_back({{"name", "probe"}, {"device_host", "instructor"}});
+  j["tools"].push_back({{"name", "second"}, {"device_host", "trainee"}});
+  const SceneDescription s = load_scene(write("two.json", j.dump()));
+  EXPECT_EQ(s.world.device_hosts, (std::vector<std::string>{"trainee", "instructor"}));
+  ASSERT_EQ(s.world.tools.size(), 3u);
+  EXPECT_EQ(s.world.tools[0].device, 0);
+  EXPECT_EQ(s.world.tools[1].device, 1);
+  EXPECT_EQ(s.world.tools[2].device, 0);
+  EXPECT_NE(content_hash(s.world), content_hash(one.world));
+  Json swapped = j;
+  swapped["tools"][1]["device_host"] = "trainee";
+  swapped["tools"][2]["device_host"] = "instructor";
+  EXPECT_NE(content_hash(load_scene(write("swapped.json", swapped.dump())).world),
+            content_hash(s.world));
+}
+
 TEST_F(SceneFileTest, EveryBadValueNamesItsJsonPath) {
   const Mutation cases[] = {
       {"missing format", [](Json& j) { j.erase("format"); }, "/", "missing required key 'format'"},
@@ -312,6 +336,24 @@ TEST_F(SceneFileTest, EveryBadValueNamesItsJsonPath) {
          j["tools"].push_back({{"name", "tip2"}, {"finger", 1}});
        },
        "/tools/1/finger", "finger 1 is used twice"},
+      {"one tool without a device host",
+       [](Json& j) {
+         j["tools"][0]["device_host"] = "trainee";
+         j["tools"].push_back({{"name", "probe"}});
+       },
+       "/tools/1", "names no device_host, while others do"},
+      {"device host name with a space",
+       [](Json& j) { j["tools"][0]["device_host"] = "the trainee"; }, "/tools/0/device_host",
+       "letters, digits"},
+      {"five device hosts",
+       [](Json& j) {
+         j["tools"][0]["device_host"] = "u0";
+         for (int k = 1; k < 5; ++k) {
+           j["tools"].push_back(
+               {{"name", "t" + std::to_string(k)}, {"device_host", "u" + std::to_string(k)}});
+         }
+       },
+       "/tools/4/device_host", "at most 4 device hosts"},
       {"missing device", [](Json& j) { j.erase("device"); }, "/", "missing required key 'device'"},
       {"unknown profile", [](Json& j) { j["device"]["profile"] = "phantom"; }, "/device/profile",
        "expected one of"},

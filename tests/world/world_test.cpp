@@ -293,6 +293,43 @@ TEST(World, EachFingertipFeelsTheOthersDent) {
   EXPECT_LT(r.command.finger_force_n[1], 500.0 * 0.004 * 0.7);  // well below the rest surface's
 }
 
+// Two users in one world (a trainee's fingertip on device 0, an instructor's probe on device 1,
+// World::set_device_input): each tool is placed by its own device, each feels the other's dent
+// as two fingertips of one hand do, and the step's command holds device 0's force alone (the
+// instructor's reaches the instructor through its tool's result: a device host renders it).
+TEST(World, TwoUsersEachPlaceTheirOwnToolAndFeelTheOthersDent) {
+  WorldDescription w = two_finger_block(0.0, 2.5);
+  w.tools[0].finger = -1;
+  w.tools[1].finger = -1;
+  w.tools[1].offset_device = Vec3::Zero();
+  w.tools[1].device = 1;
+  w.device_hosts = {"trainee", "instructor"};
+  World world(std::move(w));
+  // Until the instructor's device is heard from, its tool holds with no force.
+  const StepResult& alone = world.step(at(Vec3(0.0, 0.0, -0.003)), 1e-3);
+  EXPECT_EQ(alone.tools[1].force_world_n, Vec3::Zero());
+  EXPECT_NEAR(alone.command.force_world_n.z(), 500.0 * 0.003, 1e-9);
+  for (int i = 0; i < 50; ++i) {
+    world.set_device_input(1, at(Vec3(0.004, 0.0, -0.004)));  // 4 mm beside, 4 mm in
+    world.step(at(Vec3(0.0, 0.0, -0.003)), 1e-3);
+  }
+  const StepResult& r = world.last_result();
+  EXPECT_EQ(r.tools[1].p_world, Vec3(0.004, 0.0, -0.004));
+  EXPECT_NEAR(r.tools[0].force_world_n.z(), 500.0 * (0.003 - dent_4mm_away(0.004, 2.5)), 1e-9);
+  EXPECT_NEAR(r.tools[1].force_world_n.z(), 500.0 * (0.004 - dent_4mm_away(0.003, 2.5)), 1e-9);
+  EXPECT_EQ(r.command.force_world_n, r.tools[0].force_world_n);  // the trainee's alone
+  // The instructor lets go (an unhealthy input): that tool holds with no force, the trainee's
+  // press goes on and no longer feels the instructor's dent once it has recovered.
+  DeviceInput gone = at(Vec3(0.004, 0.0, -0.004));
+  gone.healthy = false;
+  world.set_device_input(1, gone);
+  for (int i = 0; i < 1000; ++i) {
+    world.step(at(Vec3(0.0, 0.0, -0.003)), 1e-3);
+  }
+  EXPECT_EQ(world.last_result().tools[1].force_world_n, Vec3::Zero());
+  EXPECT_NEAR(world.last_result().tools[0].force_world_n.z(), 500.0 * 0.003, 1e-6);
+}
+
 // A fingertip inside the rest surface but clear of the other's dent feels nothing.
 TEST(World, AFingertipHoveringInADentFeelsNothing) {
   World world(two_finger_block(0.0025, 2.5));  // the second 2.5 mm higher

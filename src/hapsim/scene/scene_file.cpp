@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -54,6 +55,7 @@ class Parser : public SceneReader {
   void parse_body_materials(const Json& j, const std::string& ptr, BodyDescription& body,
                             const std::vector<std::optional<TissueKind>>& tissues);
   ToolDescription parse_tool(const Json& j, const std::string& ptr) const;
+  std::string device_host_name(const Json& tool, const std::string& ptr) const;
   void parse_run(const Json& root, SceneDescription& scene) const;
   std::uint32_t material_ref(const Json& j, const std::string& ptr) const;
 
@@ -157,15 +159,38 @@ SceneDescription Parser::parse(const Json& root) {
     fail("/tools", "expected at least one tool (the device drives its tools)");
   }
   std::set<std::string> tool_names;
-  std::set<int> fingers;
+  std::set<std::pair<int, int>> fingers;  // (device, finger)
+  // Several users: each tool names its device host; the hosts are numbered in the order they
+  // first appear (the first is the device the scene's own script and `hapsim run` drive).
+  std::vector<std::string>& hosts = scene.world.device_hosts;
+  const auto named = [](const Json& t) { return t.is_object() && t.contains("device_host"); };
+  const bool several_users = std::any_of(tools.begin(), tools.end(), named);
   for (std::size_t i = 0; i < tools.size(); ++i) {
     scene.world.tools.push_back(parse_tool(tools[i], at("/tools", i)));
-    const ToolDescription& t = scene.world.tools.back();
+    ToolDescription& t = scene.world.tools.back();
     if (!tool_names.insert(t.name).second) {
       fail(at(at("/tools", i), "name"),
            "expected a unique tool name; '" + t.name + "' is used twice");
     }
-    if (t.finger >= 0 && !fingers.insert(t.finger).second) {
+    if (several_users) {
+      if (!named(tools[i])) {
+        fail(at("/tools", i), "tool '" + t.name +
+                                  "' names no device_host, while others do: name one for each "
+                                  "tool (the device host that moves it)");
+      }
+      const std::string host = device_host_name(tools[i], at(at("/tools", i), "device_host"));
+      auto it = std::find(hosts.begin(), hosts.end(), host);
+      if (it == hosts.end()) {
+        if (hosts.size() >= static_cast<std::size_t>(kMaxWorldDevices)) {
+          fail(at(at("/tools", i), "device_host"),
+               "expected at most " + std::to_string(kMaxWorldDevices) +
+                   " device hosts in one world; '" + host + "' would be one more");
+        }
+        it = hosts.insert(hosts.end(), host);
+      }
+      t.device = static_cast<int>(it - hosts.begin());
+    }
+    if (t.finger >= 0 && !fingers.insert({t.device, t.finger}).second) {
       fail(at(at("/tools", i), "finger"),
            "expected each finger actuator to drive one tool; finger " + std::to_string(t.finger) +
                " is used twice");
@@ -502,7 +527,7 @@ void Parser::parse_body_materials(const Json& j, const std::string& ptr, BodyDes
 
 ToolDescription Parser::parse_tool(const Json& j, const std::string& ptr) const {
   object(j, ptr, "a tool");
-  allow_keys(j, ptr, {"name", "radius_m", "offset_m", "finger"});
+  allow_keys(j, ptr, {"name", "radius_m", "offset_m", "finger", "device_host"});
   ToolDescription t;
   t.name = nonempty_string(required(j, ptr, "name"), at(ptr, "name"), "a tool name");
   t.radius_m = number_in(j, ptr, "radius_m", t.radius_m, 0.0, 0.1, "m");
@@ -519,6 +544,20 @@ ToolDescription Parser::parse_tool(const Json& j, const std::string& ptr) const 
     t.finger = f.get<int>();
   }
   return t;
+}
+
+// A device host's name (`hapsim device --name NAME`): letters, digits, '-' and '_', 1-32 long.
+std::string Parser::device_host_name(const Json& tool, const std::string& ptr) const {
+  const std::string name = nonempty_string(tool["device_host"], ptr, "a device host's name");
+  const bool plain =
+      name.size() <= 32 && std::all_of(name.begin(), name.end(), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_';
+      });
+  if (!plain) {
+    fail(ptr, "expected a device host's name of letters, digits, '-' and '_' (at most 32), got " +
+                  shown(tool["device_host"]));
+  }
+  return name;
 }
 
 void Parser::parse_run(const Json& root, SceneDescription& scene) const {

@@ -394,7 +394,7 @@ void FemCoupling::capture(const WorldModel& model, const WorldState& state) noex
   for (std::size_t t = 0; t < tool_count_; ++t) {
     l.p_world[t] = state.tools[t].p_world;
     l.v_world[t] = state.tools[t].v_world;
-    l.usable[t] = state.input_usable;
+    l.usable[t] = state.tools[t].input_usable;
     for (std::size_t b = 0; b < bodies_.size(); ++b) {
       l.push_world_n[t * kMaxFemBodies + b] =
           state.fem_contacts[t * kMaxFemBodies + b].push_world_n;

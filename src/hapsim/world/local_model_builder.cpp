@@ -43,7 +43,8 @@ void LocalModelBuilder::build(const WorldState& state, std::uint64_t sequence,
     m.sim_time_s = state.time_s;
     m.sequence = sequence;
     m.device_sequence = device_sequence;
-    m.valid = state.input_usable && m.x0_world_m.allFinite() && m.v0_world_m_per_s.allFinite();
+    m.valid =
+        state.tools[t].input_usable && m.x0_world_m.allFinite() && m.v0_world_m_per_s.allFinite();
     m.max_normal_force_n = 0.0;  // summed over the tool's contacts below; free space: none
   }
   std::array<bool, 64> proxy_capped{};  // per tool (a world has a handful)

@@ -89,14 +89,14 @@ void end_contact(WorldState& state, PenaltySide& side) noexcept {
 
 // haptic path
 void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) noexcept {
-  if (!state.input_usable) {
-    return;
-  }
   const WorldDescription& d = model.description();
   const std::vector<SegmentModel>& segs = model.segments();
   for (std::size_t t = 0; t < state.tools.size(); ++t) {
     ToolRuntime& tool = state.tools[t];
     tool.penalty_count = 0;
+    if (!tool.input_usable) {
+      continue;
+    }
     const double radius = d.tools[t].radius_m;
     const Vec3& p_world = tool.p_world;
     for (std::size_t i = 0; i < segs.size(); ++i) {

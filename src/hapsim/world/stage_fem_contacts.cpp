@@ -66,7 +66,7 @@ void fem_contacts(const WorldModel& model, WorldState& state, double dt_s) noexc
     for (std::size_t b = 0; b < fem_bodies.size(); ++b) {
       FemToolContact& fc = state.fem_contacts[t * kMaxFemBodies + b];
       fc.push_world_n.setZero();
-      if (!state.input_usable) {
+      if (!tool.input_usable) {
         fc.adopted_this_step = false;
         fc.blend_offset_n.setZero();
         continue;

@@ -218,6 +218,12 @@ void place_rig(const WorldModel& model, RigState& rig, WorldState& state, const 
   count_slave_collisions(model, rig, state);
 }
 
+// haptic path: a pose a tool can be placed from.
+bool pose_usable(const DeviceInput& input) noexcept {
+  return input.healthy && input.p_world.allFinite() && input.q_world.coeffs().allFinite() &&
+         input.q_world.squaredNorm() > 0.5;
+}
+
 }  // namespace
 
 // haptic path
@@ -240,8 +246,7 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
   if (state.rig) {
     place_rig(model, *state.rig, state, input, dt_s);
   }
-  state.input_usable = input.healthy && input.p_world.allFinite() &&
-                       input.q_world.coeffs().allFinite() && input.q_world.squaredNorm() > 0.5;
+  state.input_usable = pose_usable(input);
   if (model.hand() != nullptr) {
     // A glove's finger angles place the tools: a non-finite one makes the input unusable.
     const int n = std::clamp(input.joint_count, 0, kMaxDeviceJoints);
@@ -249,22 +254,11 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
       state.input_usable = std::isfinite(input.joint_rad[static_cast<std::size_t>(j)]);
     }
   }
-  if (!state.input_usable) {
-    for (ToolRuntime& tool : state.tools) {
-      tool.has_previous = false;  // no velocity spike when the input comes back
-      for (PenaltySide& side : tool.penalty_side) {
-        side = PenaltySide{};  // the tool may come back anywhere
-      }
-      std::fill(tool.pressing.begin(), tool.pressing.end(), std::uint8_t{0});
-      std::fill(tool.stick_body.begin(), tool.stick_body.end(), StickPoint{});
-    }
-    return;
-  }
-  const Quat q = input.q_world.normalized();
   std::array<Vec3, kHandFingers> tips{};
-  if (const HandModel* hand = model.hand()) {
+  const HandModel* hand = model.hand();
+  if (hand != nullptr && state.input_usable) {
     Iso3 X_world_hand = Iso3::Identity();
-    X_world_hand.linear() = q.toRotationMatrix();
+    X_world_hand.linear() = input.q_world.normalized().toRotationMatrix();
     X_world_hand.translation() = input.p_world;
     state.hand = glove_reading(
         X_world_hand, {input.joint_rad.data(), static_cast<std::size_t>(std::clamp(
@@ -273,20 +267,40 @@ void place_tools(const WorldModel& model, WorldState& state, const DeviceInput& 
   }
   for (std::size_t t = 0; t < state.tools.size(); ++t) {
     ToolRuntime& tool = state.tools[t];
-    const Vec3 p_world = model.hand() != nullptr
-                             ? tips[static_cast<std::size_t>(d.tools[t].finger)]
-                             : Vec3(input.p_world + q * d.tools[t].offset_device);
+    const int device = d.tools[t].device;
+    // Another user's tool takes that user's device's input (World::set_device_input).
+    const DeviceInput& in = device >= 1 && device < kMaxWorldDevices
+                                ? state.other_inputs[static_cast<std::size_t>(device - 1)]
+                                : input;
+    tool.input_usable = &in == &input ? state.input_usable : pose_usable(in);
     if (!state.tools_placed) {
+      tool.placed = false;
+    }
+    if (!tool.input_usable) {
+      tool.has_previous = false;  // no velocity spike when the input comes back
+      for (PenaltySide& side : tool.penalty_side) {
+        side = PenaltySide{};  // the tool may come back anywhere
+      }
+      std::fill(tool.pressing.begin(), tool.pressing.end(), std::uint8_t{0});
+      std::fill(tool.stick_body.begin(), tool.stick_body.end(), StickPoint{});
+      continue;
+    }
+    const Vec3 p_world =
+        hand != nullptr && &in == &input
+            ? tips[static_cast<std::size_t>(d.tools[t].finger)]
+            : Vec3(in.p_world + in.q_world.normalized() * d.tools[t].offset_device);
+    if (!tool.placed) {
       tool.proxy.reset(p_world);
       tool.proxy_surface_last_step = -1;
+      tool.placed = true;
     }
-    const double motion_s = input_motion_time_s(input.time_s, tool.input_time_previous_s, dt_s);
+    const double motion_s = input_motion_time_s(in.time_s, tool.input_time_previous_s, dt_s);
     tool.v_world = tool.has_previous && motion_s > 0.0
                        ? Vec3((p_world - tool.p_previous_world) / motion_s)
                        : Vec3::Zero();
     tool.moved_m = tool.has_previous ? (p_world - tool.p_previous_world).norm() : kInf;
     tool.p_previous_world = p_world;
-    tool.input_time_previous_s = input.time_s;
+    tool.input_time_previous_s = in.time_s;
     tool.has_previous = true;
     tool.p_world = p_world;
   }

@@ -137,13 +137,13 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
   if (state.rig) {
     respond_rig(model, state);
   }
-  if (!state.input_usable) {
-    return;
-  }
   const WorldDescription& d = model.description();
   const std::vector<SegmentModel>& segs = model.segments();
   for (std::size_t t = 0; t < state.tools.size(); ++t) {
     ToolRuntime& tool = state.tools[t];
+    if (!tool.input_usable) {
+      continue;
+    }
     ToolState& out = state.tool_states[t];
     const double radius = d.tools[t].radius_m;
     const auto tool_index = static_cast<std::int32_t>(t);

@@ -61,18 +61,17 @@ void safety(const WorldModel& model, WorldState& state) noexcept {
     rig_command(model, state, *state.rig);
     state.command = state.rig->result.command;
   }
-  if (!state.input_usable) {
-    for (ToolState& out : state.tool_states) {
-      out.force_world_n.setZero();
-      out.contact_count = 0;
-    }
-    return;
-  }
   const WorldDescription& d = model.description();
   for (std::size_t t = 0; t < state.tool_states.size(); ++t) {
     ToolState& out = state.tool_states[t];
-    if (!out.force_world_n.allFinite()) {
+    if (!out.force_world_n.allFinite() || t >= state.tools.size() || !state.tools[t].input_usable) {
       out.force_world_n.setZero();
+    }
+    if (t < state.tools.size() && !state.tools[t].input_usable) {
+      out.contact_count = 0;
+    }
+    if (d.tools[t].device != 0) {
+      continue;  // another user's: rendered by that user's device host from its local models
     }
     const int finger = d.tools[t].finger;
     if (finger >= 0) {

@@ -107,21 +107,48 @@ ContactMaterial World::effective_material(std::uint32_t material, double dt_s) c
   return hapsim::effective_material(model_, state_.material_contact.at(material), dt_s);
 }
 
+namespace {
+
+// haptic path
+void forget_motion(ToolRuntime& tool) noexcept {
+  tool.has_previous = false;
+  // The tool may come back anywhere (as after an unusable input): no side or dent is kept.
+  for (PenaltySide& side : tool.penalty_side) {
+    side = PenaltySide{};
+  }
+  std::fill(tool.pressing.begin(), tool.pressing.end(), std::uint8_t{0});
+  std::fill(tool.stick_body.begin(), tool.stick_body.end(), StickPoint{});
+}
+
+}  // namespace
+
 void World::forget_tool_motion() noexcept {
   for (ToolRuntime& tool : state_.tools) {
-    tool.has_previous = false;
-    // The tool may come back anywhere (as after an unusable input): no side or dent is kept.
-    for (PenaltySide& side : tool.penalty_side) {
-      side = PenaltySide{};
-    }
-    std::fill(tool.pressing.begin(), tool.pressing.end(), std::uint8_t{0});
-    std::fill(tool.stick_body.begin(), tool.stick_body.end(), StickPoint{});
+    forget_motion(tool);
   }
 }
 
 void World::restart_tools() noexcept {
   forget_tool_motion();
   state_.tools_placed = false;  // place_tools resets each proxy at its tool
+}
+
+// haptic path
+void World::restart_tools(int device) noexcept {
+  const std::vector<ToolDescription>& tools = description().tools;
+  for (std::size_t t = 0; t < tools.size() && t < state_.tools.size(); ++t) {
+    if (tools[t].device == device) {
+      forget_motion(state_.tools[t]);
+      state_.tools[t].placed = false;
+    }
+  }
+}
+
+// haptic path
+void World::set_device_input(int device, const DeviceInput& input) noexcept {
+  if (device >= 1 && device < kMaxWorldDevices) {
+    state_.other_inputs[static_cast<std::size_t>(device - 1)] = input;
+  }
 }
 
 // haptic path

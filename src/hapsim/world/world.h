@@ -56,6 +56,14 @@ class World {
   /// the tools land anywhere. Their proxies are placed where the devices now are, not dragged
   /// there from their old contacts across whatever lies between; no motion, side or dent is kept.
   void restart_tools() noexcept;
+  /// haptic path. restart_tools() for the tools of device `device` alone (another user's device
+  /// joined or left; the others keep their contacts).
+  void restart_tools(int device) noexcept;
+  /// haptic path. Device `device`'s input for the next steps (1 ≤ device < kMaxWorldDevices: the
+  /// tools of another user, ToolDescription::device; device 0's input is step()'s). An unhealthy
+  /// or non-finite one holds those tools with no force, as step() does for its own. Out of range:
+  /// ignored.
+  void set_device_input(int device, const DeviceInput& input) noexcept;
   /// haptic path. SPEC §8, for the next step only: the push each tool's device actually rendered
   /// (N, one per tool; NaN or a missing entry: not known). A sheet a tool presses takes that
   /// push instead of the step's own force: when the device is on another host rendering a local

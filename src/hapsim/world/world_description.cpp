@@ -295,6 +295,12 @@ std::string content_hash(const WorldDescription& description) {
     h.number(t.radius_m);
     h.bytes(t.offset_device.data(), sizeof(double) * 3);
     h.number(t.finger);
+    if (t.device != 0) {  // one-user scenes keep the hash they had
+      h.number(t.device);
+    }
+  }
+  for (const std::string& host : description.device_hosts) {
+    h.text(host);
   }
   h.number(description.passivity_damping_factor);
   h.number(description.has_hand ? description.hand.dip_per_pip : -1.0);

@@ -153,6 +153,11 @@ struct ToolDescription {
   /// Device finger actuator that renders this tool's force magnitude; -1: the tool's force goes
   /// to the device tip force (summed over such tools).
   int finger = -1;
+  /// Which device places the tool: 0 is the one step() is given (its command holds this tool's
+  /// force); k > 0 is another user's device (World::set_device_input), whose force reaches that
+  /// user through the tool's own results (a device host renders its local models), never the
+  /// step's command. Index into WorldDescription::device_hosts when that is not empty.
+  int device = 0;
 };
 
 /// A teleoperation rig (paper 000): a 5-DOF master arm (the device: joint_rad[0..2] arm,
@@ -211,7 +216,13 @@ struct WorldDescription {
   Vec3 gravity_m_per_s2 = Vec3(0.0, 0.0, -9.81);
   /// A teleoperation rig driven by the device (the master arm), when the scene has one.
   std::optional<TeleopRigDescription> teleop;
+  /// Several users in one world: the named device hosts (`hapsim device --name NAME`), in the
+  /// order of ToolDescription::device. Empty: one device, unnamed.
+  std::vector<std::string> device_hosts;
 };
+
+/// Most devices one world takes (one per user: a trainee, an instructor, two hands).
+inline constexpr int kMaxWorldDevices = 4;
 
 /// A world made of a teleoperation rig (the teleoperation scenes): the rig, and as ordinary bodies
 /// its floor (static), sheet (deformable, Gaussian), ball (dynamic sphere), gripper pads

@@ -283,6 +283,10 @@ struct ToolRuntime {
   double moved_m = kInf;        ///< place stage: distance since last step (inf: no last step)
   Vec3 p_previous_world = Vec3::Zero();
   double input_time_previous_s = 0.0;  ///< the device input's own time stamp last step
+  /// Place stage: the input of the tool's device was usable (healthy, finite) this step.
+  bool input_usable = false;
+  /// The proxy was placed at the tool once since the tool's device (re)started.
+  bool placed = false;
   bool has_previous = false;
 };
 
@@ -404,8 +408,17 @@ struct WorldState {
   double time_s = 0.0;
   /// Steps taken since construction or reset (the first step is 1).
   std::uint64_t step_index = 0;
-  /// Place stage: the input was usable (healthy, finite) this step.
+  /// Place stage: the step's own input (device 0) was usable (healthy, finite) this step.
   bool input_usable = false;
+  /// The inputs of the other users' devices (index k - 1 for device k; World::set_device_input),
+  /// unhealthy until one is given.
+  std::array<DeviceInput, kMaxWorldDevices - 1> other_inputs = [] {
+    std::array<DeviceInput, kMaxWorldDevices - 1> unheard{};
+    for (DeviceInput& input : unheard) {
+      input.healthy = false;
+    }
+    return unheard;
+  }();
   /// The proxies have been placed at a first position (reset() clears it).
   bool tools_placed = false;
   /// Place stage: the glove hand's tracker pose and finger angles from the last usable input
