@@ -64,11 +64,13 @@ void safety(const WorldModel& model, WorldState& state) noexcept {
   const WorldDescription& d = model.description();
   for (std::size_t t = 0; t < state.tool_states.size(); ++t) {
     ToolState& out = state.tool_states[t];
-    if (!out.force_world_n.allFinite() || t >= state.tools.size() || !state.tools[t].input_usable) {
-      out.force_world_n.setZero();
-    }
-    if (t < state.tools.size() && !state.tools[t].input_usable) {
+    // A tool whose device's input is unusable holds with no force (zero, never NaN).
+    const bool usable = t < state.tools.size() && state.tools[t].input_usable;
+    if (!usable) {
       out.contact_count = 0;
+    }
+    if (!usable || !out.force_world_n.allFinite()) {
+      out.force_world_n.setZero();
     }
     if (d.tools[t].device != 0) {
       continue;  // another user's: rendered by that user's device host from its local models
