@@ -325,13 +325,12 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   std::fflush(stdout);
 
   const std::atomic<bool>& stop = install_stop_signals();
-  // The recording's end (and, secure, its signature), however the session ended: false (with
-  // one line said) when either was not written in full.
-  const auto finish_recording = [&](SessionSummary& summary) {
+  // After finish_session_recording: says where the recording went and, secure, signs it; false
+  // (with one line said) when either was not written in full.
+  const auto report_recording = [&](const SessionSummary& summary) {
     if (!recorder) {
       return true;
     }
-    finish_session_recording(*recorder, summary);
     std::printf("recorded     %s (%zu frames)\n", args.record_path.c_str(),
                 recorder->frames_written());
     bool ok = summary.recording_error.empty();
@@ -361,7 +360,10 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
     if (!remote.wait_for_host(kUntilStopped_s, &stop)) {
       std::printf("stopped      before a device host joined\n");
       SessionSummary nothing;
-      const bool recorded = finish_recording(nothing);
+      if (recorder) {
+        finish_session_recording(*recorder, nothing);
+      }
+      const bool recorded = report_recording(nothing);
       json_out.write_failure("stopped by " + std::string(stop_signal_name()) +
                              " before a device host joined");
       exit_status() = recorded ? stopped_by_signal_status() : 2;
@@ -393,7 +395,7 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
     finish_session_recording(*recorder, summary);  // before the summary, which says a failure
   }
   std::cout << format_session_summary(summary);
-  const bool recorded = finish_recording(summary);
+  const bool recorded = report_recording(summary);
   const net::VerdictCounts verdicts = remote.verdicts();
   std::printf("published    %" PRIu64 " local models (%" PRIu64 " refused by DDS), %" PRIu64
               " view states\n",
