@@ -52,5 +52,7 @@ void add_sheet_profile_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 /// `hapsim keys` (keys_command.cpp): a secure session's keys.
 void add_keys_command(CLI::App& app);
+/// `hapsim doctor` (doctor_command.cpp): what the machine gives hapsim, each check with its fix.
+void add_doctor_command(CLI::App& app);
 
 }  // namespace hapsim::app

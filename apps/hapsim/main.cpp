@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
   add_sheet_profile_command(app);
   add_calibrate_command(app);
   add_keys_command(app);
+  add_doctor_command(app);
 #ifdef HAPSIM_WITH_BENCH
   add_bench_command(app);
 #endif

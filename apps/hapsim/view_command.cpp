@@ -6,6 +6,7 @@
 #include "stop_signal.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/device/plugin_device.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/ui/viewer.h"
 
@@ -46,7 +47,32 @@ struct ViewArgs {
   DdsOptions dds;
 };
 
+// The viewer's own errors for a machine without a display or a usable OpenGL window (ui/viewer.cpp
+// throws them as Error("viewer", …)) get the pointer to `hapsim doctor`, which says what is
+// missing and how to fix it.
+int run_viewer_or_say_doctor(const ViewerOptions& o) {
+  try {
+    return run_viewer(o);
+  } catch (const Error& e) {
+    if (e.where() == "viewer") {
+      throw CommandError(std::string(e.what()) + "; run `hapsim doctor` for the fix");
+    }
+    throw;
+  }
+}
+
 void view(const ViewArgs& args) {
+  if (plugin_path_from_device_spec(args.device)) {
+    // The viewer's session (ui/world_viewer_session.cpp) opens its devices itself and has no
+    // plugin yet: said plainly, before any window, rather than as an unknown device.
+    throw CommandError("--device " + args.device +
+                       ": the viewer does not drive a plugin's device yet; `hapsim run SCENE "
+                       "--device " +
+                       args.device +
+                       " --duration S --snapshot FILE.png` runs a scene with it (`hapsim doctor "
+                       "--device " +
+                       args.device + "` checks that it opens)");
+  }
   if (args.connect == !args.scene.empty()) {
     throw CommandError(args.connect ? "--connect takes its scene from the simulation host: give "
                                       "no scene file"
@@ -120,7 +146,7 @@ void view(const ViewArgs& args) {
   o.stop = &install_stop_signals();  // SIGINT/SIGTERM close the window as the user would
   // The scene menu offers the scene files beside the one opened.
   if (args.connect) {
-    exit_status() = with_signal_status(run_viewer(o));
+    exit_status() = with_signal_status(run_viewer_or_say_doctor(o));
     return;
   }
   const std::filesystem::path folder = std::filesystem::path(args.scene).parent_path();
@@ -133,7 +159,7 @@ void view(const ViewArgs& args) {
     }
   }
   std::sort(o.scene_choices.begin(), o.scene_choices.end());
-  exit_status() = with_signal_status(run_viewer(o));
+  exit_status() = with_signal_status(run_viewer_or_say_doctor(o));
 }
 
 }  // namespace
