@@ -1,6 +1,8 @@
 // `hapsim run SCENE`: loads a scene, drives its world with the simulated device (the scene's
 // trajectory or palpation script, another trajectory file, or a recording to replay) at 1 kHz
-// simulated time, and reports contacts, forces, deflection, pop-throughs and the step cost.
+// simulated time, and reports contacts, forces, deflection, pop-throughs and the step cost. A
+// driver plugin (`--device plugin:PATH.so`, device/plugin_device.h) is a real device instead: it
+// drives the world on the real-time loop, in its own frame as the world's.
 #include "commands.h"
 #include "json_output.h"
 #include "progress_printer.h"
@@ -9,6 +11,7 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/core/stopwatch.h"
+#include "hapsim/device/plugin_device.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/render/force_scale.h"
 #include "hapsim/render/snapshot_writer.h"
@@ -43,7 +46,8 @@ namespace {
 
 struct RunArgs {
   std::string scene;
-  std::string device;                                            // "sim" or "sim:FILE"
+  std::string device;         // "sim", "sim:FILE" or "plugin:PATH.so"
+  std::string driver_config;  // plugin: the string its open() gets
   double duration_s = std::numeric_limits<double>::quiet_NaN();  // NaN: not given
   std::string record_path;
   std::string replay_path;
@@ -240,6 +244,50 @@ class RunSnapshots final : public SnapshotSink {
   std::size_t written_ = 0;
 };
 
+// "5.0 N, 1000 N/m, 2 finger(s)": what a plugin's driver says its device is rated for.
+std::string format_plugin_rating(const DeviceProfile& p) {
+  char text[128];
+  std::snprintf(text, sizeof text, "%.1f N, %.0f N/m, %d finger(s)", p.max_force_n,
+                p.max_stiffness_n_per_m, p.finger_count);
+  return text;
+}
+
+// What the plugin wrapper counted over the run (device/plugin_device.h): the run read the
+// driver's device, and whether it refused anything the driver said.
+std::string format_plugin_summary(const PluginDevice& device) {
+  const PluginDeviceCounts n = device.counts();
+  const DeviceStatus status = device.status();
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "plugin       '%s': %llu reads (%llu without a new sample, %llu refused as "
+                "non-finite or out of range), %llu commands sent as zero, %llu refused by the "
+                "driver; health at the end: %s\n",
+                device.driver_name().c_str(), static_cast<unsigned long long>(n.reads),
+                static_cast<unsigned long long>(n.no_sample),
+                static_cast<unsigned long long>(n.bad_samples),
+                static_cast<unsigned long long>(n.commands_zeroed),
+                static_cast<unsigned long long>(n.write_refused),
+                std::string(to_string(status.health)).c_str());
+  return text;
+}
+
+nlohmann::json plugin_summary_json(const PluginDevice& device) {
+  const PluginDeviceCounts n = device.counts();
+  const DeviceProfile& p = device.profile();
+  return {{"driver", device.driver_name()},
+          {"model", p.display_name},
+          {"path", device.path().string()},
+          {"max_force_n", p.max_force_n},
+          {"max_stiffness_n_per_m", p.max_stiffness_n_per_m},
+          {"fingers", p.finger_count},
+          {"reads", n.reads},
+          {"no_sample", n.no_sample},
+          {"bad_samples", n.bad_samples},
+          {"commands_zeroed", n.commands_zeroed},
+          {"write_refused", n.write_refused},
+          {"health", std::string(to_string(device.status().health))}};
+}
+
 ContactMethod parse_method(const std::string& name) {
   return parse_contact_method(name).value_or(ContactMethod::kKnee);  // CLI11 has checked it
 }
@@ -258,10 +306,21 @@ void run(const RunArgs& args) {
       (!(args.duration_s > 0.0) || !std::isfinite(args.duration_s))) {
     throw CommandError("--duration: expected seconds > 0");
   }
-  if (args.realtime && args.snapshot_every > 0) {
-    throw CommandError(
-        "--snapshot-every: not with --realtime (the haptic thread owns the world "
-        "while it runs; the final snapshot is written after the run)");
+  // A driver plugin is a real device: its hand moves in wall-clock time, so the world steps on
+  // the real-time loop.
+  const std::optional<std::filesystem::path> plugin = plugin_path_from_device_spec(args.device);
+  const bool realtime = args.realtime || plugin.has_value();
+  if (!plugin && !args.driver_config.empty()) {
+    throw CommandError("--driver-config: only with --device plugin:PATH.so");
+  }
+  if (plugin && !args.replay_path.empty()) {
+    throw CommandError("--device and --replay both choose the input: give one");
+  }
+  if (realtime && args.snapshot_every > 0) {
+    throw CommandError(std::string("--snapshot-every: not with ") +
+                       (args.realtime ? "--realtime" : "a plugin device (it runs in real time)") +
+                       " (the haptic thread owns the world while it runs; the final snapshot is "
+                       "written after the run)");
   }
   if (!args.snapshot_path.empty()) {
     // Fail before the run, not after it: the folder must be there.
@@ -290,11 +349,11 @@ void run(const RunArgs& args) {
                        ": only with --snapshot FILE.png");
   }
   std::optional<std::filesystem::path> trajectory;
-  if (!args.device.empty() && args.device != "sim") {
+  if (!args.device.empty() && args.device != "sim" && !plugin) {
     if (args.device.rfind("sim:", 0) != 0 || args.device.size() <= 4) {
       throw CommandError("--device " + args.device +
-                         ": expected 'sim' or 'sim:FILE' (a trajectory CSV for the simulated "
-                         "device)");
+                         ": expected 'sim', 'sim:FILE' (a trajectory CSV for the simulated "
+                         "device) or 'plugin:PATH.so' (a driver, include/hapsim/device_driver.h)");
     }
     trajectory = args.device.substr(4);
   }
@@ -302,22 +361,33 @@ void run(const RunArgs& args) {
     throw CommandError("--device and --replay both choose the input: give one");
   }
 
+  // The driver is opened before the scene loads: a wrong one is one line at once.
+  std::unique_ptr<PluginDevice> plugin_device;
+  if (plugin) {
+    plugin_device = open_plugin_device(*plugin, args.driver_config);
+  }
+
   SceneLoadOptions load_options;
   if (!args.data_dir.empty()) {
     load_options.data_dir = args.data_dir;
   }
   load_options.progress = progress;
-  load_options.device_trajectory_played = !trajectory && args.replay_path.empty();
+  load_options.device_trajectory_played = !trajectory && args.replay_path.empty() && !plugin;
   const Stopwatch load_watch;
   SceneDescription loaded = load_scene(args.scene, load_options);
   if (!args.method.empty() && loaded.world.bodies.empty()) {
     throw CommandError("--method: " + args.scene +
                        " has no bodies whose contact method it could change");
   }
-  const DeviceChoice choice = !args.replay_path.empty() ? DeviceChoice::replay(args.replay_path)
-                              : trajectory              ? DeviceChoice::trajectory(*trajectory)
-                                                        : DeviceChoice::scene_script();
+  const DeviceChoice choice = plugin                      ? DeviceChoice::external()
+                              : !args.replay_path.empty() ? DeviceChoice::replay(args.replay_path)
+                              : trajectory                ? DeviceChoice::trajectory(*trajectory)
+                                                          : DeviceChoice::scene_script();
   RunSetupOptions setup_options;
+  if (plugin_device) {
+    // The world renders no stiffer than the plugin's device is rated for.
+    setup_options.external_profile = &plugin_device->profile();
+  }
   if (!args.method.empty()) {
     setup_options.method = parse_method(args.method);
   }
@@ -336,6 +406,17 @@ void run(const RunArgs& args) {
   }();
   const SceneDescription& scene = setup.scene;
   check_segment_names(scene.world, args);
+  PluginDevice* driven_by_plugin = plugin_device.get();
+  if (plugin_device) {
+    if (setup.world->rig() != nullptr) {
+      throw CommandError("--device " + args.device + ": " + args.scene +
+                         " is a teleoperation scene, whose master arm its script drives; a "
+                         "plugin drives probe and glove scenes");
+    }
+    setup.device_name = "plugin '" + plugin_device->driver_name() + "' (" + plugin->string() +
+                        ", rated " + format_plugin_rating(plugin_device->profile()) + ")";
+    setup.device = std::move(plugin_device);
+  }
   const std::optional<OrbitCamera> chosen_camera =
       args.snapshot_path.empty() ? std::nullopt
                                  : chosen_snapshot_camera(scene, args.view, args.camera);
@@ -375,18 +456,20 @@ void run(const RunArgs& args) {
   if (!(duration_s > 0.0) || !std::isfinite(duration_s)) {
     throw CommandError(args.scene + ": the run has no length (give --duration S)");
   }
-  if (const double steps = duration_s / scene.run.dt_s;
-      !(steps <= max_session_steps(args.realtime))) {
+  if (const double steps = duration_s / scene.run.dt_s; !(steps <= max_session_steps(realtime))) {
     char text[200];
     std::snprintf(text, sizeof text,
                   ": a run of %g s at run.dt_s %g s is %.3g steps; at most %.0e %s (give a "
                   "shorter --duration)",
-                  duration_s, scene.run.dt_s, steps, max_session_steps(args.realtime),
-                  args.realtime ? "in real time" : "as fast as possible");
+                  duration_s, scene.run.dt_s, steps, max_session_steps(realtime),
+                  realtime ? "in real time" : "as fast as possible");
     throw CommandError(args.scene + text);
   }
   std::printf("device       %s; %.3f s at %.0f Hz%s\n", device_name.c_str(), duration_s,
-              1.0 / scene.run.dt_s, args.realtime ? " in real time" : " as fast as possible");
+              1.0 / scene.run.dt_s,
+              !realtime       ? " as fast as possible"
+              : args.realtime ? " in real time"
+                              : " in real time (a plugin's device runs on the real-time loop)");
   // What the load and the run's assembly let through but noticed: through the log, as mesh
   // defects are, once each, before the run (and in the JSON).
   for (const std::string& warning : scene.warnings) {
@@ -445,12 +528,12 @@ void run(const RunArgs& args) {
 
   SessionOptions options;
   options.duration_s = duration_s;
-  if (snapshots && !args.realtime) {
+  if (snapshots && !realtime) {
     // Every step: numbered pictures, and the last contact the final picture is framed on.
     options.after_cycle = [&](std::size_t cycle) { snapshots->after_step(*world, cycle + 1); };
   }
   options.dt_s = scene.run.dt_s;
-  options.realtime = args.realtime;
+  options.realtime = realtime;
   options.loop.spin_s = 1e-6 * args.spin_us;
   options.recorder = recorder.get();
   options.progress = progress;
@@ -462,6 +545,22 @@ void run(const RunArgs& args) {
     finish_session_recording(*recorder, summary);
   }
   std::cout << format_session_summary(summary);
+  if (driven_by_plugin != nullptr) {
+    std::cout << format_plugin_summary(*driven_by_plugin);
+  }
+  if (summary.realtime) {
+    // What `hapsim doctor` explains, with the fix (docs/doctor.md).
+    if (!summary.realtime->realtime_priority) {
+      std::printf(
+          "warning      the haptic thread ran without SCHED_FIFO (normal scheduling: millisecond "
+          "jitter); run `hapsim doctor` for the fix\n");
+    }
+    if (!summary.realtime->memory_locked) {
+      std::printf(
+          "warning      the haptic loop ran with its memory unlocked (a page read back from "
+          "swap can stall a cycle); run `hapsim doctor` for the fix\n");
+    }
+  }
   if (stopped_by != 0) {
     std::printf(
         "interrupted  by %s after %.3f of %.3f s: the summary and what is written below cover "
@@ -497,6 +596,9 @@ void run(const RunArgs& args) {
   nlohmann::json j =
       run_summary_json(setup, summary, replay_difference ? &*replay_difference : nullptr);
   const bool failed = !j["ok"].get<bool>();
+  if (driven_by_plugin != nullptr) {
+    j["plugin"] = plugin_summary_json(*driven_by_plugin);
+  }
   if (stopped_by != 0) {                   // "interrupted": true says it too (run_summary_json)
     j["stopped_by"] = stop_signal_name();  // as watch, serve and device say it
   }
@@ -519,8 +621,12 @@ void add_run_command(CLI::App& app) {
       "run", "Run a scene: the haptic step at 1 kHz driven by the simulated device");
   cmd->add_option("scene", args->scene, "Scene file (JSON, see docs/scene-format.md)")->required();
   cmd->add_option("--device", args->device,
-                  "sim (the scene's own trajectory or palpation script) or sim:FILE (play a "
-                  "trajectory CSV)");
+                  "sim (the scene's own trajectory or palpation script), sim:FILE (play a "
+                  "trajectory CSV) or plugin:PATH.so (a driver, include/hapsim/device_driver.h: "
+                  "its device drives the world in real time, its frame the world's; give "
+                  "--duration)");
+  cmd->add_option("--driver-config", args->driver_config,
+                  "plugin: the string its open() gets (e.g. a serial port)");
   cmd->add_option("--duration", args->duration_s,
                   "Simulated seconds (default: the scene's run.duration_s, else until the "
                   "trajectory ends)")

@@ -71,7 +71,9 @@ RunSetup make_run_setup(SceneDescription scene, const DeviceChoice& choice,
     }
     r.script_start = teleop->trajectory.sample_at(teleop->trajectory.start_time_s());
   } else {
-    r.profile = &device_profile(scene.device.profile);
+    r.profile = choice.kind == DeviceChoice::Kind::kExternal && options.external_profile != nullptr
+                    ? options.external_profile
+                    : &device_profile(scene.device.profile);
     WorldOptions world_options;
     // Render no stiffer than the device stays stable at (CHAI3D's published maxima).
     world_options.max_stiffness_n_per_m = r.profile->max_stiffness_n_per_m;

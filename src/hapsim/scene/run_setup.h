@@ -44,6 +44,10 @@ struct RunSetupOptions {
   /// A URDF slave's collision meshes: its links' bodies (they collide with the ball and are
   /// drawn). Off: a box per link between joint origins, as for a chain without meshes.
   bool load_link_meshes = true;
+  /// DeviceChoice::kExternal: the device's own rated limits (a driver plugin's), instead of the
+  /// scene's profile: the world renders no stiffer than this device stays stable at, and
+  /// RunSetup::profile points here. Not owned; must outlive the setup. Null: the scene's.
+  const DeviceProfile* external_profile = nullptr;
 };
 
 struct RunSetup {
