@@ -23,6 +23,7 @@
 #include "hapsim/net/participant.h"
 #include "hapsim/net/scene_hash.h"
 #include "hapsim/net/scene_info.h"
+#include "hapsim/net/security_key_dir.h"
 #include "hapsim/net/served_scene.h"
 #include "hapsim/runtime/deadline_clock.h"
 #include "hapsim/runtime/haptic_loop.h"
@@ -31,12 +32,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cinttypes>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -54,6 +57,7 @@ struct DeviceArgs {
   std::string data_dir;
   DdsOptions dds;
   int device_id = 0;
+  std::string name;  // several users: which of the served scene's device hosts this is
   double duration_s = std::numeric_limits<double>::quiet_NaN();  // NaN: until stopped
   std::string force_mode = "local-model";
   std::string finger_map;
@@ -70,6 +74,9 @@ constexpr std::int64_t kSilentAfter_ns = 200'000'000;
 // restarted serve takes seconds to load anyway, and a loaded machine can starve the DDS receive
 // thread for a few hundred ms (seen: 200 ms with both cores busy) without the host being gone.
 constexpr std::int64_t kOtherHostAfter_ns = 1'000'000'000;
+// Models answering another host on this device id, and none answering us: the id (the name) is
+// taken by a host the simulation follows. 100 models: a tenth of a second of a one-tool session.
+constexpr std::uint64_t kTakenAfterModels = 100;
 
 // "--finger-map 0:2,1:3": the scene's finger 0 drives the device's finger 2, and so on; fingers
 // not named keep their number.
@@ -96,18 +103,70 @@ std::array<int, kMaxFingers> parse_finger_map(const std::string& text) {
   return map;
 }
 
-net::ServedScene served_scene(const net::SceneInfoSample& info,
-                              const std::array<int, kMaxFingers>& finger_map) {
-  net::ServedScene s;
+// This host's part of a served scene: the whole of a one-user scene, or the tools of the device
+// host it is named for (or the first one, when no name is given).
+struct OwnPart {
+  net::ServedScene scene;
+  std::uint16_t device_id = 0;
+  std::string name;  // "" for a one-user scene
+  std::vector<std::string> other_names;
+};
+
+// Throws CommandError when --name does not fit the served scene.
+OwnPart own_part(const net::SceneInfoSample& info, const DeviceArgs& args,
+                 const std::array<int, kMaxFingers>& finger_map) {
+  std::vector<net::ServedDeviceHost> hosts;
+  try {
+    hosts = net::served_device_hosts(info);
+  } catch (const Error& e) {
+    if (!args.name.empty()) {
+      throw CommandError("--name " + args.name + ": the served scene does not read here (" +
+                         e.what() + ")");
+    }
+  }
+  OwnPart part;
+  part.device_id = static_cast<std::uint16_t>(args.device_id);
+  net::ServedScene& s = part.scene;
   s.scene_hash = info.scene_hash;
   s.serve_id = info.serve_id;
   s.tool_count = info.tool_count;
+  std::array<int, kMaxFingers> fingers{};
   for (std::size_t t = 0; t < kMaxFingers; ++t) {
-    const int finger = info.tool_finger[t];
-    s.tool_finger[t] =
-        static_cast<std::int16_t>(finger >= 0 ? finger_map[static_cast<std::size_t>(finger)] : -1);
+    fingers[t] = info.tool_finger[t];
   }
-  return s;
+  if (hosts.empty() && !args.name.empty()) {
+    throw CommandError("--name " + args.name + ": the served scene (" + info.scene_file +
+                       ") has one user and names no device hosts: start without --name");
+  }
+  if (!hosts.empty()) {
+    std::string names;
+    for (const net::ServedDeviceHost& h : hosts) {
+      names += (names.empty() ? "'" : ", '") + h.name + "'";
+    }
+    const auto it = args.name.empty()
+                        ? hosts.begin()
+                        : std::find_if(hosts.begin(), hosts.end(),
+                                       [&](const auto& h) { return h.name == args.name; });
+    if (it == hosts.end()) {
+      throw CommandError("--name " + args.name + ": the served scene (" + info.scene_file +
+                         ") has device hosts " + names + ", not this one");
+    }
+    part.name = it->name;
+    part.device_id = it->device_id;
+    s.tool_count = static_cast<std::uint16_t>(it->tool_finger.size());
+    std::copy(it->tool_finger.begin(), it->tool_finger.end(), fingers.begin());
+    for (const net::ServedDeviceHost& h : hosts) {
+      if (h.name != part.name) {
+        part.other_names.push_back(h.name);
+      }
+    }
+  }
+  for (std::size_t t = 0; t < kMaxFingers; ++t) {
+    const int finger = fingers[t];
+    s.tool_finger[t] = static_cast<std::int16_t>(
+        finger >= 0 && finger < kMaxFingers ? finger_map[static_cast<std::size_t>(finger)] : -1);
+  }
+  return part;
 }
 
 // The newest SceneInfo that arrived (nullopt: none since the last call); a bad one is said once.
@@ -247,15 +306,33 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     exit_status() = stopped_by_signal_status();
     return;
   }
-  std::printf("serving      %s (hash %016" PRIx64 "), %u tool(s)\n", info->scene_file.c_str(),
-              info->scene_hash, static_cast<unsigned>(info->tool_count));
+  const OwnPart part = own_part(*info, args, finger_map);
+  std::printf("serving      %s (hash %016" PRIx64 "), %u tool(s) for this host\n",
+              info->scene_file.c_str(), info->scene_hash,
+              static_cast<unsigned>(part.scene.tool_count));
+  if (!part.name.empty()) {
+    std::string others;
+    for (const std::string& other : part.other_names) {
+      others += (others.empty() ? "'" : ", '") + other + "'";
+    }
+    std::printf("user         '%s' (device id %u)%s%s%s\n", part.name.c_str(),
+                static_cast<unsigned>(part.device_id),
+                others.empty() ? "" : "; also in the world: ", others.c_str(),
+                args.name.empty() ? " (the scene's first device host: --name NAME chooses)" : "");
+  }
   if (sim) {
     host = open_sim_device(args, *info);
+    if (!part.name.empty() && part.device_id != info->device_id && args.scene.empty()) {
+      std::printf(
+          "note         the served scene's script moves its first user's tools; '%s' "
+          "plays it too (give this host its own with --scene FILE)\n",
+          part.name.c_str());
+    }
   }
   const DeviceProfile& profile = host.device->profile();
 
   net::DeviceHostOptions options;
-  options.device_id = static_cast<std::uint16_t>(args.device_id);
+  options.device_id = part.device_id;
   options.mode = mode;
   // A glove has no tip actuator (its tip rating is 0): its tools are on fingers, and a tool on
   // none is held to the finger rating too (the device's own clamp has the last word).
@@ -274,7 +351,7 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     options.passivity.max_damping_n_s_per_m = profile.max_damping_n_s_per_m;
   }
   net::DeviceHostClient client(participant, options);
-  client.set_scene(served_scene(*info, finger_map));
+  client.set_scene(part.scene);
 
   HapticLoopOptions loop_options;
   loop_options.period_s = 0.001;
@@ -311,6 +388,7 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
   std::optional<net::SceneInfoSample> other;
   std::uint64_t other_said = serve_id;
   std::uint64_t other_hosts = 0;
+  bool taken = false;
   while (loop.running() && !stop.load(std::memory_order_relaxed)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
     if (auto fresh = take_said(info_in); fresh && fresh->serve_id != serve_id) {
@@ -319,13 +397,39 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     const net::DeviceHostStatus s = client.status();
     const std::int64_t now_ns = monotonic_ns();
     const bool alive = s.last_model_ns != 0 && now_ns - s.last_model_ns < kSilentAfter_ns;
+    // Taken: the simulation answers another host on this device id (the same name), never us.
+    if (s.models_accepted == 0 && s.models_other_device_host >= kTakenAfterModels) {
+      taken = true;
+      break;
+    }
     if (other && (s.last_model_ns == 0 || now_ns - s.last_model_ns >= kOtherHostAfter_ns)) {
       serve_id = other->serve_id;
       std::printf("simulation   host restarted: %s (hash %016" PRIx64 ")%s\n",
                   other->scene_file.c_str(), other->scene_hash,
                   other->scene_hash != info->scene_hash ? ", another scene" : "");
       std::fflush(stdout);
-      client.set_scene(served_scene(*other, finger_map));
+      std::optional<OwnPart> next;
+      try {
+        next = own_part(*other, args, finger_map);
+      } catch (const CommandError& e) {
+        std::printf("simulation   its scene has no place for this host (%s): rendering nothing\n",
+                    e.what());
+      }
+      if (next && next->device_id != part.device_id) {
+        std::printf(
+            "simulation   its scene gives this host device id %u, not %u: rendering "
+            "nothing (restart hapsim device)\n",
+            static_cast<unsigned>(next->device_id), static_cast<unsigned>(part.device_id));
+        next.reset();
+      }
+      if (!next) {
+        next = part;
+        next->scene = net::ServedScene{};
+        next->scene.scene_hash = other->scene_hash;
+        next->scene.serve_id = other->serve_id;  // no tools: nothing rendered
+      }
+      std::fflush(stdout);
+      client.set_scene(next->scene);
       other.reset();
     } else if (other && other->serve_id != other_said) {
       other_said = other->serve_id;
@@ -371,6 +475,14 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     }
   }
   loop.stop();
+  if (taken) {
+    const std::string who = part.name.empty() ? "device id " + std::to_string(part.device_id)
+                                              : "device host '" + part.name + "' (device id " +
+                                                    std::to_string(part.device_id) + ")";
+    throw CommandError(who + " is taken on session '" + args.dds.session +
+                       "': the simulation host answers another device host there (stop it, or "
+                       "start this one with another --name)");
+  }
 
   const HapticLoopStatus st = loop.status();
   const net::DeviceHostStatus s = client.status();
@@ -406,6 +518,11 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     j["clamped_cycles"] = st.clamped_cycles;
     j["models_rendered"] = s.models_accepted;
     j["models_not_ours"] = s.models_not_ours;
+    j["models_for_another_host"] = s.models_other_device_host;
+    if (!part.name.empty()) {
+      j["name"] = part.name;
+      j["device_id"] = part.device_id;
+    }
     for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
       j["models"][net::verdict_name(static_cast<net::SampleVerdict>(v))] = s.verdicts[v];
     }
@@ -455,8 +572,14 @@ void add_device_command(CLI::App& app) {
                   "sim: play this scene's script instead of the served scene's");
   cmd->add_option("--data", args->data_dir,
                   "sim: the scene's data folder (default: the simulation host's)");
-  cmd->add_option("--device-id", args->device_id, "This device's id (default 0)")
-      ->check(CLI::Range(0, 65535));
+  CLI::Option* id_option =
+      cmd->add_option("--device-id", args->device_id, "This device's id (default 0)")
+          ->check(CLI::Range(0, 65535));
+  cmd->add_option("--name", args->name,
+                  "Several users in one world: which of the served scene's device hosts this is "
+                  "(its tools' \"device_host\"; default: the first); a name another host holds "
+                  "is refused")
+      ->excludes(id_option);
   cmd->add_option("--duration", args->duration_s,
                   "Seconds to run the loop, and the longest wait for a simulation host "
                   "(default: until stopped)")
@@ -479,6 +602,16 @@ void add_device_command(CLI::App& app) {
   add_dds_options(cmd, args->dds, net::SecurityRole::kDevice);
   cmd->callback([args] {
     (void)net::session_partition(args->dds.session);
+    // Secure, a named host joins as the device identity of its name when DIR has one (hapsim
+    // keys add-device trainee), so each user's device is its own identity.
+    if (args->dds.secure() && args->dds.identity.empty() && !args->name.empty()) {
+      const net::SecurityKeyDir keys(args->dds.secure_dir);
+      std::error_code ec;
+      if (std::filesystem::is_directory(keys.identity(args->name), ec) &&
+          net::read_role(keys, args->name) == net::role_name(net::SecurityRole::kDevice)) {
+        args->dds.identity = args->name;
+      }
+    }
     run_device(*args);
   });
 }

@@ -17,6 +17,7 @@
 #include "json_output.h"
 #include "stop_signal.h"
 
+#include "hapsim/device/absent_device.h"
 #include "hapsim/net/command_receiver.h"
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/legacy_force_udp.h"
@@ -92,16 +93,30 @@ std::string read_text(const std::string& path) {
 // Off the haptic thread: publishes the newest snapshot for viewers at the view rate, acts on the
 // commands viewers and operators send (net/command_receiver.h) and prints every change of who
 // drives the world and every command, until `done`.
+// One device host of the served world: its link and what the summary calls it.
+struct ServedHost {
+  std::string name;  // the scene's device_host name ("" for a one-user scene)
+  std::uint16_t device_id = 0;
+  std::unique_ptr<Device> absent;  // the fallback of another user's device (k > 0)
+  std::unique_ptr<net::RemoteDevice> link;
+};
+
+// "device host" or "device host 'trainee'", for the lines that name one.
+std::string host_label(const ServedHost& host) {
+  return host.name.empty() ? std::string("device host") : "device host '" + host.name + "'";
+}
+
 class ServeMonitor {
  public:
   ServeMonitor(const net::Participant& participant, const World& world, std::uint64_t hash,
-               std::uint64_t serve_id, const net::RemoteDevice& device, double view_rate_hz)
+               std::uint64_t serve_id, const std::vector<ServedHost>& hosts, double view_rate_hz)
       : views_out_(participant),
         encoder_(world),
         commands_(participant, world, hash, serve_id),
         hash_(hash),
         serve_id_(serve_id),
-        device_(device),
+        hosts_(hosts),
+        device_(*hosts.front().link),
         period_(std::chrono::microseconds(static_cast<std::int64_t>(1e6 / view_rate_hz))) {
     for (const MaterialDescription& m : world.description().materials) {
       material_names_.push_back(m.name);
@@ -140,20 +155,35 @@ class ServeMonitor {
  private:
   void run() {
     const auto start = std::chrono::steady_clock::now();
-    std::uint64_t transitions = device_.transitions();
+    std::vector<std::uint64_t> transitions;
+    std::vector<bool> other_said(hosts_.size(), false);
+    for (const ServedHost& host : hosts_) {
+      transitions.push_back(host.link->transitions());
+    }
     while (!done_.load(std::memory_order_relaxed)) {
       std::this_thread::sleep_for(period_);
       const double t_s =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (device_.transitions() != transitions) {
-        transitions = device_.transitions();
-        std::printf("device host  %s at %.3f s\n",
-                    device_.host_driving()
-                        ? "joined: its states drive the world"
-                        : "silent: the scene's script drives the world (the device host stopped "
-                          "or its link is down)",
-                    t_s);
-        std::fflush(stdout);
+      for (std::size_t k = 0; k < hosts_.size(); ++k) {
+        const net::RemoteDevice& link = *hosts_[k].link;
+        if (link.transitions() != transitions[k]) {
+          transitions[k] = link.transitions();
+          const char* silent = k == 0 ? "silent: the scene's script drives the world (the device "
+                                        "host stopped or its link is down)"
+                                      : "silent: its tools are held, with no force (the device "
+                                        "host stopped or its link is down)";
+          std::printf("%-12s %s at %.3f s\n", host_label(hosts_[k]).c_str(),
+                      link.host_driving() ? "joined: its states drive the world" : silent, t_s);
+          std::fflush(stdout);
+        }
+        if (link.other_host_states() > 0 && !other_said[k]) {
+          other_said[k] = true;  // once: a second host keeps sending until it gives up
+          std::printf(
+              "%-12s claimed by a second host (device id %u) at %.3f s: refused while "
+              "the first one drives it\n",
+              host_label(hosts_[k]).c_str(), static_cast<unsigned>(hosts_[k].device_id), t_s);
+          std::fflush(stdout);
+        }
       }
       const std::lock_guard<std::mutex> lock(snapshots_mutex_);
       commands_.poll(client_, [&](const net::CommandEvent& event) {
@@ -188,7 +218,8 @@ class ServeMonitor {
   std::uint64_t refused_materials_ = 0;
   std::uint64_t hash_;
   std::uint64_t serve_id_;
-  const net::RemoteDevice& device_;
+  const std::vector<ServedHost>& hosts_;
+  const net::RemoteDevice& device_;  // device 0's: its host drives the step
   std::chrono::microseconds period_;
   std::mutex snapshots_mutex_;  // the monitor's thread and run_session's (off the haptic one)
   TripleBuffer<WorldSnapshot>* snapshots_ = nullptr;
@@ -240,11 +271,36 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   const std::uint64_t hash = net::scene_hash(world.content_hash());
   const std::uint64_t serve_id = net::draw_serve_id();
   const auto device_id = static_cast<std::uint16_t>(args.device_id);
-  const std::size_t tools = std::min<std::size_t>(world.description().tools.size(), kMaxFingers);
-  if (world.description().tools.size() > tools) {
-    std::printf("note         %zu tools: models are served for the first %zu (one per finger)\n",
-                world.description().tools.size(), tools);
+  // Several users: one device host per name the scene's tools give, with ids from --device-id
+  // on in the scene's order (hapsim device --name NAME finds its own).
+  const std::vector<std::string>& host_names = world.description().device_hosts;
+  const std::size_t host_count = std::max<std::size_t>(1, host_names.size());
+  if (args.device_id + host_count - 1 > 65535) {
+    throw CommandError("--device-id " + std::to_string(args.device_id) + ": the scene's " +
+                       std::to_string(host_count) + " device hosts need ids up to 65535");
   }
+  if (host_count > 1 && !args.record_path.empty()) {
+    throw CommandError("--record " + args.record_path + ": " + args.scene + " has " +
+                       std::to_string(host_count) +
+                       " device hosts, and a recording holds one device's input (record a "
+                       "one-user scene)");
+  }
+  // Per device, the tools it moves (models for the first kMaxFingers: one key per finger).
+  std::vector<std::vector<std::size_t>> host_tools(host_count);
+  for (std::size_t t = 0; t < world.description().tools.size(); ++t) {
+    host_tools[static_cast<std::size_t>(world.description().tools[t].device)].push_back(t);
+  }
+  for (std::size_t k = 0; k < host_count; ++k) {
+    if (host_tools[k].size() > static_cast<std::size_t>(kMaxFingers)) {
+      std::printf(
+          "note         %zu tools on %s: models are served for the first %d (one per "
+          "finger)\n",
+          host_tools[k].size(), host_names.empty() ? "the device" : host_names[k].c_str(),
+          kMaxFingers);
+      host_tools[k].resize(static_cast<std::size_t>(kMaxFingers));
+    }
+  }
+  const std::size_t tools = host_tools[0].size();  // device 0's: what SceneInfo describes
 
   net::DdsDomain domain(args.dds.domain, HAPSIM_DEFAULT_DDS_CONFIG, args.dds.network());
   // A secure serve signs what it records, as its identity: its key is checked now, not after the
@@ -254,7 +310,18 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
     signer.emplace(net::SecurityKeyDir(args.dds.secure_dir), args.dds.identity_name());
   }
   net::Participant participant(args.dds.domain, args.dds.session);
-  net::RemoteDevice remote(participant, device_id, hash, *setup.device);
+  std::vector<ServedHost> hosts(host_count);
+  for (std::size_t k = 0; k < host_count; ++k) {
+    ServedHost& host = hosts[k];
+    host.name = host_names.empty() ? std::string() : host_names[k];
+    host.device_id = static_cast<std::uint16_t>(device_id + k);
+    if (k > 0) {
+      host.absent = std::make_unique<AbsentDevice>(*setup.profile);
+    }
+    host.link = std::make_unique<net::RemoteDevice>(participant, host.device_id, hash,
+                                                    k == 0 ? *setup.device : *host.absent);
+  }
+  net::RemoteDevice& remote = *hosts[0].link;
   double lockstep_s = args.lockstep_us * 1e-6;
   if (lockstep_s > 0.9 / args.rate_hz) {
     lockstep_s = 0.9 / args.rate_hz;
@@ -264,7 +331,9 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
         args.lockstep_us, args.rate_hz, lockstep_s * 1e6);
   }
   if (link) {
-    remote.set_link_shim(*link);
+    for (ServedHost& host : hosts) {
+      host.link->set_link_shim(*link);
+    }
     if (lockstep_s > 0.0) {
       lockstep_s = 0.0;
       std::printf(
@@ -274,7 +343,11 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
     std::printf("link shim    on the device states received: %s\n", args.link_shim.c_str());
   }
   remote.set_lockstep_wait(lockstep_s);
-  net::LocalModelPublisher publisher(participant, world, remote, device_id, hash, tools);
+  std::vector<net::RemoteDevice*> links;
+  for (ServedHost& host : hosts) {
+    links.push_back(host.link.get());
+  }
+  net::LocalModelPublisher publisher(participant, world, links, device_id, hash);
   std::unique_ptr<net::LegacyForceUdpSender> legacy;
   if (!args.legacy_force_udp.empty()) {
     const DeviceProfile& profile = *setup.profile;
@@ -289,7 +362,7 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
         legacy->destination().host.c_str(), static_cast<unsigned>(legacy->destination().port),
         profile.max_finger_force_n);
   }
-  ServeMonitor monitor(participant, world, hash, serve_id, remote, args.view_rate_hz);
+  ServeMonitor monitor(participant, world, hash, serve_id, hosts, args.view_rate_hz);
 
   // What this host serves, once: reliable and transient-local, so a late joiner gets it.
   net::SceneInfoSample info;
@@ -299,7 +372,8 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   info.device_id = device_id;
   info.tool_count = static_cast<std::uint16_t>(tools);
   for (std::size_t t = 0; t < tools; ++t) {
-    info.tool_finger[t] = static_cast<std::int16_t>(world.description().tools[t].finger);
+    info.tool_finger[t] =
+        static_cast<std::int16_t>(world.description().tools[host_tools[0][t]].finger);
   }
   info.scene_file = args.scene;
   info.scene_json = read_text(args.scene);
@@ -310,7 +384,17 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   }
 
   std::printf("serve        %s, %zu tool(s), scene hash %016" PRIx64 ", at %.0f Hz\n",
-              args.scene.c_str(), tools, hash, args.rate_hz);
+              args.scene.c_str(), world.description().tools.size(), hash, args.rate_hz);
+  for (std::size_t k = 0; k < host_count && !host_names.empty(); ++k) {
+    std::string tool_names;
+    for (const std::size_t t : host_tools[k]) {
+      tool_names += (tool_names.empty() ? "" : ", ") + world.description().tools[t].name;
+    }
+    std::printf("user         '%s': device id %u, tools %s (hapsim device --name %s)%s\n",
+                hosts[k].name.c_str(), static_cast<unsigned>(hosts[k].device_id),
+                tool_names.c_str(), hosts[k].name.c_str(),
+                k == 0 ? "; the scene's script moves them until its host joins" : "");
+  }
   std::printf("dds          domain %d, session '%s' (partition %s), config %s\n", args.dds.domain,
               args.dds.session.c_str(), participant.partition().c_str(), domain.config().c_str());
   if (domain.secure()) {
@@ -400,13 +484,20 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   std::printf("published    %" PRIu64 " local models (%" PRIu64 " refused by DDS), %" PRIu64
               " view states\n",
               publisher.published(), publisher.refused_writes(), monitor.views_published());
-  std::printf("device host  drove %" PRIu64 " of %zu cycles (lockstep: waited in %" PRIu64
-              ", %" PRIu64 " ran out); peak force it rendered %.3f N; states:",
-              remote.cycles_driven(), summary.steps, remote.lockstep_waits(),
-              remote.lockstep_timeouts(), publisher.peak_rendered_force_n());
-  for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
-    std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
-                verdicts[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
+  for (std::size_t k = 0; k < host_count; ++k) {
+    const net::RemoteDevice& host_link = *hosts[k].link;
+    const net::VerdictCounts host_verdicts = host_link.verdicts();
+    std::printf("%-12s drove %" PRIu64 " of %zu cycles", host_label(hosts[k]).c_str(),
+                host_link.cycles_driven(), summary.steps);
+    if (k == 0) {
+      std::printf(" (lockstep: waited in %" PRIu64 ", %" PRIu64 " ran out)",
+                  host_link.lockstep_waits(), host_link.lockstep_timeouts());
+    }
+    std::printf("; peak force it rendered %.3f N; states:", publisher.peak_rendered_force_n(k));
+    for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
+      std::printf(" %s %" PRIu64 "%s", net::verdict_name(static_cast<net::SampleVerdict>(v)),
+                  host_verdicts[v], v + 1 < net::kSampleVerdicts ? "," : "\n");
+    }
   }
   const net::VerdictCounts& commands = monitor.command_verdicts();
   const std::uint64_t commands_received = std::accumulate(commands.begin(), commands.end(), 0ULL);
@@ -447,6 +538,29 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
       j["serve"]["commands"][verdict] = commands[v];
     }
     j["serve"]["refused_material_changes"] = monitor.refused_material_changes();
+    if (!host_names.empty()) {
+      // Several users: each host's share, its tools' forces are under "tools" by name.
+      nlohmann::json per_host = nlohmann::json::array();
+      for (std::size_t k = 0; k < host_count; ++k) {
+        const net::RemoteDevice& host_link = *hosts[k].link;
+        nlohmann::json h = {{"name", hosts[k].name},
+                            {"device_id", hosts[k].device_id},
+                            {"cycles_driven", host_link.cycles_driven()},
+                            {"peak_rendered_force_n", publisher.peak_rendered_force_n(k)},
+                            {"second_host_states_refused", host_link.other_host_states()}};
+        h["tools"] = nlohmann::json::array();
+        for (const std::size_t t : host_tools[k]) {
+          h["tools"].push_back(world.description().tools[t].name);
+        }
+        const net::VerdictCounts host_verdicts = host_link.verdicts();
+        for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
+          h["device_states"][net::verdict_name(static_cast<net::SampleVerdict>(v))] =
+              host_verdicts[v];
+        }
+        per_host.push_back(h);
+      }
+      j["serve"]["device_hosts"] = per_host;
+    }
     if (recorder) {
       j["serve"]["recording"] = args.record_path;
       j["serve"]["recording_frames"] = recorder->frames_written();

@@ -38,18 +38,20 @@ struct BadSample {
 
 std::vector<BadSample> bad_samples() {
   std::vector<BadSample> bad;
-  hapsim_msg_LocalModel m = message_for(kCount + 1);
+  hapsim_msg_LocalModel m = message_for(kCount + 2);
   m.f0_n[0] = std::numeric_limits<double>::quiet_NaN();
   bad.push_back({m, SampleVerdict::kMalformed});
-  m = message_for(kCount + 2);
+  m = message_for(kCount + 3);
   m.scene_hash ^= 0xff;
   bad.push_back({m, SampleVerdict::kOtherScene});
   m = message_for(kCount / 2);  // an old sequence arriving late
   bad.push_back({m, SampleVerdict::kOutOfOrder});
-  m = message_for(kCount + 3);
-  m.device_sequence = 0;  // answers a device state older than the gate allows
-  bad.push_back({m, SampleVerdict::kStale});
   m = message_for(kCount + 4);
+  // Answers a device state older than the gate allows: older than every good one (they answer
+  // states 2 to kCount + 1; 0 would be the simulation's own script, which has no age).
+  m.device_sequence = 1;
+  bad.push_back({m, SampleVerdict::kStale});
+  m = message_for(kCount + 5);
   m.f0_n[2] = 1e7;
   bad.push_back({m, SampleVerdict::kOutOfRange});
   for (std::size_t i = 0; i < bad.size(); ++i) {
@@ -73,7 +75,7 @@ std::vector<BadSample> bad_samples() {
     // that has not.
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     auto deadline = Clock::now();
-    for (std::uint64_t s = 1; s <= kCount; ++s) {
+    for (std::uint64_t s = 2; s <= kCount + 1; ++s) {
       writer.write(message_for(s));
       deadline += std::chrono::milliseconds(1);
       std::this_thread::sleep_until(deadline);
@@ -110,7 +112,7 @@ TEST(DdsLoopback, LocalModelsAtOneKilohertzArriveBitForBitInOrderAndBadOnesAreCo
   LocalModelLimits limits;
   limits.max_age_cycles = kCount;
   LocalModelGate gate(test::kDeviceId, test::kSceneHash, 1, limits);
-  const std::uint64_t device_sequence_now = kCount + 1;
+  const std::uint64_t device_sequence_now = kCount + 2;
   std::map<double, SampleVerdict> expected_bad;
   for (const BadSample& b : bad_samples()) {
     expected_bad[b.message.sim_time_s] = b.expected;

@@ -203,5 +203,46 @@ TEST_F(GloveHostTest, AFingerToolRendersIntoItsFingerAtTheFingersRating) {
   EXPECT_NEAR(said.rendered.finger_force_n[1], 4.0, 1e-9);
 }
 
+// Two device hosts on one device id (a second `hapsim device --name trainee`): each numbers its
+// states from its own random base, so the models answering the first host's states are the
+// second's "another host's", refused and counted, never rendered; the first renders them.
+TEST_F(DeviceHostClientTest, ASecondHostOnTheSameDeviceIdTellsTheOthersModelsFromItsOwn) {
+  DeviceHostClient second(participant, options());
+  second.set_scene(scene());
+  const Vec3 x0(0.0, 0.0, -0.001);
+  DeviceInput second_input;
+  second_input.p_world = x0;
+  for (int k = 0; k < 5; ++k) {
+    (void)cycle(x0);
+    (void)second.step(second_input, 0.001);
+  }
+  const DeviceStateSample state = newest_state();  // the first host's
+  ASSERT_GT(state.sequence, 0u);
+  models_out.write(encode_local_model(wall_model(1, state.sequence, x0), {0, 0}, kHash));
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  for (int k = 0; k < 30; ++k) {
+    (void)cycle(x0);
+    EXPECT_EQ(second.step(second_input, 0.001).force_world_n, Vec3::Zero());
+  }
+  EXPECT_EQ(client->status().models_accepted, 1u);
+  EXPECT_EQ(client->status().models_other_device_host, 0u);
+  const DeviceHostStatus s = second.status();
+  EXPECT_EQ(s.models_accepted, 0u);
+  EXPECT_EQ(s.models_other_device_host, 1u);
+  EXPECT_EQ(s.verdicts[static_cast<std::size_t>(SampleVerdict::kOtherHost)], 1u);
+}
+
+// A host's states are numbered from its own base (given here; random by default): the first
+// state is base + 1.
+TEST_F(DeviceHostClientTest, StatesAreNumberedFromTheHostsOwnBase) {
+  DeviceHostOptions o = options();
+  o.state_sequence_base = 1'000'000;
+  client.emplace(participant, o);
+  client->set_scene(scene());
+  (void)cycle(Vec3::Zero());
+  const DeviceStateSample state = newest_state();
+  EXPECT_EQ(state.sequence, 1'000'001u);
+}
+
 }  // namespace
 }  // namespace hapsim::net

@@ -139,6 +139,18 @@ TEST(LocalModelGate, AcceptsInOrderAndCountsEachReason) {
   EXPECT_STREQ(verdict_name(SampleVerdict::kStale), "stale");
 }
 
+// A model answering no device state (device sequence 0: the simulation's own script) has no age:
+// it is not stale however far the device's count is (a device host numbers its states from a
+// random base), so the host sees it for what it is, not its own, and renders nothing of it.
+TEST(LocalModelGate, AModelAnsweringTheScriptIsNeverStale) {
+  LocalModelGate gate(kDeviceId, kSceneHash, 1);
+  LocalContactModel out;
+  hapsim_msg_LocalModel script = message_for(1);
+  script.device_sequence = 0;
+  EXPECT_EQ(gate.admit(script, std::uint64_t{1} << 61, out), SampleVerdict::kAccepted);
+  EXPECT_EQ(out.device_sequence, 0u);
+}
+
 TEST(LocalModelGate, AdmittingAndCodingAllocateNothing) {
   LocalModelGate gate(kDeviceId, kSceneHash, 1);
   LocalContactModel out;

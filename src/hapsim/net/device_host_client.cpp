@@ -1,6 +1,7 @@
 #include "hapsim/net/device_host_client.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/net/scene_info.h"
 #include "hapsim/runtime/deadline_clock.h"
 
 #include <algorithm>
@@ -76,6 +77,11 @@ DeviceHostClient::DeviceHostClient(const Participant& participant, const DeviceH
     link_ = std::make_unique<LinkShim<hapsim_msg_LocalModel, kLinkCapacity>>(*options.link);
     link_epoch_s_ = static_cast<double>(monotonic_ns()) * 1e-9;
   }
+  // Drawn below 2^62, so the numbering never wraps in a session; two hosts land within a
+  // session's states of each other with odds of about 1e-9 a day.
+  sequence_base_ =
+      options.state_sequence_base != 0 ? options.state_sequence_base : (draw_serve_id() >> 2U) + 1;
+  sequence_ = sequence_base_;
 }
 
 void DeviceHostClient::set_scene(const ServedScene& scene) noexcept {
@@ -142,6 +148,15 @@ void DeviceHostClient::admit_model(const hapsim_msg_LocalModel& m, double now_s,
       now_ns - followed_seen_ns_ < silent_ns) {
     verdicts_[static_cast<std::size_t>(SampleVerdict::kOtherHost)].fetch_add(
         1, std::memory_order_relaxed);
+    return;
+  }
+  // A model for this device id that answers a state this host never sent: another device host
+  // on the same id (the same name) sends states, and the simulation answers that host.
+  if (m.device_id == options_.device_id && m.device_sequence != 0 &&
+      (m.device_sequence <= sequence_base_ || m.device_sequence > sequence_)) {
+    verdicts_[static_cast<std::size_t>(SampleVerdict::kOtherHost)].fetch_add(
+        1, std::memory_order_relaxed);
+    models_other_device_host_.fetch_add(1, std::memory_order_relaxed);
     return;
   }
   LocalContactModel model;
@@ -213,7 +228,8 @@ const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_
   apply_scene();
   ++sequence_;
   const Vec3 p_m = input.p_world.allFinite() ? input.p_world : p_previous_m_;
-  v_m_per_s_ = sequence_ > 1 && dt_s > 0.0 ? Vec3((p_m - p_previous_m_) / dt_s) : Vec3::Zero();
+  v_m_per_s_ = sequence_ > sequence_base_ + 1 && dt_s > 0.0 ? Vec3((p_m - p_previous_m_) / dt_s)
+                                                            : Vec3::Zero();
   p_previous_m_ = p_m;
   p_history_m_[sequence_ % kHistory] = p_m;
   took_model_ = false;
@@ -291,6 +307,7 @@ DeviceHostStatus DeviceHostClient::status() const noexcept {
   s.states_published = states_published_.load(std::memory_order_relaxed);
   s.models_accepted = models_accepted_.load(std::memory_order_relaxed);
   s.models_not_ours = models_not_ours_.load(std::memory_order_relaxed);
+  s.models_other_device_host = models_other_device_host_.load(std::memory_order_relaxed);
   for (std::size_t v = 0; v < kSampleVerdicts; ++v) {
     s.verdicts[v] = verdicts_[v].load(std::memory_order_relaxed);
   }

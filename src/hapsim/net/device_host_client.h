@@ -56,6 +56,10 @@ struct DeviceHostOptions {
   /// `--link-shim`: received models go through a simulated link first (its clock: this host's
   /// seconds since the client was made). Empty: none.
   std::optional<LinkShimOptions> link;
+  /// The sequence this host numbers its states from (the first state is one more). 0: drawn at
+  /// random, so a second host on the same device id (a name already taken) tells the models
+  /// answering the other's states from its own (DeviceHostStatus::models_other_device_host).
+  std::uint64_t state_sequence_base = 0;
 };
 
 /// `options.render` with a finger actuator's rating as its force limit (when one is given).
@@ -79,6 +83,10 @@ struct DeviceHostStatus {
   std::uint64_t models_accepted = 0;
   /// Models answering no state of this host (the simulation's script), not rendered.
   std::uint64_t models_not_ours = 0;
+  /// Models for this device id answering states another device host sent (this host's device
+  /// id, or its name, is taken by another host that the simulation follows); refused, counted
+  /// under kOtherHost too.
+  std::uint64_t models_other_device_host = 0;
   VerdictCounts verdicts{};
   /// monotonic_ns() of the newest accepted model and of the last cycle with a non-zero force
   /// (0: never).
@@ -157,6 +165,7 @@ class DeviceHostClient final : public HapticClient {
   /// monotonic_ns() when each state went out (by sequence), and whether a model answered it.
   std::array<std::int64_t, kHistory> state_sent_ns_{};
   std::array<bool, kHistory> answered_{};
+  std::uint64_t sequence_base_ = 0;  ///< states are numbered from sequence_base_ + 1
   std::uint64_t sequence_ = 0;
   /// The simulation host followed: the writer of the first model accepted for the current scene,
   /// until it is silent for the renderer's fade (0: none yet). Another writer's models meanwhile
@@ -173,6 +182,7 @@ class DeviceHostClient final : public HapticClient {
   std::atomic<std::uint64_t> states_published_{0};
   std::atomic<std::uint64_t> models_accepted_{0};
   std::atomic<std::uint64_t> models_not_ours_{0};
+  std::atomic<std::uint64_t> models_other_device_host_{0};
   std::array<std::atomic<std::uint64_t>, kSampleVerdicts> verdicts_{};
   std::atomic<std::int64_t> last_model_ns_{0};
   std::atomic<std::int64_t> last_force_ns_{0};

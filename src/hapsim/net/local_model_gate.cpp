@@ -82,7 +82,9 @@ SampleVerdict LocalModelGate::check(const hapsim_msg_LocalModel& m,
   if (has_newest_[finger] && m.model_sequence <= newest_sequence_[finger]) {
     return SampleVerdict::kOutOfOrder;
   }
-  if (device_sequence_now - m.device_sequence > limits_.max_age_cycles) {
+  // Sequence 0 answers no device state (the simulation's own script): no age to tell; the
+  // device host counts it as not its own and renders nothing of it.
+  if (m.device_sequence != 0 && device_sequence_now - m.device_sequence > limits_.max_age_cycles) {
     return SampleVerdict::kStale;
   }
   return SampleVerdict::kAccepted;

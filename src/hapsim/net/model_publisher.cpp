@@ -7,19 +7,30 @@
 namespace hapsim::net {
 
 LocalModelPublisher::LocalModelPublisher(const Participant& participant, const World& world,
-                                         RemoteDevice& device, std::uint16_t device_id,
-                                         std::uint64_t scene_hash, std::size_t tools,
+                                         std::span<RemoteDevice* const> devices,
+                                         std::uint16_t first_device_id, std::uint64_t scene_hash,
                                          LocalModelBuildOptions options)
     : writer_(participant),
       builder_(world.model(), options),
-      device_(device),
-      device_id_(device_id),
+      first_device_id_(first_device_id),
       scene_hash_(scene_hash),
-      models_(std::min<std::size_t>(tools, kMaxFingers)) {
-  for (const ToolDescription& tool : world.description().tools) {
-    tool_finger_.push_back(tool.finger);
+      devices_(std::min<std::size_t>(devices.size(), kMaxWorldDevices)) {
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    devices_[k].link = devices[k];
   }
-  rendered_push_n_.assign(tool_finger_.size(), std::numeric_limits<double>::quiet_NaN());
+  const std::vector<ToolDescription>& tools = world.description().tools;
+  for (std::size_t t = 0; t < tools.size(); ++t) {
+    const auto k = static_cast<std::size_t>(tools[t].device);
+    if (k < devices_.size() && devices_[k].tools.size() < static_cast<std::size_t>(kMaxFingers)) {
+      devices_[k].tools.push_back(t);
+      devices_[k].finger.push_back(tools[t].finger);
+    }
+  }
+  for (DeviceTools& d : devices_) {
+    d.push_n.assign(d.tools.size(), std::numeric_limits<double>::quiet_NaN());
+  }
+  models_.resize(tools.size());
+  rendered_push_n_.assign(tools.size(), std::numeric_limits<double>::quiet_NaN());
 }
 
 // haptic path
@@ -44,12 +55,35 @@ void rendered_push_per_tool(const DeviceCommand& rendered, std::span<const int> 
 
 // haptic path
 void LocalModelPublisher::before_step(World& world) noexcept {
-  if (device_.take_source_switch()) {
-    world.restart_tools();  // a 1 m teleport: never drag the proxies across the body
+  bool any_driving = false;
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    RemoteDevice& link = *devices_[k].link;
+    if (k > 0) {
+      // Device 0 is the step's own input (the session reads it); the others' are read here.
+      world.set_device_input(static_cast<int>(k), link.read(world.state().time_s));
+    }
+    if (link.take_source_switch()) {
+      // A 1 m teleport: never drag the proxies across the body. One user: every tool.
+      if (devices_.size() == 1) {
+        world.restart_tools();
+      } else {
+        world.restart_tools(static_cast<int>(k));
+      }
+    }
+    any_driving = any_driving || link.host_driving();
   }
-  // SPEC §8: the tissue gives way to what the device host rendered, while it drives the tools.
-  if (device_.host_driving()) {
-    rendered_push_per_tool(device_.host_state().rendered, tool_finger_, rendered_push_n_);
+  // SPEC §8: the tissue gives way to what each device host rendered, while it drives its tools.
+  if (any_driving) {
+    for (DeviceTools& d : devices_) {
+      if (d.link->host_driving()) {
+        rendered_push_per_tool(d.link->host_state().rendered, d.finger, d.push_n);
+      } else {
+        std::fill(d.push_n.begin(), d.push_n.end(), std::numeric_limits<double>::quiet_NaN());
+      }
+      for (std::size_t i = 0; i < d.tools.size(); ++i) {
+        rendered_push_n_[d.tools[i]] = d.push_n[i];
+      }
+    }
     world.set_rendered_push(rendered_push_n_);
   }
 }
@@ -59,18 +93,21 @@ void LocalModelPublisher::after_step(const World& world, const HapticCycle& cycl
   if (legacy_ != nullptr && cycle.output != nullptr) {
     (void)legacy_->send_command(*cycle.output, legacy_finger_max_n_);  // failures are counted
   }
-  const bool driving = device_.host_driving();
-  builder_.build(world.state(), ++sequence_, driving ? device_.host_state().sequence : 0, models_);
+  builder_.build(world.state(), ++sequence_, 0, models_);
   write_models();
-  if (driving) {
-    const DeviceCommand& rendered = device_.host_state().rendered;
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    const RemoteDevice& link = *devices_[k].link;
+    if (!link.host_driving()) {
+      continue;
+    }
+    const DeviceCommand& rendered = link.host_state().rendered;
     double peak = rendered.force_world_n.allFinite() ? rendered.force_world_n.norm() : 0.0;
     for (int f = 0; f < std::min(rendered.finger_count, kMaxFingers); ++f) {
       const double finger_n = rendered.finger_force_n[static_cast<std::size_t>(f)];
       peak = std::isfinite(finger_n) ? std::max(peak, finger_n) : peak;
     }
-    if (peak > peak_rendered_n_.load(std::memory_order_relaxed)) {
-      peak_rendered_n_.store(peak, std::memory_order_relaxed);
+    if (peak > peak_rendered_n_[k].load(std::memory_order_relaxed)) {
+      peak_rendered_n_[k].store(peak, std::memory_order_relaxed);
     }
   }
 }
@@ -79,11 +116,9 @@ void LocalModelPublisher::after_step(const World& world, const HapticCycle& cycl
 void LocalModelPublisher::after_paused_cycle(const World& world,
                                              const HapticCycle& /*cycle*/) noexcept {
   ++sequence_;
-  const std::uint64_t answered = device_.host_driving() ? device_.host_state().sequence : 0;
   for (LocalContactModel& m : models_) {
     m = LocalContactModel{};  // invalid: free space
     m.sequence = sequence_;
-    m.device_sequence = answered;
     m.sim_time_s = world.state().time_s;
   }
   write_models();
@@ -92,14 +127,22 @@ void LocalModelPublisher::after_paused_cycle(const World& world,
 // haptic path
 void LocalModelPublisher::write_models() noexcept {
   std::uint64_t written = 0;
-  for (std::size_t t = 0; t < models_.size(); ++t) {
-    written += writer_.write(encode_local_model(
-                   models_[t], {device_id_, static_cast<std::uint16_t>(t)}, scene_hash_))
-                   ? 1
-                   : 0;
+  std::uint64_t refused = 0;
+  for (std::size_t k = 0; k < devices_.size(); ++k) {
+    const DeviceTools& d = devices_[k];
+    const std::uint64_t answered = d.link->host_driving() ? d.link->host_state().sequence : 0;
+    const auto device_id = static_cast<std::uint16_t>(first_device_id_ + k);
+    for (std::size_t i = 0; i < d.tools.size(); ++i) {
+      LocalContactModel& m = models_[d.tools[i]];
+      m.device_sequence = answered;
+      const bool ok = writer_.write(
+          encode_local_model(m, {device_id, static_cast<std::uint16_t>(i)}, scene_hash_));
+      written += ok ? 1 : 0;
+      refused += ok ? 0 : 1;
+    }
   }
   published_.fetch_add(written, std::memory_order_relaxed);
-  refused_.fetch_add(models_.size() - written, std::memory_order_relaxed);
+  refused_.fetch_add(refused, std::memory_order_relaxed);
 }
 
 }  // namespace hapsim::net

@@ -1,8 +1,9 @@
 // The simulation host's side of each haptic cycle (`hapsim serve`): before the world steps, it
-// restarts the world's tools when the input's source changed (a device host joined or went
-// silent: the tools jump, and no proxy, velocity or stick point should survive that); after the
-// step, it builds each tool's local contact model (world/local_model_builder.h) and writes it on
-// the session's LocalModel topic, answering the device state the step used. Allocation-free.
+// restarts a device's tools when its input's source changed (a device host joined or went
+// silent: the tools jump, and no proxy, velocity or stick point should survive that) and hands
+// the world the other users' inputs; after the step, it builds each tool's local contact model
+// (world/local_model_builder.h) and writes it on the session's LocalModel topic, answering the
+// state of that tool's device host the step used. Allocation-free.
 #pragma once
 
 #include "hapsim/net/legacy_force_udp.h"
@@ -12,6 +13,7 @@
 #include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/world/local_model_builder.h"
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <span>
@@ -29,10 +31,14 @@ void rendered_push_per_tool(const DeviceCommand& rendered, std::span<const int> 
 
 class LocalModelPublisher final : public WorldCycleObserver {
  public:
-  /// Models for the first `tools` tools of `world` (at most kMaxFingers: one contact key each).
-  LocalModelPublisher(const Participant& participant, const World& world, RemoteDevice& device,
-                      std::uint16_t device_id, std::uint64_t scene_hash, std::size_t tools,
-                      LocalModelBuildOptions options = {});
+  /// Models for the tools of `world`: `devices[k]` is world device k's link (ToolDescription::
+  /// device; one per named device host, or the one device of a one-user scene). Device k's models
+  /// are keyed (first_device_id + k, the tool's index among k's tools); a device's tools beyond
+  /// kMaxFingers get none. Device 0 is the session's step input; the others' inputs are read here
+  /// each cycle (World::set_device_input). The devices must outlive the publisher.
+  LocalModelPublisher(const Participant& participant, const World& world,
+                      std::span<RemoteDevice* const> devices, std::uint16_t first_device_id,
+                      std::uint64_t scene_hash, LocalModelBuildOptions options = {});
 
   /// Also send every step's finger forces (the command after safety) as the knee paper's legacy
   /// packet, full scale `finger_max_n` (`serve --legacy-force-udp`). Not owned.
@@ -56,27 +62,37 @@ class LocalModelPublisher final : public WorldCycleObserver {
   [[nodiscard]] std::uint64_t refused_writes() const noexcept {
     return refused_.load(std::memory_order_relaxed);
   }
-  /// Largest force the device host said it rendered (tip force, or a finger's), N.
-  [[nodiscard]] double peak_rendered_force_n() const noexcept {
-    return peak_rendered_n_.load(std::memory_order_relaxed);
+  /// Largest force device `device`'s host said it rendered (tip force, or a finger's), N.
+  [[nodiscard]] double peak_rendered_force_n(std::size_t device = 0) const noexcept {
+    return device < peak_rendered_n_.size()
+               ? peak_rendered_n_[device].load(std::memory_order_relaxed)
+               : 0.0;
   }
 
  private:
+  /// One world device: its link and its tools (world index, finger).
+  struct DeviceTools {
+    RemoteDevice* link = nullptr;
+    std::vector<std::size_t> tools;  ///< world tool indices, at most kMaxFingers
+    std::vector<int> finger;
+    std::vector<double> push_n;  ///< scratch: what it rendered, per tool
+  };
+
   TopicWriter<hapsim_msg_LocalModel> writer_;
   LocalModelBuilder builder_;
-  RemoteDevice& device_;
-  std::uint16_t device_id_;
+  std::uint16_t first_device_id_;
   std::uint64_t scene_hash_;
-  std::vector<LocalContactModel> models_;
-  std::vector<int> tool_finger_;
-  std::vector<double> rendered_push_n_;  ///< per tool, for World::set_rendered_push
-  /// Writes models_ (answering `device_sequence`), counting what DDS took. haptic path
+  std::vector<DeviceTools> devices_;
+  std::vector<LocalContactModel> models_;  ///< per world tool
+  std::vector<double> rendered_push_n_;    ///< per world tool, for World::set_rendered_push
+  /// Sets each keyed tool's device_sequence (the state of its host the step used, 0: none) and
+  /// writes them. haptic path
   void write_models() noexcept;
 
   std::uint64_t sequence_ = 0;
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::uint64_t> refused_{0};
-  std::atomic<double> peak_rendered_n_{0.0};
+  std::array<std::atomic<double>, kMaxWorldDevices> peak_rendered_n_{};
   LegacyForceUdpSender* legacy_ = nullptr;
   double legacy_finger_max_n_ = 0.0;
 };

@@ -15,6 +15,7 @@ RemoteDevice::RemoteDevice(const Participant& participant, std::uint16_t device_
                            std::uint64_t scene_hash, Device& fallback, double host_timeout_s)
     : states_(participant),
       gate_(device_id, scene_hash),
+      device_id_(device_id),
       fallback_(fallback),
       host_timeout_ns_(static_cast<std::int64_t>(host_timeout_s * 1e9)),
       host_seen_ns_(std::numeric_limits<std::int64_t>::min() / 2) {
@@ -35,11 +36,24 @@ void RemoteDevice::set_link_shim(const LinkShimOptions& options) {
 }
 
 // haptic path
-bool RemoteDevice::admit_state(const hapsim_msg_DeviceState& m, std::int64_t now_ns) noexcept {
+bool RemoteDevice::admit_state(const hapsim_msg_DeviceState& m, std::int64_t now_ns,
+                               dds_instance_handle_t writer) noexcept {
+  // One host per device: a second one on this id (a name already taken) steers nothing while
+  // the first drives; it is told by the models, which answer the first host's states only.
+  if (writer != 0 && followed_writer_ != 0 && writer != followed_writer_ &&
+      m.device_id == device_id_ && now_ns - host_seen_ns_ < host_timeout_ns_) {
+    verdicts_[static_cast<std::size_t>(SampleVerdict::kOtherHost)].fetch_add(
+        1, std::memory_order_relaxed);
+    other_host_states_.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
   const SampleVerdict verdict = gate_.admit(m, host_state_);
   verdicts_[static_cast<std::size_t>(verdict)].fetch_add(1, std::memory_order_relaxed);
   if (verdict == SampleVerdict::kAccepted) {
     host_seen_ns_ = now_ns;
+    if (writer != 0) {
+      followed_writer_ = writer;
+    }
     return true;
   }
   return false;
@@ -49,8 +63,8 @@ bool RemoteDevice::admit_state(const hapsim_msg_DeviceState& m, std::int64_t now
 bool RemoteDevice::take_states(std::int64_t now_ns) noexcept {
   bool accepted = false;
   if (!link_) {
-    states_.take([&](const hapsim_msg_DeviceState& m, const dds_sample_info_t&) {
-      accepted = admit_state(m, now_ns) || accepted;
+    states_.take([&](const hapsim_msg_DeviceState& m, const dds_sample_info_t& info) {
+      accepted = admit_state(m, now_ns, info.publication_handle) || accepted;
     });
     return accepted;
   }
@@ -59,7 +73,7 @@ bool RemoteDevice::take_states(std::int64_t now_ns) noexcept {
     link_lost_.fetch_add(link_->send(m, link_s) ? 0 : 1, std::memory_order_relaxed);
   });
   (void)link_->deliver(link_s, [&](const hapsim_msg_DeviceState& m) {
-    accepted = admit_state(m, now_ns) || accepted;
+    accepted = admit_state(m, now_ns, 0) || accepted;
   });
   return accepted;
 }

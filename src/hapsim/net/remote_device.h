@@ -82,6 +82,11 @@ class RemoteDevice final : public Device {
     return cycles_driven_.load(std::memory_order_relaxed);
   }
   [[nodiscard]] VerdictCounts verdicts() const noexcept;
+  /// States for this device from a second writer while the first one drives (another device
+  /// host claiming the same device id, i.e. the same name): refused (kOtherHost).
+  [[nodiscard]] std::uint64_t other_host_states() const noexcept {
+    return other_host_states_.load(std::memory_order_relaxed);
+  }
   /// Cycles that waited for the host's state, and those the wait ran out.
   [[nodiscard]] std::uint64_t lockstep_waits() const noexcept {
     return lockstep_waits_.load(std::memory_order_relaxed);
@@ -93,10 +98,17 @@ class RemoteDevice final : public Device {
  private:
   /// True when a state was accepted.
   bool take_states(std::int64_t now_ns) noexcept;
-  bool admit_state(const hapsim_msg_DeviceState& m, std::int64_t now_ns) noexcept;
+  /// `writer`: the DDS writer it came from (0: not known, as through the link shim).
+  bool admit_state(const hapsim_msg_DeviceState& m, std::int64_t now_ns,
+                   dds_instance_handle_t writer) noexcept;
 
   TopicReader<hapsim_msg_DeviceState> states_;
   DeviceStateGate gate_;
+  std::uint16_t device_id_;
+  /// The device host followed: the writer of the first state accepted, until it is silent for
+  /// the host timeout; another writer's states for this device meanwhile are refused.
+  dds_instance_handle_t followed_writer_ = 0;
+  std::atomic<std::uint64_t> other_host_states_{0};
   Device& fallback_;
   std::int64_t host_timeout_ns_;
   std::int64_t lockstep_wait_ns_ = 0;

@@ -53,6 +53,29 @@ std::optional<SceneInfoSample> wait_for_scene_info(LoanedReader<hapsim_msg_Scene
   }
 }
 
+std::vector<ServedDeviceHost> served_device_hosts(const SceneInfoSample& info) {
+  SceneLoadOptions load;
+  load.device_trajectory_played = false;  // only the tools are read
+  if (!info.data_dir.empty()) {
+    load.data_dir = info.data_dir;
+  }
+  const SceneDescription scene = parse_scene(info.scene_json, info.scene_file, load);
+  const WorldDescription& world = scene.world;
+  std::vector<ServedDeviceHost> hosts(world.device_hosts.size());
+  for (std::size_t k = 0; k < hosts.size(); ++k) {
+    hosts[k].name = world.device_hosts[k];
+    hosts[k].device_id = static_cast<std::uint16_t>(info.device_id + k);
+  }
+  for (const ToolDescription& tool : world.tools) {
+    const auto k = static_cast<std::size_t>(tool.device);
+    if (k < hosts.size() && hosts[k].tool_names.size() < static_cast<std::size_t>(kMaxFingers)) {
+      hosts[k].tool_names.push_back(tool.name);
+      hosts[k].tool_finger.push_back(tool.finger);
+    }
+  }
+  return hosts;
+}
+
 RunSetup build_served_scene(const SceneInfoSample& info, const DeviceChoice& choice,
                             const std::string& data_dir) {
   SceneLoadOptions load;

@@ -10,6 +10,7 @@
 #include <atomic>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace hapsim::net {
 
@@ -22,6 +23,21 @@ namespace hapsim::net {
 [[nodiscard]] std::optional<SceneInfoSample> wait_for_scene_info(
     LoanedReader<hapsim_msg_SceneInfo>& reader, double timeout_s,
     const std::atomic<bool>* stop = nullptr);
+
+/// One user's device host in a served scene (SceneInfo's text): its name, its device id (the
+/// serve's first one plus its place among the scene's hosts) and its tools (at most kMaxFingers,
+/// as serve keys their models).
+struct ServedDeviceHost {
+  std::string name;
+  std::uint16_t device_id = 0;
+  std::vector<std::string> tool_names;
+  std::vector<int> tool_finger;  ///< per tool, -1: the tip
+};
+
+/// The device hosts the served scene's tools name ("device_host"), in the scene's order; empty
+/// for a one-user scene. Reads the scene's text only (no mesh is loaded). Throws hapsim::Error
+/// when the text does not parse.
+[[nodiscard]] std::vector<ServedDeviceHost> served_device_hosts(const SceneInfoSample& info);
 
 /// The served scene built here, with `choice` as its device (external for a viewer, the scene's
 /// script for a simulated device), from `data_dir` if given, else the host's. Throws

@@ -65,7 +65,8 @@ const hapsim_msg_ViewState& ViewStateEncoder::encode(const WorldSnapshot& s,
     put3(v.proxy_m, s.tools[t].proxy_world);
     put3(v.force_n, s.tools[t].force_world_n);
     v.rendered_force_n = t < s.tool_force_n.size() ? s.tool_force_n[t] : 0.0;
-    v.contact_count = s.tools[t].contact_count;
+    // -1: not in the world (ToolState::present), without a field the IDL does not have.
+    v.contact_count = s.tools[t].present ? s.tools[t].contact_count : -1;
   }
   put3(m.hand_p_m, s.hand.X_world_hand.translation());
   const Quat hand_q(s.hand.X_world_hand.linear());
@@ -235,7 +236,8 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
     s.tools[t].p_world = get3(v.p_m);
     s.tools[t].proxy_world = get3(v.proxy_m);
     s.tools[t].force_world_n = get3(v.force_n);
-    s.tools[t].contact_count = v.contact_count;
+    s.tools[t].present = v.contact_count >= 0;
+    s.tools[t].contact_count = static_cast<std::int32_t>(std::max<long>(v.contact_count, 0));
     s.tool_force_n[t] = v.rendered_force_n;
   }
   s.hand.X_world_hand = Iso3::Identity();

@@ -10,6 +10,7 @@
 #include "hapsim/render/force_scale.h"
 #include "hapsim/render/hand_figure.h"
 #include "hapsim/render/slave_figure.h"
+#include "hapsim/render/user_colour.h"
 
 #include <algorithm>
 #include <array>
@@ -584,12 +585,16 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
       std::max(0.05, rest_bounds_world_.isEmpty() ? 0.1 : rest_bounds_world_.sizes().norm());
   for (std::size_t t = 0; t < tools_.size() && t < d.tools.size(); ++t) {
     const ToolState& tool = tools_[t];
+    if (!tool.present) {
+      continue;  // another user's tool whose device host is not there
+    }
     const double f = t < tool_force_n_.size() ? tool_force_n_[t] : 0.0;
-    // Green when free (a fingertip: the hand's colour), towards red as the force grows to the
-    // display's full scale.
+    // Each user's colour when free (the first's green, or the hand's; then purple, amber, cyan),
+    // towards red as the force grows to the display's full scale.
     const float heat = static_cast<float>(std::clamp(f / heat_full_scale_n, 0.0, 1.0));
     const double radius = std::max(d.tools[t].radius_m, 0.002);
-    const Vec3f cool = has_hand_ ? kHandColour : Vec3f(0.2f, 0.8f, 0.25f);
+    const Vec3f cool = d.tools[t].device > 0 ? user_colour(d.tools[t].device)
+                                             : (has_hand_ ? kHandColour : user_colour(0));
     scene_.spheres.push_back({tool.p_world, radius,
                               Vec3f((1.0f - heat) * cool + heat * Vec3f(0.95f, 0.2f, 0.25f)),
                               false});

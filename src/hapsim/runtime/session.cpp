@@ -170,7 +170,11 @@ class SessionAccountant {
       const ToolState& tool = r.tools[t];
       ToolSummary& ts = summary_.tools[t];
       const int finger = desc.tools[t].finger;
-      const double f = finger >= 0 && finger < out.finger_count
+      // Another user's tool (device > 0) is not in this device's command: its force is what
+      // the world gave it (that user's device host applies its own safety layer).
+      const bool own = desc.tools[t].device == 0;
+      const double f = !own ? tool.force_world_n.norm()
+                       : finger >= 0 && finger < out.finger_count
                            ? out.finger_force_n[static_cast<std::size_t>(finger)]
                            : tool.force_world_n.norm() * tip_scale;
       ts.peak_force_n = std::max(ts.peak_force_n, f);
@@ -181,6 +185,17 @@ class SessionAccountant {
       // A proxy placed (the first step, or a jump: a reset, a device put down inside) inside a
       // body started there: one event, said once, not a pop-through per step until it leaves.
       const double radius = desc.tools[t].radius_m;
+      if (!own && !world_.state().tools[t].input_usable) {
+        // Not in the world (another user's device host has not joined, or left): nothing to
+        // check, and it is placed afresh when it comes.
+        if (!checks_.empty()) {
+          last_proxy_world_[t] = Vec3::Constant(kNever);
+          for (std::size_t k = 0; k < checks_.size(); ++k) {
+            proxy_inside_[k * desc.tools.size() + t] = kOutside;
+          }
+        }
+        continue;
+      }
       const bool placed = !checks_.empty() && (last_proxy_world_[t].x() == kNever ||
                                                (tool.proxy_world - last_proxy_world_[t]).norm() >
                                                    std::max(radius, kPlacementJump_m));

@@ -66,6 +66,7 @@ void safety(const WorldModel& model, WorldState& state) noexcept {
     ToolState& out = state.tool_states[t];
     // A tool whose device's input is unusable holds with no force (zero, never NaN).
     const bool usable = t < state.tools.size() && state.tools[t].input_usable;
+    out.present = d.tools[t].device == 0 || (usable && state.tools[t].placed);
     if (!usable) {
       out.contact_count = 0;
     }

@@ -123,6 +123,10 @@ struct ToolState {
   Vec3 proxy_world = Vec3::Zero();  ///< god-object position (equals p_world when free)
   Vec3 force_world_n = Vec3::Zero();
   std::int32_t contact_count = 0;
+  /// False while the tool is not in the world: another user's tool whose device host has not
+  /// joined or went silent (it has no pose; viewers leave it out). Device 0's tools are always
+  /// present (an unusable input holds them where they were).
+  bool present = true;
 };
 
 /// What a teleoperation rig did this step (world_description.h: TeleopRigDescription).
