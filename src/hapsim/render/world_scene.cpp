@@ -589,7 +589,7 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
       continue;  // another user's tool whose device host is not there
     }
     const double f = t < tool_force_n_.size() ? tool_force_n_[t] : 0.0;
-    // Each user's colour when free (the first's green, or the hand's; then purple, amber, cyan),
+    // Each user's colour when free (render/user_colour.h; the first's green, or the hand's),
     // towards red as the force grows to the display's full scale.
     const float heat = static_cast<float>(std::clamp(f / heat_full_scale_n, 0.0, 1.0));
     const double radius = std::max(d.tools[t].radius_m, 0.002);

@@ -172,7 +172,10 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
     const double tip_scale = tip_n > 0.0 ? cycle.output->force_world_n.norm() / tip_n : 0.0;
     for (std::size_t t = 0; t < tools; ++t) {
       const int finger = d.tools[t].finger;
-      s.tool_force_n[t] = finger >= 0 && finger < cycle.output->finger_count
+      // Another user's tool is not in this device's command: its force is the world's (that
+      // user's device host renders it).
+      s.tool_force_n[t] = d.tools[t].device != 0 ? r.tools[t].force_world_n.norm()
+                          : finger >= 0 && finger < cycle.output->finger_count
                               ? cycle.output->finger_force_n[static_cast<std::size_t>(finger)]
                               : r.tools[t].force_world_n.norm() * tip_scale;
     }

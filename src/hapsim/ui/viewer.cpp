@@ -9,6 +9,7 @@
 #include "hapsim/render/png_image.h"
 #include "hapsim/render/renderer.h"
 #include "hapsim/render/snapshot_writer.h"
+#include "hapsim/render/user_colour.h"
 #include "hapsim/runtime/ramp_warning.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/ui/force_graph.h"
@@ -29,6 +30,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -717,6 +719,26 @@ class Viewer {
     }
   }
 
+  // "users: trainee instructor", each in its colour (several users in one world only).
+  static void draw_user_legend(const SessionReadout& r) {
+    std::array<bool, 8> said{};
+    bool first = true;
+    for (const ToolReadout& t : r.tools) {
+      const auto k = static_cast<std::size_t>(std::clamp(t.device, 0, 7));
+      if (t.user.empty() || said[k]) {
+        continue;
+      }
+      said[k] = true;
+      if (first) {
+        ImGui::TextUnformatted("users:");
+        first = false;
+      }
+      ImGui::SameLine();
+      const Vec3f c = user_colour(t.device);
+      ImGui::TextColored(ImVec4(c.x(), c.y(), c.z(), 1.0f), "%s", t.user.c_str());
+    }
+  }
+
   void draw_data_area() {
     const SessionReadout& r = session_->readout();
     const HapticLoopStatus st = session_->loop_status();
@@ -725,13 +747,27 @@ class Viewer {
     ImGui::Separator();
     ImGui::TextUnformatted("tool            x      y      z mm    F N");
     for (const ToolReadout& t : r.tools) {
-      ImGui::Text("%-12.12s %6.1f %6.1f %6.1f %6.2f", t.name.c_str(), t.p_world.x() * 1e3,
-                  t.p_world.y() * 1e3, t.p_world.z() * 1e3, t.force_n);
+      if (!t.user.empty()) {
+        // Several users: each tool's line in its user's colour (as drawn), a legend below.
+        const Vec3f c = user_colour(t.device);
+        const ImVec4 colour(c.x(), c.y(), c.z(), 1.0f);
+        if (!t.present) {
+          ImGui::TextColored(colour, "%-12.12s (no device host)", t.name.c_str());
+          continue;
+        }
+        ImGui::TextColored(colour, "%-12.12s %6.1f %6.1f %6.1f %6.2f", t.name.c_str(),
+                           t.p_world.x() * 1e3, t.p_world.y() * 1e3, t.p_world.z() * 1e3,
+                           t.force_n);
+      } else {
+        ImGui::Text("%-12.12s %6.1f %6.1f %6.1f %6.2f", t.name.c_str(), t.p_world.x() * 1e3,
+                    t.p_world.y() * 1e3, t.p_world.z() * 1e3, t.force_n);
+      }
       if ((t.proxy_world - t.p_world).norm() > 1e-4) {
         ImGui::Text("  proxy      %6.1f %6.1f %6.1f", t.proxy_world.x() * 1e3,
                     t.proxy_world.y() * 1e3, t.proxy_world.z() * 1e3);
       }
     }
+    draw_user_legend(r);
     for (const auto& [label, value] : r.lines) {
       ImGui::TextWrapped("%s: %s", label.c_str(), value.c_str());
     }

@@ -55,6 +55,11 @@ struct ToolReadout {
   /// Force the device renders for this tool (its finger or its share of the tip force), N.
   double force_n = 0.0;
   int contacts = 0;
+  /// Several users in one world: whose tool it is (the scene's device_host, "" for one user),
+  /// the user's device index (its colour), and whether it is in the world (its host joined).
+  std::string user;
+  int device = 0;
+  bool present = true;
 };
 
 /// The newest state, for the data area and the force graph.

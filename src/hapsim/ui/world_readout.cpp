@@ -29,6 +29,10 @@ void fill_world_readout(const World& world, const WorldScene& view, const WorldS
     r.proxy_world = s.tools[t].proxy_world;
     r.force_n = s.tool_force_n[t];
     r.contacts = s.tools[t].contact_count;
+    r.device = d.tools[t].device;
+    r.user =
+        d.device_hosts.empty() ? std::string() : d.device_hosts[static_cast<std::size_t>(r.device)];
+    r.present = s.tools[t].present;
     readout.bars.emplace_back(r.name, r.force_n);
   }
   readout.contact_count = s.contact_count;
