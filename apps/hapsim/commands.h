@@ -34,9 +34,9 @@ int& exit_status();
 
 void add_info_command(CLI::App& app);
 void add_query_command(CLI::App& app);
+/// `hapsim bench ...` (bench_command.cpp): runs `hapsim-bench ...`, the benchmarks' own program
+/// beside this one (apps/hapsim-bench/), so `hapsim` links none of the benchmark oracles.
 void add_bench_command(CLI::App& app);
-/// `hapsim bench snapshot` (snapshot_bench.cpp), a subcommand of `bench`.
-void add_snapshot_bench(CLI::App& bench);
 void add_run_command(CLI::App& app);
 void add_assess_command(CLI::App& app);
 void add_view_command(CLI::App& app);

@@ -1,14 +1,9 @@
 // The `hapsim` command: one binary, one subcommand per job (info, query, bench, ...).
 // Every user-facing failure is one line on stderr and exit status 2.
+#include "cli_main.h"
 #include "commands.h"
 
-#include "hapsim/core/error.h"
-
 #include <spdlog/spdlog.h>
-
-#include <exception>
-#include <filesystem>
-#include <iostream>
 
 namespace hapsim::app {
 
@@ -44,35 +39,6 @@ int main(int argc, char** argv) {
   add_calibrate_command(app);
   add_keys_command(app);
   add_doctor_command(app);
-#ifdef HAPSIM_WITH_BENCH
   add_bench_command(app);
-#endif
-  try {
-    app.parse(argc, argv);  // subcommand callbacks run inside parse()
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "hapsim: " << e.what() << " (see hapsim --help)\n";
-    return 2;
-  } catch (const CommandError& e) {
-    std::cerr << "hapsim: " << e.what() << "\n";
-    return 2;
-  } catch (const hapsim::Error& e) {
-    std::cerr << "hapsim: " << e.what() << "\n";
-    return 2;
-  } catch (const std::filesystem::filesystem_error& e) {
-    // A path the user gave that the file system refuses (a symlink loop, an unreadable folder,
-    // a name too long) is bad input like any other: name the path and the reason.
-    const std::string path = e.path1().empty() ? std::string("a path") : e.path1().string();
-    std::cerr << "hapsim: " << path << ": " << e.code().message() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "hapsim: internal error: " << e.what() << "\n";
-    return 1;
-  }
-  return exit_status();
+  return run_cli_main(app, argc, argv, "hapsim");
 }

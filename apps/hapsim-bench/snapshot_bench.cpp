@@ -3,8 +3,7 @@
 // render scene updated from it (deformed surfaces, tools), drawn offscreen (EGL, llvmpipe where
 // there is no GPU; 4x multisampling by default, as run does), read back, and the PNG encoded.
 // Wall time per picture (median) and the CPU time of this thread and of the rasteriser's threads.
-#ifdef HAPSIM_WITH_BENCH
-
+#include "bench_commands.h"
 #include "commands.h"
 #include "snapshot_view.h"
 
@@ -129,5 +128,3 @@ void add_snapshot_bench(CLI::App& bench) {
 }
 
 }  // namespace hapsim::app
-
-#endif  // HAPSIM_WITH_BENCH

@@ -34,12 +34,13 @@
 namespace hapsim::app {
 namespace {
 
-// One child process of this binary, its output to `log`.
+// One child process of `hapsim` (beside this hapsim-bench), its output to `log`.
 class Child {
  public:
   Child(const std::vector<std::string>& args, const std::filesystem::path& log) {
-    // This very binary, whatever it was started as.
-    const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+    // The hapsim in this binary's folder, whatever this one was started as.
+    const std::string self =
+        (std::filesystem::read_symlink("/proc/self/exe").parent_path() / "hapsim").string();
     std::vector<std::string> words{self};
     words.insert(words.end(), args.begin(), args.end());
     std::vector<char*> argv;

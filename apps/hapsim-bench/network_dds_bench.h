@@ -1,5 +1,5 @@
 // `hapsim bench network --dds`: the distributed palpation over real Cyclone DDS on loopback, as
-// separate processes of this binary (serve --wait-for-device, device, and N `watch` viewers),
+// separate processes of `hapsim` (serve --wait-for-device, device, and N `watch` viewers),
 // once with no viewer and once with N: the device's round trip (a state to the first model
 // answering it), how its 1 kHz loop kept time, serve's loop, and the views each viewer got.
 // With --secure: the probe's round trip and a participant's join time, plain against secure.
