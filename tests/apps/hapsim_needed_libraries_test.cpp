@@ -99,6 +99,26 @@ TEST(HapsimLinksNoOracle, TheHapsimBinaryNeedsNoOracleLibrary) {
   EXPECT_EQ(oracle_in(needed), "") << HAPSIM_BIN_PATH << " needs: " << joined(needed);
 }
 
+// ... nor through the libraries it needs (the project's own shared libraries included): every
+// library the loader would map, as `ldd` lists them.
+TEST(HapsimLinksNoOracle, NoLibraryItLoadsIsAnOracle) {
+  const std::string cmd = "ldd " + std::string(HAPSIM_BIN_PATH) + " 2>&1";
+  std::FILE* pipe = popen(cmd.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::vector<std::string> loaded;
+  char line[1024];
+  while (std::fgets(line, sizeof line, pipe) != nullptr) {
+    std::string name(line);
+    name.erase(0, name.find_first_not_of(" \t"));
+    name = name.substr(0, name.find_first_of(" \t\n"));
+    loaded.push_back(std::filesystem::path(name).filename().string());
+  }
+  ASSERT_EQ(pclose(pipe), 0) << joined(loaded);
+  ASSERT_NE(std::find(loaded.begin(), loaded.end(), "libstdc++.so.6"), loaded.end())
+      << joined(loaded);
+  EXPECT_EQ(oracle_in(loaded), "") << HAPSIM_BIN_PATH << " loads: " << joined(loaded);
+}
+
 #ifdef HAPSIM_BENCH_BIN_PATH
 // The same reader finds the oracles where they are linked: hapsim-bench (the comparison rows).
 TEST(HapsimLinksNoOracle, HapsimBenchIsWhereTheOraclesAre) {
