@@ -124,12 +124,22 @@ DeviceInput RemoteDevice::read(double time_s) noexcept {
     // A cycle without a new state (late, lost) moves the device on at its reported velocity
     // instead of holding it: held, then caught up, it would jump two cycles at once, and the
     // world's velocity (and damping force) with it. A few cycles at most, then it holds.
+    const bool after_reckoning = fresh && missed_states_ > 0;
     missed_states_ = fresh ? 0 : std::min(missed_states_ + 1, kMaxDeadReckoned);
     const double reckoned_s = dt_s * missed_states_;
     input.time_s = host_state_.input.time_s + host_time_offset_s_ + reckoned_s;
     if (missed_states_ > 0 && host_state_.v_world_m_per_s.allFinite()) {
       input.p_world += host_state_.v_world_m_per_s * reckoned_s;
     }
+    // The first real state after reckoned ones corrects the estimate: that correction is not
+    // motion the device made in the little host time since the estimate's stamp (a state late
+    // by 0.1 ms is stamped 0.1 ms after it, and 0.05 mm over 0.1 ms reads as 0.5 m/s, a damping
+    // force of its own). It takes at least a step; later stamps keep their differences.
+    if (after_reckoning && input.time_s < previous_input_time_s_ + dt_s) {
+      host_time_offset_s_ += previous_input_time_s_ + dt_s - input.time_s;
+      input.time_s = previous_input_time_s_ + dt_s;
+    }
+    previous_input_time_s_ = input.time_s;
     cycles_driven_.fetch_add(1, std::memory_order_relaxed);
   }
   return input;

@@ -122,7 +122,8 @@ class RemoteDevice final : public Device {
   double previous_time_s_ = 0.0;
   /// This loop's time less the host's, when the host joined (its states' time on this clock).
   double host_time_offset_s_ = std::numeric_limits<double>::quiet_NaN();
-  double host_time_last_s_ = 0.0;  ///< the newest host state's own time
+  double host_time_last_s_ = 0.0;       ///< the newest host state's own time
+  double previous_input_time_s_ = 0.0;  ///< the host input's time read() gave last
   dds_entity_t waitset_ = 0;
   DeviceStateSample host_state_;
   std::int64_t host_seen_ns_;

@@ -1,0 +1,107 @@
+// The simulation host's device (net/remote_device.h) against a device host played by the test
+// over DDS on loopback: a second writer on the same device id steers nothing while the first
+// drives (a name already taken), and the first real state after a dead-reckoned cycle is stamped
+// at least a step after it, so the estimate's correction never reads as a fast motion.
+#include "hapsim/net/remote_device.h"
+#include "hapsim/device/absent_device.h"
+#include "hapsim/net/device_state_codec.h"
+#include "hapsim/net/topic_writer.h"
+
+#include "net/net_test_support.h"
+
+#include <chrono>
+#include <string>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+namespace hapsim::net {
+namespace {
+
+constexpr dds_domainid_t kDomain = 89;
+constexpr std::uint64_t kHash = 0xabcdULL;
+
+class RemoteDeviceTest : public ::testing::Test {
+ protected:
+  void SetUp() override { ASSERT_TRUE(test::on_loopback_config()); }
+
+  // Waits until `writer` reaches the device's reader.
+  static void matched(const TopicWriter<hapsim_msg_DeviceState>& writer) {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (writer.matched_readers() == 0 && std::chrono::steady_clock::now() < give_up) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  }
+  // A host state: sequence `n` stamped `host_time_s` at x = `x_m`, moving at `v_m_per_s` along x.
+  static hapsim_msg_DeviceState state(std::uint64_t n, double host_time_s, double x_m,
+                                      double v_m_per_s = 0.0) {
+    DeviceStateSample s;
+    s.sequence = n;
+    s.input.time_s = host_time_s;
+    s.input.p_world = Vec3(x_m, 0.0, 0.0);
+    s.v_world_m_per_s = Vec3(v_m_per_s, 0.0, 0.0);
+    return encode_device_state(s, kHash);
+  }
+  static void settle() { std::this_thread::sleep_for(std::chrono::milliseconds(30)); }
+
+  Participant participant{
+      kDomain,
+      std::string("rd-") + ::testing::UnitTest::GetInstance()->current_test_info()->name()};
+  AbsentDevice fallback{DeviceProfile{}};
+  // A long host timeout: the test's sleeps must not read as a silent host.
+  RemoteDevice remote{participant, 0, kHash, fallback, 5.0};
+};
+
+TEST_F(RemoteDeviceTest, ASecondHostOnTheSameIdSteersNothingWhileTheFirstDrives) {
+  TopicWriter<hapsim_msg_DeviceState> first(participant);
+  TopicWriter<hapsim_msg_DeviceState> second(participant);
+  matched(first);
+  matched(second);
+  ASSERT_TRUE(first.write(state(100, 1.0, 0.01)));
+  settle();
+  EXPECT_NEAR(remote.read(0.0).p_world.x(), 0.01, 1e-15);
+  ASSERT_TRUE(remote.take_source_switch());
+  ASSERT_TRUE(second.write(state(900, 1.001, 0.05)));  // newer, but another host's
+  settle();
+  EXPECT_NEAR(remote.read(0.001).p_world.x(), 0.01, 1e-15);  // held (no velocity to reckon)
+  EXPECT_EQ(remote.other_host_states(), 1u);
+  EXPECT_EQ(remote.verdicts()[static_cast<std::size_t>(SampleVerdict::kOtherHost)], 1u);
+  ASSERT_TRUE(first.write(state(101, 1.001, 0.011)));
+  settle();
+  EXPECT_NEAR(remote.read(0.002).p_world.x(), 0.011, 1e-15);
+}
+
+TEST_F(RemoteDeviceTest, TheFirstStateAfterAReckonedCycleIsAtLeastAStepLater) {
+  TopicWriter<hapsim_msg_DeviceState> host(participant);
+  matched(host);
+  // 0.1 m/s along x, one state a millisecond; the third is late (the host's own cycle ran 0.1 ms
+  // late and serve stepped without it, reckoning the device at 0.2 mm), and the device had in
+  // fact gone on to 0.25 mm.
+  ASSERT_TRUE(host.write(state(1, 5.000, 0.0000, 0.1)));
+  settle();
+  const DeviceInput a = remote.read(0.000);
+  ASSERT_TRUE(a.healthy);
+  ASSERT_TRUE(remote.take_source_switch());  // the host joined (serve restarts the tools)
+  ASSERT_TRUE(host.write(state(2, 5.001, 0.0001, 0.1)));
+  settle();
+  const DeviceInput b = remote.read(0.001);
+  EXPECT_NEAR(b.time_s - a.time_s, 0.001, 1e-12);
+  const DeviceInput reckoned = remote.read(0.002);  // no state: moved on at 0.1 m/s
+  EXPECT_NEAR(reckoned.p_world.x(), 0.0002, 1e-12);
+  EXPECT_NEAR(reckoned.time_s - b.time_s, 0.001, 1e-12);
+  ASSERT_TRUE(host.write(state(3, 5.0021, 0.00025, 0.05)));
+  settle();
+  const DeviceInput late = remote.read(0.003);
+  EXPECT_NEAR(late.p_world.x(), 0.00025, 1e-15);
+  // Over its own 0.1 ms the correction (0.05 mm) would read as 0.5 m/s, five times the device's
+  // speed; over a step, 0.05 m/s.
+  const double elapsed_s = late.time_s - reckoned.time_s;
+  EXPECT_NEAR(elapsed_s, 0.001, 1e-12);
+  // Later states keep their own differences, from the shifted anchor.
+  ASSERT_TRUE(host.write(state(4, 5.0031, 0.0003, 0.05)));
+  settle();
+  EXPECT_NEAR(remote.read(0.004).time_s - late.time_s, 0.001, 1e-12);
+}
+
+}  // namespace
+}  // namespace hapsim::net
