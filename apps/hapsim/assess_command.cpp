@@ -9,6 +9,7 @@
 #include "checked_output.h"
 #include "commands.h"
 #include "json_output.h"
+#include "shipped_files.h"
 #include "snapshot_view.h"
 
 #include "hapsim/core/error.h"
@@ -38,13 +39,6 @@
 #include <optional>
 #include <string>
 #include <vector>
-
-#ifndef HAPSIM_ASSESSMENT_REPORT_SCRIPT
-#define HAPSIM_ASSESSMENT_REPORT_SCRIPT ""
-#endif
-#ifndef HAPSIM_SCENES_DIR
-#define HAPSIM_SCENES_DIR "scenes"
-#endif
 
 namespace hapsim::app {
 namespace {

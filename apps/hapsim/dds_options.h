@@ -4,6 +4,8 @@
 // (`--secure DIR` or HAPSIM_SECURE_DIR, docs/security.md) with the identity to join as.
 #pragma once
 
+#include "shipped_files.h"
+
 #include "hapsim/core/error.h"
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/security_config.h"

@@ -8,6 +8,7 @@
 // Exit status: 0 when no check failed (warnings included), 1 when one did, 2 for bad options.
 #include "commands.h"
 #include "json_output.h"
+#include "shipped_files.h"
 
 #include "hapsim/core/device_profile.h"
 #include "hapsim/core/error.h"

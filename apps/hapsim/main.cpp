@@ -3,6 +3,8 @@
 #include "cli_main.h"
 #include "commands.h"
 
+#include "hapsim/version.h"
+
 #include <spdlog/spdlog.h>
 
 namespace hapsim::app {
@@ -17,7 +19,7 @@ int& exit_status() {
 int main(int argc, char** argv) {
   using namespace hapsim::app;
   CLI::App app{"hapsim - real-time haptic simulation"};
-  app.set_version_flag("--version", "hapsim 0.1.0");
+  app.set_version_flag("--version", "hapsim " HAPSIM_VERSION_STRING);  // project(VERSION)
   app.require_subcommand(1);
   spdlog::set_level(spdlog::level::warn);
   app.add_flag_callback(

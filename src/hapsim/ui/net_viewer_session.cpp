@@ -1,6 +1,7 @@
 #include "hapsim/ui/net_viewer_session.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/core/install_dirs.h"
 #include "hapsim/net/command_sender.h"
 #include "hapsim/net/dds_domain.h"
 #include "hapsim/net/loaned_reader.h"
@@ -36,7 +37,8 @@ class NetViewerSession final : public ViewerSession {
  public:
   explicit NetViewerSession(const ViewerConfig& config)
       : session_(config.session),
-        domain_(config.domain, HAPSIM_DEFAULT_DDS_CONFIG,
+        domain_(config.domain,
+                shipped_path("config/cyclonedds-loopback.xml", HAPSIM_BUILD_TREE_DDS_CONFIG),
                 {config.interface, config.peers, config.security, config.security_label}),
         participant_(config.domain, config.session),
         info_in_(participant_),
