@@ -25,6 +25,7 @@ struct ViewArgs {
   std::string scene;
   std::string data_dir;
   std::string device = "mouse";
+  std::string driver_config;  // plugin: the string its open() gets
   std::string method;
   std::string deformation = "deflection";
   std::string size = "1280x720";
@@ -62,16 +63,20 @@ int run_viewer_or_say_doctor(const ViewerOptions& o) {
 }
 
 void view(const ViewArgs& args) {
-  if (plugin_path_from_device_spec(args.device)) {
-    // The viewer's session (ui/world_viewer_session.cpp) opens its devices itself and has no
-    // plugin yet: said plainly, before any window, rather than as an unknown device.
+  const bool plugin = plugin_path_from_device_spec(args.device).has_value();
+  if (!plugin && !args.driver_config.empty()) {
+    throw CommandError("--driver-config: only with --device plugin:PATH.so");
+  }
+  if (plugin && args.connect) {
     throw CommandError("--device " + args.device +
-                       ": the viewer does not drive a plugin's device yet; `hapsim run SCENE "
-                       "--device " +
-                       args.device +
-                       " --duration S --snapshot FILE.png` runs a scene with it (`hapsim doctor "
-                       "--device " +
-                       args.device + "` checks that it opens)");
+                       ": --connect draws a served world, whose devices its hosts drive "
+                       "(hapsim device --device plugin:PATH.so)");
+  }
+  if (plugin) {
+    // The viewer's session opens the driver itself (ui/world_viewer_session.cpp; again for each
+    // scene chosen in the menu); a driver that does not load or open is one line here, before
+    // any window.
+    (void)open_plugin_device(*plugin_path_from_device_spec(args.device), args.driver_config);
   }
   if (args.connect == !args.scene.empty()) {
     throw CommandError(args.connect ? "--connect takes its scene from the simulation host: give "
@@ -92,6 +97,7 @@ void view(const ViewArgs& args) {
   o.config.scene = args.scene;
   o.config.data_dir = args.data_dir;
   o.config.device = args.device;
+  o.config.driver_config = args.driver_config;
   o.config.method = args.method;
   o.config.deformation = args.deformation;
   char x = 0;
@@ -178,7 +184,10 @@ void add_view_command(CLI::App& app) {
   cmd->add_option("--data", args->data_dir, "Real-data folder for scenes that use one");
   cmd->add_option("--device", args->device,
                   "mouse (the viewer's probe), sim (the scene's script), sim:FILE (a trajectory "
-                  "CSV) or spacemouse (a 3D mouse via spacenavd)");
+                  "CSV), spacemouse (a 3D mouse via spacenavd) or plugin:PATH.so (a device "
+                  "driver, include/hapsim/device_driver.h)");
+  cmd->add_option("--driver-config", args->driver_config,
+                  "With --device plugin:PATH.so: the string the driver's open() gets");
   cmd->add_option("--method", args->method, "Override every body's contact method")
       ->check(CLI::IsMember({"exact", "spheretree", "knee"}));
   cmd->add_option("--deformation", args->deformation,

@@ -1,14 +1,20 @@
 // `hapsim run SCENE --device plugin:PATH.so`: a driver plugin's device drives the world on the
 // real-time loop (the example driver, examples/device_plugin, pressing the CSG block's top face
 // from its own frame), the summary and the JSON name it, the world renders no stiffer than the
-// plugin's rating, and every wrong use is one named line with exit status 2. `hapsim view` says
-// plainly that it does not drive a plugin yet.
+// plugin's rating, and every wrong use is one named line with exit status 2. `hapsim view
+// --device plugin:PATH.so` runs the viewer with it (under Xvfb): the window names the driver, the
+// press reaches the block and the tool is drawn.
 #include "hapsim_process.h"
+
+#include "hapsim/render/png_image.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cstdlib>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 namespace hapsim {
@@ -99,12 +105,82 @@ TEST(RunPluginDevice, ABadPluginPathIsOneLineBeforeTheSceneLoads) {
       << config.output;
 }
 
-TEST(RunPluginDevice, TheViewerSaysItDoesNotDriveAPluginYet) {
-  const RunResult r = run_hapsim("view " + kBlock + " --device plugin:/some/driver.so");
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_TRUE(contains(r.output, "the viewer does not drive a plugin's device yet")) << r.output;
-  EXPECT_TRUE(contains(r.output, "hapsim doctor --device plugin:/some/driver.so")) << r.output;
+TEST(RunPluginDevice, TheViewerRefusesABadPluginOrConfigBeforeAnyWindow) {
+  // No display needed: these fail before the viewer opens one.
+  const RunResult missing = test::run_hapsim_env(
+      "env -u DISPLAY", "view " + kBlock + " --device plugin:/some/driver.so --duration 1");
+  EXPECT_EQ(missing.exit_code, 2) << missing.output;
+  EXPECT_TRUE(contains(missing.output, "hapsim: plugin /some/driver.so: no such file"))
+      << missing.output;
+  const RunResult config = run_hapsim("view " + kBlock + " --driver-config x --duration 1");
+  EXPECT_EQ(config.exit_code, 2) << config.output;
+  EXPECT_TRUE(contains(config.output, "--driver-config: only with --device plugin:PATH.so"))
+      << config.output;
+#ifdef HAPSIM_EXAMPLE_DRIVER
+  const RunResult refused = test::run_hapsim_env(
+      "env -u DISPLAY", "view " + kBlock + " --device plugin:" + HAPSIM_EXAMPLE_DRIVER +
+                            " --driver-config colour=red --duration 1");
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_TRUE(contains(refused.output, "unknown key 'colour'")) << refused.output;
+#endif
 }
+
+#ifdef HAPSIM_EXAMPLE_DRIVER
+// The viewer on the CSG block with the example driver, as `run` above: its window and JSON name
+// the plugin, its presses reach the block (a force, none above the plugin's 5 N), and the last
+// frame shows the tool (the green sphere) over the block.
+TEST(RunPluginDevice, TheViewerRunsWithThePluginsDevice) {
+  if (std::system("command -v xvfb-run > /dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "xvfb-run missing (scripts/setup.sh installs it)";
+  }
+  const auto json_path = temp_path("view-plugin.json");
+  const auto png = temp_path("view-plugin.png");
+  const auto log = temp_path("view-plugin.log");
+  const std::string cmd =
+      std::string("xvfb-run -a -s '-screen 0 1280x720x24' ") + HAPSIM_BIN_PATH + " view " + kBlock +
+      kPlugin + " --duration 2.5 --no-panels --size 640x480 --json " + json_path.string() +
+      " --screenshot " + png.string() + " > " + log.string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  std::ifstream log_in(log);
+  const std::string output((std::istreambuf_iterator<char>(log_in)), {});
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << output;
+  EXPECT_TRUE(contains(output, "plugin 'example-circle-press' (" +
+                                   std::string(HAPSIM_EXAMPLE_DRIVER) + ", rated 5.0 N"))
+      << output;
+
+  std::ifstream in(json_path);
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_TRUE(contains(j.at("device").get<std::string>(), "plugin 'example-circle-press'"));
+  EXPECT_TRUE(j.at("ok").get<bool>()) << j.dump(2);
+  ASSERT_EQ(j.at("peak_force_n").size(), 1u) << j.dump(2);
+  EXPECT_GT(j["peak_force_n"][0].get<double>(), 0.5) << j.dump(2);
+  EXPECT_LE(j["peak_force_n"][0].get<double>(), 5.0 + 1e-9) << j.dump(2);
+
+  // The tool is drawn over the block's top face, where the driver's circle is: the tool's
+  // colours (green free, red in contact, the yellow force arrow: red or green well above blue,
+  // which neither the grey floor and background nor the blue block are) in the picture's upper
+  // middle. The viewer's own mouse probe would start low on the left.
+  const RgbaImage image = read_png(png.string());
+  ASSERT_EQ(image.width, 640);
+  int tool = 0;
+  double sum_x = 0.0;
+  double sum_y = 0.0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = &image.rgba[(static_cast<std::size_t>(y) * image.width + x) * 4];
+      const int warm = std::max(p[0], p[1]);
+      if (warm > 120 && 2 * p[2] < warm) {
+        ++tool;
+        sum_x += x;
+        sum_y += y;
+      }
+    }
+  }
+  ASSERT_GT(tool, 100) << "no tool drawn in " << png;
+  EXPECT_NEAR(sum_x / tool, 0.5 * image.width, 0.1 * image.width) << png;
+  EXPECT_LT(sum_y / tool, 0.45 * image.height) << png;
+}
+#endif
 
 }  // namespace
 }  // namespace hapsim

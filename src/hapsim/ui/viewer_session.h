@@ -23,9 +23,12 @@ class SpaceMouseSource;
 struct ViewerConfig {
   std::filesystem::path scene;
   std::filesystem::path data_dir;
-  /// "mouse" (the viewer's probe), "sim" (the scene's own script), "sim:FILE" (a trajectory) or
-  /// "spacemouse" (a 3D mouse through spacenavd).
+  /// "mouse" (the viewer's probe), "sim" (the scene's own script), "sim:FILE" (a trajectory),
+  /// "spacemouse" (a 3D mouse through spacenavd) or "plugin:PATH.so" (a device driver plugin,
+  /// device/plugin_device.h).
   std::string device = "mouse";
+  /// plugin:PATH.so: the string the driver's open() gets.
+  std::string driver_config;
   /// Contact method for every body: "" (the scene's), "exact", "spheretree" or "knee".
   std::string method;
   /// Deformation method: "deflection" (vertex deflection, eq. 1, the scene's deformable bodies)

@@ -5,6 +5,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/device/interactive_device.h"
 #include "hapsim/device/master_probe_device.h"
+#include "hapsim/device/plugin_device.h"
 #include "hapsim/device/recording.h"
 #include "hapsim/device/space_mouse_axes.h"
 #include "hapsim/kinematics/hand_model.h"
@@ -61,10 +62,10 @@ Vec3 probe_start_for(const WorldDescription& world, const Box3& bounds_world) {
 
 // The viewer's session for every scene (architecture.md#viewer): the World on the real-time
 // haptic loop with its device (the viewer's mouse probe, the scene's script or a trajectory, a 3D
-// mouse; for a teleoperation rig the probe is the slave tool's target, turned into master joints by
-// MasterProbeDevice); one client, one snapshot, one recorder. What is drawn and read out differs
-// per kind of thing: bodies and tools, or a rig (its readout and controls); one WorldScene draws
-// both.
+// mouse, a driver plugin's device; for a teleoperation rig the probe is the slave tool's target,
+// turned into master joints by MasterProbeDevice); one client, one snapshot, one recorder. What is
+// drawn and read out differs per kind of thing: bodies and tools, or a rig (its readout and
+// controls); one WorldScene draws both.
 class WorldViewerSession final : public ViewerSession {
  public:
   WorldViewerSession(const ViewerConfig& config, SceneDescription scene) : config_(config) {
@@ -81,6 +82,15 @@ class WorldViewerSession final : public ViewerSession {
     std::optional<std::filesystem::path> trajectory;
     if (sim && config.device.size() > 4) {
       trajectory = config.device.substr(4);
+    }
+    // A driver plugin is opened before the world is built: the world renders no stiffer than its
+    // device is rated for (as `hapsim run --device plugin:` does).
+    const std::optional<std::filesystem::path> plugin_path =
+        plugin_path_from_device_spec(config.device);
+    std::unique_ptr<PluginDevice> plugin;
+    if (plugin_path) {
+      plugin = open_plugin_device(*plugin_path, config.driver_config);
+      setup_options.external_profile = &plugin->profile();
     }
     RunSetup setup = make_run_setup(std::move(scene),
                                     !sim         ? DeviceChoice::external()
@@ -123,6 +133,20 @@ class WorldViewerSession final : public ViewerSession {
     } else if (sim) {
       device_ = std::move(setup.device);
       device_name_ = setup.device_name;
+    } else if (plugin) {
+      if (hand_mapping) {
+        throw Error("--device " + config.device,
+                    scene_.file.filename().string() +
+                        " is a teleoperation scene, whose master arm its script drives; a plugin "
+                        "drives probe and glove scenes");
+      }
+      const DeviceProfile& rated = plugin->profile();
+      char rating[128];
+      std::snprintf(rating, sizeof rating, "rated %.1f N, %.0f N/m", rated.max_force_n,
+                    rated.max_stiffness_n_per_m);
+      device_name_ =
+          "plugin '" + plugin->driver_name() + "' (" + plugin_path->string() + ", " + rating + ")";
+      device_ = std::move(plugin);
     } else if (config.device == "spacemouse") {
 #if defined(HAPSIM_WITH_SPNAV)
       SpacenavOptions so;
@@ -135,8 +159,8 @@ class WorldViewerSession final : public ViewerSession {
       throw Error("3D mouse", "this build has no 3D mouse support (libspnav was not found)");
 #endif
     } else {
-      throw Error("device",
-                  "expected mouse, sim, sim:FILE or spacemouse, got '" + config.device + "'");
+      throw Error("device", "expected mouse, sim, sim:FILE, spacemouse or plugin:PATH.so, got '" +
+                                config.device + "'");
     }
     if (probe_) {
       // A rig's master wants joints: the probe's position goes through the master's IK.
