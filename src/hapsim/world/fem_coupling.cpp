@@ -5,6 +5,7 @@
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/deform/fem_body_description.h"
 #include "hapsim/geometry/tet_mesh.h"
+#include "hapsim/world/passivity_floor.h"
 #include "hapsim/world/world_model.h"
 #include "hapsim/world/world_state.h"
 
@@ -646,7 +647,8 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     // spring between updates exact: no floor of its own (the passivity sweep's rows: omega3 at
     // 1.5x its rating generated 0.24 J with backward Euler below it, none quasi-static).
     const double b_sample = fem.options().integration == FemIntegration::kBackwardEuler
-                                ? passivity_damping_factor_ * k_series * fem.options().dt_s
+                                ? passivity_damping_floor_n_s_per_m(passivity_damping_factor_,
+                                                                    k_series, fem.options().dt_s)
                                 : 0.0;
     m.damping_n_s_per_m = b_sample * n_world * n_world.transpose();
     m.normal_world = n_world;

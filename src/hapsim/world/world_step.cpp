@@ -1,6 +1,7 @@
 #include "hapsim/world/world_step.h"
 
 #include "hapsim/world/fem_coupling.h"
+#include "hapsim/world/passivity_floor.h"
 #include "hapsim/world/world_stages.h"
 
 #include <algorithm>
@@ -13,21 +14,22 @@ ContactMaterial effective_material(const WorldModel& model, const ContactMateria
                                    double dt_s) noexcept {
   ContactMaterial m = contact;
   m.stiffness_n_per_m = std::min(m.stiffness_n_per_m, model.options().max_stiffness_n_per_m);
-  const double dt = std::isfinite(dt_s) && dt_s > 0.0 ? dt_s : 0.0;
-  m.damping_n_s_per_m = std::max(
-      m.damping_n_s_per_m, model.description().passivity_damping_factor * m.stiffness_n_per_m * dt);
+  m.damping_n_s_per_m =
+      std::max(m.damping_n_s_per_m,
+               passivity_damping_floor_n_s_per_m(model.description().passivity_damping_factor,
+                                                 m.stiffness_n_per_m, dt_s));
   return m;
 }
 
 double fem_contact_damping_n_s_per_m(const WorldModel& model, const ContactMaterial& contact,
                                      const LocalContactModel& fem_model, double dt_s) noexcept {
-  const double dt = std::isfinite(dt_s) && dt_s > 0.0 ? dt_s : 0.0;
   const Vec3& n = fem_model.normal_world;
   const double k_n = n.dot(fem_model.stiffness_n_per_m * n);
   const double b_fem = n.dot(fem_model.damping_n_s_per_m * n);
   double b = std::max(contact.damping_n_s_per_m, 0.0);
   if (std::isfinite(k_n) && k_n > 0.0) {
-    b = std::max(b, model.description().passivity_damping_factor * k_n * dt);
+    b = std::max(b, passivity_damping_floor_n_s_per_m(model.description().passivity_damping_factor,
+                                                      k_n, dt_s));
   }
   if (std::isfinite(b_fem) && b_fem > 0.0) {
     b = std::max(b, b_fem);
@@ -49,8 +51,9 @@ void refresh_materials(const WorldModel& model, WorldState& state, double dt_s) 
     ContactMaterial& body = state.body_materials[m];
     body = state.material_contact[m];
     body.damping_n_s_per_m =
-        std::max(body.damping_n_s_per_m, model.description().passivity_damping_factor *
-                                             body.stiffness_n_per_m * (dt_s > 0.0 ? dt_s : 0.0));
+        std::max(body.damping_n_s_per_m,
+                 passivity_damping_floor_n_s_per_m(model.description().passivity_damping_factor,
+                                                   body.stiffness_n_per_m, dt_s));
   }
 }
 

@@ -21,7 +21,7 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
                        double dt_s) noexcept;
 
 /// The material a step uses: `contact` (as edited) with its stiffness clamped to the model's
-/// maximum and its damping raised to the passivity floor factor·k·dt.
+/// maximum and its damping raised to the passivity floor (world/passivity_floor.h).
 [[nodiscard]] ContactMaterial effective_material(const WorldModel& model,
                                                  const ContactMaterial& contact,
                                                  double dt_s) noexcept;
