@@ -99,12 +99,14 @@ TEST(HapsimLinksNoOracle, TheHapsimBinaryNeedsNoOracleLibrary) {
   EXPECT_EQ(oracle_in(needed), "") << HAPSIM_BIN_PATH << " needs: " << joined(needed);
 }
 
-// ... nor through the libraries it needs (the project's own shared libraries included): every
-// library the loader would map, as `ldd` lists them.
-TEST(HapsimLinksNoOracle, NoLibraryItLoadsIsAnOracle) {
-  const std::string cmd = "ldd " + std::string(HAPSIM_BIN_PATH) + " 2>&1";
+// Every library the loader would map for `binary`, as `ldd` lists them (file names).
+std::vector<std::string> loaded_libraries(const std::string& binary) {
+  const std::string cmd = "ldd " + binary + " 2>&1";
   std::FILE* pipe = popen(cmd.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
+  if (pipe == nullptr) {
+    ADD_FAILURE() << "cannot run " << cmd;
+    return {};
+  }
   std::vector<std::string> loaded;
   char line[1024];
   while (std::fgets(line, sizeof line, pipe) != nullptr) {
@@ -113,11 +115,29 @@ TEST(HapsimLinksNoOracle, NoLibraryItLoadsIsAnOracle) {
     name = name.substr(0, name.find_first_of(" \t\n"));
     loaded.push_back(std::filesystem::path(name).filename().string());
   }
-  ASSERT_EQ(pclose(pipe), 0) << joined(loaded);
-  ASSERT_NE(std::find(loaded.begin(), loaded.end(), "libstdc++.so.6"), loaded.end())
-      << joined(loaded);
+  EXPECT_EQ(pclose(pipe), 0) << cmd << ": " << joined(loaded);
+  EXPECT_NE(std::find(loaded.begin(), loaded.end(), "libstdc++.so.6"), loaded.end())
+      << cmd << ": " << joined(loaded);
+  return loaded;
+}
+
+// ... nor through the libraries it needs (the project's own shared libraries included).
+TEST(HapsimLinksNoOracle, NoLibraryItLoadsIsAnOracle) {
+  const std::vector<std::string> loaded = loaded_libraries(HAPSIM_BIN_PATH);
   EXPECT_EQ(oracle_in(loaded), "") << HAPSIM_BIN_PATH << " loads: " << joined(loaded);
 }
+
+#ifdef HAPSIM_PYTHON_MODULE_PATH
+// The Python module is installed too: no oracle behind `import hapsim` either.
+TEST(HapsimLinksNoOracle, NoLibraryThePythonModuleLoadsIsAnOracle) {
+  if (!std::filesystem::exists(HAPSIM_PYTHON_MODULE_PATH)) {
+    GTEST_SKIP() << HAPSIM_PYTHON_MODULE_PATH
+                 << " not built (cmake --build --target hapsim_python)";
+  }
+  const std::vector<std::string> loaded = loaded_libraries(HAPSIM_PYTHON_MODULE_PATH);
+  EXPECT_EQ(oracle_in(loaded), "") << HAPSIM_PYTHON_MODULE_PATH << " loads: " << joined(loaded);
+}
+#endif
 
 #ifdef HAPSIM_BENCH_BIN_PATH
 // The same reader finds the oracles where they are linked: hapsim-bench (the comparison rows).
