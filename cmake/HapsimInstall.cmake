@@ -12,8 +12,10 @@ set(HAPSIM_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/hapsim" CACHE STRING
 set(HAPSIM_INSTALL_DATADIR "${CMAKE_INSTALL_DATADIR}/hapsim")
 
 set(_hapsim_libraries hapsim_headless hapsim_render hapsim_net_types hapsim_net hapsim_ui)
+set(HAPSIM_WITH_SPNAV OFF)
 if(TARGET hapsim_spacenav)
   list(APPEND _hapsim_libraries hapsim_spacenav)
+  set(HAPSIM_WITH_SPNAV ON)
 endif()
 
 # Installed binaries find the libraries relative to themselves, wherever the prefix is copied.
