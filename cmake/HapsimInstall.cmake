@@ -45,7 +45,7 @@ install(TARGETS ${_hapsim_libraries} EXPORT hapsimTargets
 # Headers: every layer's (a world header includes core, geometry, collision, ...), the drivers' C
 # ABI, the generated version and DDS message headers. docs/cpp.md says which are stable in 0.x.
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/src/hapsim" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}"
-        FILES_MATCHING PATTERN "*.h")
+        FILES_MATCHING PATTERN "*.h" PATTERN "idl" EXCLUDE)
 install(FILES "${PROJECT_SOURCE_DIR}/include/hapsim/device_driver.h"
               "${PROJECT_BINARY_DIR}/include/hapsim/version.h"
         DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/hapsim")
