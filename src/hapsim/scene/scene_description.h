@@ -4,7 +4,7 @@
 
 #include "hapsim/core/types.h"
 #include "hapsim/device/glove_calibration.h"
-#include "hapsim/training/assessment_definition.h"
+#include "hapsim/scene/assessment_definition.h"
 #include "hapsim/world/world_description.h"
 
 #include <filesystem>

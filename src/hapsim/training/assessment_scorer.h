@@ -5,7 +5,7 @@
 #pragma once
 
 #include "hapsim/runtime/cycle_record.h"
-#include "hapsim/training/assessment_definition.h"
+#include "hapsim/scene/assessment_definition.h"
 #include "hapsim/training/assessment_result.h"
 #include "hapsim/world/world.h"
 

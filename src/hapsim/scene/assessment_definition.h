@@ -2,7 +2,7 @@
 // palpate (a segment, optionally a point and radius on it, with the force and dwell that count as
 // "palpated"), the safe force per tissue (a segment or a material) and an optional time limit.
 // Plain data: scene/assessment_reader.h reads it from a scene's "assessment"; the scorer
-// (assessment_scorer.h) applies it to a session's cycles.
+// (training/assessment_scorer.h) applies it to a session's cycles.
 #pragma once
 
 #include "hapsim/core/types.h"

@@ -1,0 +1,2 @@
+// Fixture for the include-layer test.
+#pragma once
