@@ -607,7 +607,13 @@ class Viewer {
         }
         ImGui::EndCombo();
       }
-      combo("device", pending_config_.device, {"mouse", "sim", "spacemouse"});
+      // A driver plugin the viewer started with (--device plugin:PATH.so) stays on offer.
+      const std::string& started = options_.config.device;
+      if (started.rfind("plugin:", 0) == 0) {
+        combo("device", pending_config_.device, {"mouse", "sim", "spacemouse", started.c_str()});
+      } else {
+        combo("device", pending_config_.device, {"mouse", "sim", "spacemouse"});
+      }
       combo("contact method", pending_config_.method, {"", "exact", "spheretree", "knee"});
       combo("deformation", pending_config_.deformation, {"deflection", "none"});
       ImGui::PopItemWidth();
