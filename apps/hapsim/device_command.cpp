@@ -74,9 +74,11 @@ constexpr std::int64_t kSilentAfter_ns = 200'000'000;
 // restarted serve takes seconds to load anyway, and a loaded machine can starve the DDS receive
 // thread for a few hundred ms (seen: 200 ms with both cores busy) without the host being gone.
 constexpr std::int64_t kOtherHostAfter_ns = 1'000'000'000;
-// Models answering another host on this device id, and none answering us: the id (the name) is
-// taken by a host the simulation follows. 100 models: a tenth of a second of a one-tool session.
-constexpr std::uint64_t kTakenAfterModels = 100;
+// Models answering another host on this device id, and none answering us, for this long while
+// they keep coming: the id (the name) is taken by a host the simulation follows. Longer than
+// serve's 0.1 s host timeout, so a host that has just left (serve answers its last states until
+// then) does not make its successor give up.
+constexpr std::int64_t kTakenAfter_ns = 500'000'000;
 
 // "--finger-map 0:2,1:3": the scene's finger 0 drives the device's finger 2, and so on; fingers
 // not named keep their number.
@@ -389,6 +391,9 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
   std::uint64_t other_said = serve_id;
   std::uint64_t other_hosts = 0;
   bool taken = false;
+  std::uint64_t other_host_models = 0;  // models answering another host on our id, so far
+  std::int64_t other_host_since_ns = 0;
+  std::int64_t other_host_last_ns = 0;
   while (loop.running() && !stop.load(std::memory_order_relaxed)) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
     if (auto fresh = take_said(info_in); fresh && fresh->serve_id != serve_id) {
@@ -398,9 +403,17 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     const std::int64_t now_ns = monotonic_ns();
     const bool alive = s.last_model_ns != 0 && now_ns - s.last_model_ns < kSilentAfter_ns;
     // Taken: the simulation answers another host on this device id (the same name), never us.
-    if (s.models_accepted == 0 && s.models_other_device_host >= kTakenAfterModels) {
-      taken = true;
-      break;
+    if (s.models_accepted == 0 && s.models_other_device_host > 0) {
+      if (s.models_other_device_host != other_host_models) {
+        other_host_models = s.models_other_device_host;
+        other_host_last_ns = now_ns;
+        other_host_since_ns = other_host_since_ns == 0 ? now_ns : other_host_since_ns;
+      }
+      if (now_ns - other_host_since_ns >= kTakenAfter_ns &&
+          now_ns - other_host_last_ns < kSilentAfter_ns) {
+        taken = true;
+        break;
+      }
     }
     if (other && (s.last_model_ns == 0 || now_ns - s.last_model_ns >= kOtherHostAfter_ns)) {
       serve_id = other->serve_id;
