@@ -321,6 +321,15 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
     host.link = std::make_unique<net::RemoteDevice>(participant, host.device_id, hash,
                                                     k == 0 ? *setup.device : *host.absent);
   }
+  for (std::size_t k = 0; k < host_count && host_count > 1; ++k) {
+    std::vector<std::uint16_t> siblings;
+    for (std::size_t j = 0; j < host_count; ++j) {
+      if (j != k) {
+        siblings.push_back(hosts[j].device_id);
+      }
+    }
+    hosts[k].link->set_sibling_device_ids(siblings);
+  }
   net::RemoteDevice& remote = *hosts[0].link;
   double lockstep_s = args.lockstep_us * 1e-6;
   if (lockstep_s > 0.9 / args.rate_hz) {

@@ -103,5 +103,25 @@ TEST_F(RemoteDeviceTest, TheFirstStateAfterAReckonedCycleIsAtLeastAStepLater) {
   EXPECT_NEAR(remote.read(0.004).time_s - late.time_s, 0.001, 1e-12);
 }
 
+// Several users: the other users' states reach every link in serve; each link skips its
+// siblings' without a verdict, so "other device" counts only strangers' states.
+TEST_F(RemoteDeviceTest, AnotherUsersStatesAreNotCountedAsAStrangersDevice) {
+  const std::uint16_t sibling = 1;
+  remote.set_sibling_device_ids({&sibling, 1});
+  TopicWriter<hapsim_msg_DeviceState> other_user(participant);
+  matched(other_user);
+  hapsim_msg_DeviceState from_sibling = state(1, 1.0, 0.02);
+  from_sibling.device_id = 1;
+  hapsim_msg_DeviceState from_stranger = state(1, 1.0, 0.03);
+  from_stranger.device_id = 7;
+  ASSERT_TRUE(other_user.write(from_sibling));
+  ASSERT_TRUE(other_user.write(from_stranger));
+  settle();
+  EXPECT_FALSE(remote.read(0.0).healthy);  // neither drives this device (its fallback: absent)
+  const VerdictCounts v = remote.verdicts();
+  EXPECT_EQ(v[static_cast<std::size_t>(SampleVerdict::kOtherDevice)], 1u);  // the stranger only
+  EXPECT_EQ(v[static_cast<std::size_t>(SampleVerdict::kAccepted)], 0u);
+}
+
 }  // namespace
 }  // namespace hapsim::net

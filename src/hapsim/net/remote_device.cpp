@@ -38,6 +38,11 @@ void RemoteDevice::set_link_shim(const LinkShimOptions& options) {
 // haptic path
 bool RemoteDevice::admit_state(const hapsim_msg_DeviceState& m, std::int64_t now_ns,
                                dds_instance_handle_t writer) noexcept {
+  if (std::find(sibling_ids_.begin(),
+                sibling_ids_.begin() + static_cast<std::ptrdiff_t>(sibling_count_), m.device_id) !=
+      sibling_ids_.begin() + static_cast<std::ptrdiff_t>(sibling_count_)) {
+    return false;  // another user's state in this world: its own link counts it
+  }
   // One host per device: a second one on this id (a name already taken) steers nothing while
   // the first drives; it is told by the models, which answer the first host's states only.
   if (writer != 0 && followed_writer_ != 0 && writer != followed_writer_ &&

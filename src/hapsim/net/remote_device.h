@@ -12,11 +12,13 @@
 #include "hapsim/net/participant.h"
 #include "hapsim/net/topic_reader.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <span>
 
 namespace hapsim::net {
 
@@ -36,6 +38,14 @@ class RemoteDevice final : public Device {
   void set_link_shim(const LinkShimOptions& options);
   [[nodiscard]] std::uint64_t link_lost() const noexcept {
     return link_lost_.load(std::memory_order_relaxed);
+  }
+
+  /// Several users: the device ids of the other users' hosts in this world. Their states are
+  /// theirs, not strangers': skipped without a verdict (not counted as "other device"). Before
+  /// the loop starts; at most kMaxSiblings.
+  void set_sibling_device_ids(std::span<const std::uint16_t> ids) noexcept {
+    sibling_count_ = std::min(ids.size(), sibling_ids_.size());
+    std::copy_n(ids.begin(), sibling_count_, sibling_ids_.begin());
   }
 
   /// Lockstep with the device host: while one drives and no new state came this cycle, read()
@@ -105,6 +115,9 @@ class RemoteDevice final : public Device {
   TopicReader<hapsim_msg_DeviceState> states_;
   DeviceStateGate gate_;
   std::uint16_t device_id_;
+  static constexpr std::size_t kMaxSiblings = 8;
+  std::array<std::uint16_t, kMaxSiblings> sibling_ids_{};
+  std::size_t sibling_count_ = 0;
   /// The device host followed: the writer of the first state accepted, until it is silent for
   /// the host timeout; another writer's states for this device meanwhile are refused.
   dds_instance_handle_t followed_writer_ = 0;
