@@ -8,6 +8,7 @@
 #include "hapsim/runtime/fem_thread.h"
 #include "hapsim/runtime/ramp_warning.h"
 #include "hapsim/runtime/record_drain.h"
+#include "hapsim/runtime/tool_rendered_force.h"
 #include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/world/fem_coupling.h"
 
@@ -169,14 +170,8 @@ class SessionAccountant {
     for (std::size_t t = 0; t < tools; ++t) {
       const ToolState& tool = r.tools[t];
       ToolSummary& ts = summary_.tools[t];
-      const int finger = desc.tools[t].finger;
-      // Another user's tool (device > 0) is not in this device's command: its force is what
-      // the world gave it (that user's device host applies its own safety layer).
       const bool own = desc.tools[t].device == 0;
-      const double f = !own ? tool.force_world_n.norm()
-                       : finger >= 0 && finger < out.finger_count
-                           ? out.finger_force_n[static_cast<std::size_t>(finger)]
-                           : tool.force_world_n.norm() * tip_scale;
+      const double f = tool_rendered_force_n(desc.tools[t], tool, out, tip_scale);
       ts.peak_force_n = std::max(ts.peak_force_n, f);
       if (tool.contact_count > 0) {
         ++ts.contact_steps;

@@ -2,6 +2,7 @@
 
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/deform/virtual_sheet.h"
+#include "hapsim/runtime/tool_rendered_force.h"
 
 #include <algorithm>
 #include <chrono>
@@ -171,13 +172,7 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
     const double tip_n = r.command.force_world_n.norm();
     const double tip_scale = tip_n > 0.0 ? cycle.output->force_world_n.norm() / tip_n : 0.0;
     for (std::size_t t = 0; t < tools; ++t) {
-      const int finger = d.tools[t].finger;
-      // Another user's tool is not in this device's command: its force is the world's (that
-      // user's device host renders it).
-      s.tool_force_n[t] = d.tools[t].device != 0 ? r.tools[t].force_world_n.norm()
-                          : finger >= 0 && finger < cycle.output->finger_count
-                              ? cycle.output->finger_force_n[static_cast<std::size_t>(finger)]
-                              : r.tools[t].force_world_n.norm() * tip_scale;
+      s.tool_force_n[t] = tool_rendered_force_n(d.tools[t], r.tools[t], *cycle.output, tip_scale);
     }
   }
   if (s.teleop && world_.rig() != nullptr) {
