@@ -35,25 +35,26 @@ if(TARGET hapsim_python)
   set_target_properties(hapsim_python PROPERTIES INSTALL_RPATH "${_python_rpath}")
 endif()
 
-install(TARGETS hapsim RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
+install(TARGETS hapsim RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}" COMPONENT runtime)
 install(TARGETS ${_hapsim_libraries} EXPORT hapsimTargets
-        LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}"
-        ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}"
-        RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}"
+        LIBRARY DESTINATION "${CMAKE_INSTALL_LIBDIR}" COMPONENT runtime NAMELINK_COMPONENT dev
+        ARCHIVE DESTINATION "${CMAKE_INSTALL_LIBDIR}" COMPONENT dev
+        RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}" COMPONENT runtime
         INCLUDES DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")
 
 # Headers: every layer's (a world header includes core, geometry, collision, ...), the drivers' C
 # ABI, the generated version and DDS message headers. docs/cpp.md says which are stable in 0.x.
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/src/hapsim" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}"
-        FILES_MATCHING PATTERN "*.h" PATTERN "idl" EXCLUDE)
+        COMPONENT dev FILES_MATCHING PATTERN "*.h" PATTERN "idl" EXCLUDE)
 install(FILES "${PROJECT_SOURCE_DIR}/include/hapsim/device_driver.h"
               "${PROJECT_BINARY_DIR}/include/hapsim/version.h"
-        DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/hapsim")
+        DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/hapsim" COMPONENT dev)
 install(FILES "${PROJECT_BINARY_DIR}/src/hapsim_messages.h"
-        DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/hapsim/net/generated")
+        DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}/hapsim/net/generated" COMPONENT dev)
 
 # The package: targets, their dependencies (hapsimConfig.cmake.in), the version (0.1.x matches 0.1).
-install(EXPORT hapsimTargets NAMESPACE hapsim:: DESTINATION "${HAPSIM_INSTALL_CMAKEDIR}")
+install(EXPORT hapsimTargets NAMESPACE hapsim:: DESTINATION "${HAPSIM_INSTALL_CMAKEDIR}"
+        COMPONENT dev)
 configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/hapsimConfig.cmake.in"
                               "${PROJECT_BINARY_DIR}/hapsimConfig.cmake"
                               INSTALL_DESTINATION "${HAPSIM_INSTALL_CMAKEDIR}")
@@ -61,16 +62,19 @@ write_basic_package_version_file("${PROJECT_BINARY_DIR}/hapsimConfigVersion.cmak
                                  COMPATIBILITY SameMinorVersion)
 install(FILES "${PROJECT_BINARY_DIR}/hapsimConfig.cmake"
               "${PROJECT_BINARY_DIR}/hapsimConfigVersion.cmake"
-        DESTINATION "${HAPSIM_INSTALL_CMAKEDIR}")
+        DESTINATION "${HAPSIM_INSTALL_CMAKEDIR}" COMPONENT dev)
 
 # Shipped data: the scenes with their meshes, the loopback-only DDS config, the report script.
-install(DIRECTORY "${PROJECT_SOURCE_DIR}/scenes/" DESTINATION "${HAPSIM_INSTALL_DATADIR}/scenes")
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/scenes/" DESTINATION "${HAPSIM_INSTALL_DATADIR}/scenes"
+        COMPONENT runtime)
 install(FILES "${PROJECT_SOURCE_DIR}/config/cyclonedds-loopback.xml"
-        DESTINATION "${HAPSIM_INSTALL_DATADIR}/config")
+        DESTINATION "${HAPSIM_INSTALL_DATADIR}/config" COMPONENT runtime)
 install(FILES "${PROJECT_SOURCE_DIR}/python/hapsim/assessment_report.py"
-        DESTINATION "${HAPSIM_INSTALL_DATADIR}")
+        DESTINATION "${HAPSIM_INSTALL_DATADIR}" COMPONENT runtime)
 # The docs, with the C++ examples (docs/cpp.md) beside them.
-install(DIRECTORY "${PROJECT_SOURCE_DIR}/docs/" DESTINATION "${CMAKE_INSTALL_DOCDIR}")
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/docs/" DESTINATION "${CMAKE_INSTALL_DOCDIR}"
+        COMPONENT runtime)
 install(FILES "${PROJECT_SOURCE_DIR}/README.md" "${PROJECT_SOURCE_DIR}/LICENSE"
-        DESTINATION "${CMAKE_INSTALL_DOCDIR}")
-install(DIRECTORY "${PROJECT_SOURCE_DIR}/examples/cpp/" DESTINATION "${CMAKE_INSTALL_DOCDIR}/examples/cpp")
+        DESTINATION "${CMAKE_INSTALL_DOCDIR}" COMPONENT runtime)
+install(DIRECTORY "${PROJECT_SOURCE_DIR}/examples/cpp/" DESTINATION "${CMAKE_INSTALL_DOCDIR}/examples/cpp"
+        COMPONENT dev)
