@@ -9,8 +9,29 @@
 #    the release flags; -O3 on gtest's macro-expanded bodies only cost compile time.
 # nlohmann/json stays out of the precompiled headers on purpose: a fifth of the files include
 # it, and the larger header costs the other four fifths more to load than it saves.
+option(HAPSIM_CCACHE "Compile through ccache when it is installed (a warm rebuild in seconds)" ON)
 option(HAPSIM_PCH "Precompile the standard, Eigen and GoogleTest headers (a faster cold build)" ON)
 option(HAPSIM_UNITY_BUILD "Compile the headless library and the app in batches of files (a faster cold build)" ON)
+
+# ccache, when present (not installed by scripts/setup.sh: a bare machine builds without it), and
+# unless a launcher was chosen: a build folder rebuilt from nothing (`rm -rf build`, a second CI
+# run of the same clone) takes its objects from the cache. Depend mode: a miss costs one compile,
+# not a preprocessor run and a compile, so a cold cache adds next to nothing. base_dir at the
+# source folder makes the include paths relative, so a clone elsewhere (CI's) shares the cache for
+# every file whose command and contents are the same there (not the batched files of a unity
+# build, which name their sources by absolute path, nor the tests, whose HAPSIM_SOURCE_DIR
+# differs). The precompiled headers need the pch sloppiness (ccache manual, "Precompiled headers").
+if(HAPSIM_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
+  find_program(HAPSIM_CCACHE_PROGRAM ccache)
+  if(HAPSIM_CCACHE_PROGRAM)
+    set(_ccache ${CMAKE_COMMAND} -E env CCACHE_BASEDIR=${CMAKE_SOURCE_DIR} CCACHE_DEPEND=1
+                "CCACHE_SLOPPINESS=pch_defines,time_macros,include_file_mtime,include_file_ctime"
+                ${HAPSIM_CCACHE_PROGRAM})
+    set(CMAKE_C_COMPILER_LAUNCHER ${_ccache})
+    set(CMAKE_CXX_COMPILER_LAUNCHER ${_ccache})
+    message(STATUS "hapsim: compiling through ${HAPSIM_CCACHE_PROGRAM} (HAPSIM_CCACHE=OFF to not)")
+  endif()
+endif()
 
 set(HAPSIM_PCH_HEADERS
     <algorithm> <array> <atomic> <chrono> <cmath> <cstdint> <filesystem> <fstream> <limits>
