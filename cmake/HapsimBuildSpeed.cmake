@@ -18,9 +18,11 @@ option(HAPSIM_UNITY_BUILD "Compile the headless library and the app in batches o
 # run of the same clone) takes its objects from the cache. Depend mode: a miss costs one compile,
 # not a preprocessor run and a compile, so a cold cache adds next to nothing. base_dir at the
 # source folder makes the include paths relative, so a clone elsewhere (CI's) shares the cache for
-# every file whose command and contents are the same there (not the batched files of a unity
-# build, which name their sources by absolute path, nor the tests, whose HAPSIM_SOURCE_DIR
-# differs). The precompiled headers need the pch sloppiness (ccache manual, "Precompiled headers").
+# the release files whose command and contents are the same there: not the batched files of a
+# unity build (they name their sources by absolute path), not the tests (HAPSIM_SOURCE_DIR), and
+# nothing built with -g (the folder is then hashed: 5 of 40 sanitizer objects hit from another
+# clone, 40 of 40 in the same folder). The precompiled headers need the pch sloppiness (ccache
+# manual, "Precompiled headers").
 if(HAPSIM_CCACHE AND NOT CMAKE_CXX_COMPILER_LAUNCHER)
   find_program(HAPSIM_CCACHE_PROGRAM ccache)
   if(HAPSIM_CCACHE_PROGRAM)
