@@ -2,7 +2,7 @@
 // cost of hapsim's exact BVH, sphere tree and contact-radius query against CGAL, FCL and Embree
 // on the same meshes and points (bench/collision_cases.h). `hapsim bench step`: the haptic step's
 // cost per contact method (bench/step_cases.h). `hapsim bench network`: raw force against the
-// local contact model over a simulated link (net/link_sweep.h). `hapsim bench fem`: a FEM block's
+// local contact model over a simulated link (bench/link_sweep.h). `hapsim bench fem`: a FEM block's
 // solver, the haptic step beside it and the local model's force error (bench/fem_cases.h).
 // Progress on stderr, the table on stdout, rows as JSON on request.
 #include "bench_commands.h"
@@ -15,12 +15,12 @@
 #include "bench/collision_cases.h"
 #include "bench/contact_cases.h"
 #include "bench/fem_cases.h"
+#include "bench/link_sweep.h"
 #include "bench/passivity_cases.h"
 #include "bench/soak_cases.h"
 #include "bench/step_cases.h"
 #include "hapsim/core/data_dir.h"
 #include "hapsim/core/stopwatch.h"
-#include "hapsim/net/link_sweep.h"
 #include "hapsim/scene/scene_file.h"
 
 #include <unistd.h>
@@ -473,23 +473,23 @@ std::string ms_or_dash(double seconds) {
   return text;
 }
 
-std::string format_network_table(const std::vector<net::LinkSweepRow>& rows) {
+std::string format_network_table(const std::vector<bench::LinkSweepRow>& rows) {
   std::string out;
   char line[256];
   std::snprintf(line, sizeof line, "%-11s %-6s %-7s %5s %4s %6s | %8s %8s %8s %7s %9s %-6s %s\n",
                 "mode", "env", "hand", "delay", "loss", "outage", "steady_N", "error_%", "ripple_N",
                 "peak_N", "energy_mJ", "stable", "zero_ms (after last model)");
   out += line;
-  for (const net::LinkSweepRow& row : rows) {
-    const net::LinkCase& c = row.link_case;
+  for (const bench::LinkSweepRow& row : rows) {
+    const bench::LinkCase& c = row.link_case;
     const std::string zero =
         row.is_outage() ? ms_or_dash(row.run.outage_force_zero_s) + " (" +
                               ms_or_dash(row.run.outage_force_zero_after_last_model_s) + ")"
                         : "-";
     std::snprintf(line, sizeof line,
                   "%-11s %-6s %-7s %5.0f %4.0f %6s | %8.3f %+8.2f %8.4f %7.2f %9.2f %-6s %s\n",
-                  net::to_string(c.mode), net::environment_name(c.environment),
-                  net::hand_name(c.hand), 1e3 * c.delay_s, 100.0 * c.loss,
+                  net::to_string(c.mode), bench::environment_name(c.environment),
+                  bench::hand_name(c.hand), 1e3 * c.delay_s, 100.0 * c.loss,
                   row.is_outage() ? ms_or_dash(c.outage_s).c_str() : "-", row.run.steady_force_n,
                   100.0 * row.steady_force_error, row.run.hold_ripple_rms_n, row.run.peak_force_n,
                   1e3 * row.run.energy_generated_j, row.run.stable ? "yes" : "NO", zero.c_str());
@@ -502,15 +502,15 @@ nlohmann::json null_if_negative(double value) {
   return value < 0.0 ? nlohmann::json(nullptr) : nlohmann::json(value);
 }
 
-nlohmann::json network_rows_to_json(const std::vector<net::LinkSweepRow>& rows) {
+nlohmann::json network_rows_to_json(const std::vector<bench::LinkSweepRow>& rows) {
   nlohmann::json out = nlohmann::json::array();
-  for (const net::LinkSweepRow& row : rows) {
-    const net::LinkCase& c = row.link_case;
-    const net::LinkRun& r = row.run;
+  for (const bench::LinkSweepRow& row : rows) {
+    const bench::LinkCase& c = row.link_case;
+    const bench::LinkRun& r = row.run;
     out.push_back({
         {"mode", net::to_string(c.mode)},
-        {"environment", net::environment_name(c.environment)},
-        {"hand", net::hand_name(c.hand)},
+        {"environment", bench::environment_name(c.environment)},
+        {"hand", bench::hand_name(c.hand)},
         {"delay_ms", 1e3 * c.delay_s},
         {"jitter_max_ms", 1e3 * c.jitter_s},
         {"loss", c.loss},
@@ -546,18 +546,19 @@ nlohmann::json network_rows_to_json(const std::vector<net::LinkSweepRow>& rows) 
 
 // The targets for the local model, checked on every local-model row; what misses is
 // printed with its figure.
-std::vector<std::string> local_model_misses(const std::vector<net::LinkSweepRow>& rows) {
+std::vector<std::string> local_model_misses(const std::vector<bench::LinkSweepRow>& rows) {
   std::vector<std::string> misses;
   char line[256];
-  for (const net::LinkSweepRow& row : rows) {
-    const net::LinkCase& c = row.link_case;
+  for (const bench::LinkSweepRow& row : rows) {
+    const bench::LinkCase& c = row.link_case;
     if (c.mode != net::ForceMode::kLocalModel) {
       continue;
     }
-    std::snprintf(
-        line, sizeof line, "%s %s %.0f ms %.0f %%%s: ", net::environment_name(c.environment),
-        net::hand_name(c.hand), 1e3 * c.delay_s, 100.0 * c.loss, row.is_outage() ? " outage" : "");
-    const net::LinkRun& r = row.run;
+    std::snprintf(line, sizeof line,
+                  "%s %s %.0f ms %.0f %%%s: ", bench::environment_name(c.environment),
+                  bench::hand_name(c.hand), 1e3 * c.delay_s, 100.0 * c.loss,
+                  row.is_outage() ? " outage" : "");
+    const bench::LinkRun& r = row.run;
     std::string what;
     if (!r.stable) {
       what += "unstable; ";
@@ -599,8 +600,8 @@ void run_network(const NetworkArgs& args) {
   if (!args.json_path.empty()) {
     json_out = open_output("--json", args.json_path);
   }
-  net::LinkSweepOptions options =
-      args.quick ? net::quick_link_sweep_options() : net::LinkSweepOptions{};
+  bench::LinkSweepOptions options =
+      args.quick ? bench::quick_link_sweep_options() : bench::LinkSweepOptions{};
   if (!args.modes.empty()) {
     options.modes.clear();
     for (const std::string& mode : args.modes) {
@@ -625,7 +626,7 @@ void run_network(const NetworkArgs& args) {
     printer(label, fraction);
   };
   const Stopwatch watch;
-  const std::vector<net::LinkSweepRow> rows = net::run_link_sweep(options);
+  const std::vector<bench::LinkSweepRow> rows = bench::run_link_sweep(options);
   const double elapsed_s = watch.elapsed_s();
   std::cout << format_network_table(rows);
   std::cout << "1-DOF press, device 0.2 kg; jitter U[0, d/2]; error: steady force against the "
@@ -636,7 +637,7 @@ void run_network(const NetworkArgs& args) {
                "|F| < 0.01 N for good ('-': raw holds its last force)\n";
   int raw_unstable = 0;
   int raw_rows = 0;
-  for (const net::LinkSweepRow& row : rows) {
+  for (const bench::LinkSweepRow& row : rows) {
     if (row.link_case.mode == net::ForceMode::kRaw && row.link_case.delay_s >= 0.005 &&
         !row.is_outage()) {
       ++raw_rows;

@@ -1,6 +1,7 @@
 // How a device host turns what the simulation sends into force: the raw force it computed, or the
 // local contact model evaluated at the device's own fresh position (SPEC §8). One definition for
-// the device host (net/device_host_client.h) and the link sweep (net/link_sweep.h).
+// the device host (net/device_host_client.h) and `hapsim bench network`'s link sweep
+// (bench/link_sweep.h).
 #pragma once
 
 #include <cstdint>

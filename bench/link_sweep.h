@@ -2,14 +2,17 @@
 // fingertip pressing an environment through a simulated link, with the force closed either the
 // paper's way (raw) or through the local contact model (SPEC §8), so their stability, accuracy
 // and energy can be compared over delay, loss, jitter and an outage. A plain simulation,
-// deterministic for a seed, no clock.
+// deterministic for a seed, no clock. A benchmark, not part of the net library: it lives in the
+// bench cases (hapsim_bench_cases, not installed) and uses the net layer's codecs, gates and
+// LinkShim as a device host and serve use them; the 1-DOF plant below is its own (no library
+// code uses it).
 //
 // The plant (one cycle = 1 ms, semi-implicit Euler): a 0.2 kg device held by a hand, a spring
 // and damper pulling it towards a target. Penetration runs along +x, the environment pushes
 // back along −x. The device starts 5 mm above the surface at rest; the hand holds it there for
 // 0.5 s while the link fills (a session is running before anyone touches anything), then moves
 // its target 25 mm in, to 20 mm below the surface, in 0.3 s (minimum jerk: a press, peak 0.16
-// m/s; `approach_s` = 0 is a step, the slam of tests/net/local_model_1dof_test.cpp).
+// m/s; `approach_s` = 0 is a step, the slam of tests/bench/local_model_1dof_test.cpp).
 // Environments (both with 1 N·s/m of contact damping):
 //  * tissue: a 2000 N/m contact spring in series with stiffening tissue a·(exp(y/y0) − 1)
 //    (200 N/m at first touch, ~860 N/m at the relaxed hold), the tissue's depth driven by the
@@ -65,7 +68,7 @@
 #include <string>
 #include <vector>
 
-namespace hapsim::net {
+namespace hapsim::bench {
 
 enum class SweepEnvironment : std::uint8_t { kTissue, kWall };
 enum class SweepHand : std::uint8_t { kRelaxed, kStiff };
@@ -102,7 +105,7 @@ struct HandModel {
 
 /// One run.
 struct LinkCase {
-  ForceMode mode = ForceMode::kLocalModel;
+  net::ForceMode mode = net::ForceMode::kLocalModel;
   SweepEnvironment environment = SweepEnvironment::kTissue;
   SweepHand hand = SweepHand::kRelaxed;
   double delay_s = 0.0;  ///< one-way, both directions
@@ -175,7 +178,7 @@ struct LinkRun {
                                            SweepHand hand) noexcept;
 
 struct LinkSweepOptions {
-  std::vector<ForceMode> modes{ForceMode::kRaw, ForceMode::kLocalModel};
+  std::vector<net::ForceMode> modes{net::ForceMode::kRaw, net::ForceMode::kLocalModel};
   std::vector<SweepEnvironment> environments{SweepEnvironment::kTissue, SweepEnvironment::kWall};
   std::vector<SweepHand> hands{SweepHand::kRelaxed, SweepHand::kStiff};
   std::vector<int> delays_ms{0, 5, 20, 50, 100};
@@ -213,4 +216,4 @@ struct LinkSweepRow {
 /// Every (mode, environment, hand, delay, loss) of the grid, then the outage rows.
 [[nodiscard]] std::vector<LinkSweepRow> run_link_sweep(const LinkSweepOptions& options);
 
-}  // namespace hapsim::net
+}  // namespace hapsim::bench

@@ -1,4 +1,4 @@
-#include "hapsim/net/link_sweep.h"
+#include "bench/link_sweep.h"
 
 #include "hapsim/force/local_contact_model.h"
 #include "hapsim/net/device_state_codec.h"
@@ -14,7 +14,20 @@
 #include <cstdint>
 #include <memory>
 
-namespace hapsim::net {
+namespace hapsim::bench {
+
+// The net layer's pieces the sweep runs, as a device host and serve run them.
+using net::DeviceStateGate;
+using net::DeviceStateSample;
+using net::encode_device_state;
+using net::encode_local_model;
+using net::ForceMode;
+using net::LinkShim;
+using net::LinkShimCounts;
+using net::LinkShimOptions;
+using net::LocalModelGate;
+using net::SampleVerdict;
+
 namespace {
 
 // Penetration runs along world +x; the surface's outward normal is −x.
@@ -490,4 +503,4 @@ std::vector<LinkSweepRow> run_link_sweep(const LinkSweepOptions& options) {
   return rows;
 }
 
-}  // namespace hapsim::net
+}  // namespace hapsim::bench

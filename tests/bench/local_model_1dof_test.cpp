@@ -1,7 +1,7 @@
 // The issue-12 analysis as a test: a 1-DOF fingertip (device 0.2 kg held by a 300 N/m hand)
 // presses a 2000 N/m contact spring on stiffening tissue, with the simulation on the far side of
 // a link with one-way delay and i.i.d. loss both ways. Three ways of closing the loop, run by
-// the sweep's model (net/link_sweep.h) with the hand's target stepped in at once and no
+// the sweep's model (bench/link_sweep.h) with the hand's target stepped in at once and no
 // passivity observer, so what is measured is the closing alone:
 //  * raw force: the simulation sends the force at the position it last heard of;
 //  * local model, K = contact in series with tissue: the device renders f0 + K·(x − x0) itself;
@@ -9,7 +9,7 @@
 // The steady force is checked against the analytic equilibrium (hand spring = contact spring =
 // tissue force, solved by bisection here, not by simulating), and oscillation by the force's
 // rms about its mean over the last second.
-#include "hapsim/net/link_sweep.h"
+#include "bench/link_sweep.h"
 
 #include <cmath>
 #include <cstdio>
@@ -18,8 +18,10 @@
 
 #include <gtest/gtest.h>
 
-namespace hapsim::net {
+namespace hapsim::bench {
 namespace {
+
+using net::ForceMode;
 
 const OneDofPlant kPlant{};
 constexpr double kHandStiffness_n_per_m = 300.0;
@@ -128,7 +130,7 @@ TEST(OneDofAnalysis, AnalyticHoldIsConsistent) {
   EXPECT_EQ(hand_model(SweepHand::kRelaxed).stiffness_n_per_m, kHandStiffness_n_per_m);
   EXPECT_EQ(hand_model(SweepHand::kRelaxed).target_m, kHandTarget_m);
   for (const double x_m : {-0.001, 0.002, 0.01, 0.02}) {
-    EXPECT_NEAR(net::quasi_static_force_n(kPlant, SweepEnvironment::kTissue, x_m),
+    EXPECT_NEAR(bench::quasi_static_force_n(kPlant, SweepEnvironment::kTissue, x_m),
                 quasi_static_force_n(x_m), 1e-9);
   }
 }
@@ -187,4 +189,4 @@ INSTANTIATE_TEST_SUITE_P(DelayAndLoss, OneDofLink, ::testing::ValuesIn(sweep()),
                          });
 
 }  // namespace
-}  // namespace hapsim::net
+}  // namespace hapsim::bench

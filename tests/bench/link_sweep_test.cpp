@@ -1,17 +1,19 @@
-// The network sweep (net/link_sweep.h) against answers worked out here: the wall's hold is the
+// The network sweep (bench/link_sweep.h) against answers worked out here: the wall's hold is the
 // hand spring and the wall spring in series; the tissue's hold and its stored energy come from
 // this file's own bisection and quadrature of the force law; raw force must be caught unstable
 // at 20 ms and the local model must hold the targets on a reduced grid; an outage fades
 // the local model to zero 150 ms after its last model, while raw holds its last force.
-#include "hapsim/net/link_sweep.h"
+#include "bench/link_sweep.h"
 
 #include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
 
-namespace hapsim::net {
+namespace hapsim::bench {
 namespace {
+
+using net::ForceMode;
 
 const OneDofPlant kPlant{};
 
@@ -250,4 +252,4 @@ TEST(LinkSweep, SweepRowsCompareTheLocalModelWithItsZeroDelayRun) {
 }
 
 }  // namespace
-}  // namespace hapsim::net
+}  // namespace hapsim::bench
