@@ -1,10 +1,12 @@
 // Aiming a scene's palpation: the target lands on the first surface met along `from` (skin over
 // bone, like a finger would), exactly on analytic shapes, whatever contact method the body uses;
 // the planned press reaches that surface plus the depth.
-#include "hapsim/scene/scene_device.h"
+#include "hapsim/script/palpation_aim.h"
+#include "hapsim/script/scene_palpation_plan.h"
 
 #include "hapsim/core/error.h"
 #include "hapsim/geometry/procedural.h"
+#include "hapsim/world/world.h"
 
 #include <gtest/gtest.h>
 

@@ -1,14 +1,14 @@
 #include "hapsim/scene/teleop_setup.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/kinematics/inverse_kinematics.h"
+#include "hapsim/kinematics/master_arm.h"
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
-#include "hapsim/script/pick_and_place_trajectory.h"
+#include "hapsim/script/slave_start.h"
+#include "hapsim/script/teleop_pick_and_place_plan.h"
 
 #include <memory>
 #include <utility>
-#include <vector>
 
 namespace hapsim {
 
@@ -58,32 +58,14 @@ TeleopSetup make_teleop_setup(const SceneDescription& scene,
     }
     s.device_name = "simulated master (trajectory " + file.string() + ")";
   } else {
-    PickAndPlaceScript script;
-    script.pick_world = d.ball_start_world;
-    script.place_world = scene.device.pick_and_place.place_m;
-    script.clearance_m = scene.device.pick_and_place.clearance_m;
-    script.carry_s = scene.device.pick_and_place.carry_s;
-    script.sample_period_s = scene.device.pick_and_place.sample_period_s;
-    script.grasp_depth_m =
-        grasp_depth_m(d.gripper.pad_depth_m, d.gripper.pad_half_m.z(), d.ball.radius_m);
-    script.open_width_m = 0.9 * d.follower.gripper_max_width_m;
-    s.trajectory =
-        make_pick_and_place_plan(script, master, d.mapping, d.follower.gripper_max_width_m)
-            .trajectory;
+    s.trajectory = make_teleop_pick_and_place(scene.device.pick_and_place, d, master).trajectory;
     s.has_target = true;
-    s.target_world = script.place_world;
+    s.target_world = scene.device.pick_and_place.place_m;
     s.device_name = "simulated master (scripted pick-and-place)";
   }
 
   // The slave starts where the master's first pose asks it to be (one cold IK, before the run).
-  const DeviceInput first = s.trajectory.sample_at(s.trajectory.start_time_s());
-  const Iso3 start = slave_target(
-      d.mapping,
-      master.hand_pose({first.joint_rad[0], first.joint_rad[1], first.joint_rad[2]}).translation(),
-      first.joint_rad[0]);
-  const std::vector<double> seed(static_cast<std::size_t>(d.slave->dof()), 0.0);
-  d.slave_start_rad.assign(seed.size(), 0.0);
-  if (!solve_ik(*d.slave, start, seed, d.slave_start_rad).reached) {
+  if (!solve_slave_start(d, master, s.trajectory)) {
     throw Error(scene.file.string(),
                 "the master's first pose puts the slave's target out of its reach");
   }

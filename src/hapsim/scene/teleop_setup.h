@@ -1,7 +1,9 @@
 // A teleoperation scene file made runnable (000): the world and rig it describes, with the slave's
 // start joints solved so the slave begins where the master's first pose puts it, and the master
 // input that drives it (the scripted pick-and-place, or a trajectory of master joints). Shared by
-// `hapsim run` and the viewer, so both build exactly the same world.
+// `hapsim run` and the viewer, so both build exactly the same world. Here: reading the rig's
+// slave (procedural or URDF) and the trajectory file, and choosing the input; the planning is in
+// script/ (teleop_pick_and_place_plan.h, slave_start.h).
 #pragma once
 
 #include "hapsim/scene/scene_description.h"
