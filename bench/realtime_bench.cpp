@@ -2,12 +2,14 @@
 // (the viewer's triple-buffered snapshot with deformed vertices copied by delta, and the ring of
 // cycle records), side by side in the same run; the triple buffer's own hand-over; and drawing
 // one 1280x720 frame of the knee offscreen on Mesa's software rasteriser (what bounds the
-// viewer's fps). The loop's timing over a minute comes from scripts/measure-realtime.sh.
+// viewer's fps). The knee's world and device are the ones `hapsim run` builds for the scene
+// (make_run_setup, scene/run_setup.h: materials no stiffer than the device's rating). The loop's
+// timing over a minute comes from scripts/measure-realtime.sh.
 #include "hapsim/core/triple_buffer.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
 #include "hapsim/runtime/world_haptic_client.h"
-#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 
 #include <benchmark/benchmark.h>
@@ -22,10 +24,11 @@ namespace hapsim {
 namespace {
 
 struct Knee {
-  SceneDescription scene =
-      load_scene(std::filesystem::path(HAPSIM_BENCH_SCENES_DIR) / "knee_procedural.json");
-  World world{scene.world};
-  std::unique_ptr<SimulatedDevice> device = make_scene_device(scene, world);
+  RunSetup setup = make_run_setup(
+      load_scene(std::filesystem::path(HAPSIM_BENCH_SCENES_DIR) / "knee_procedural.json"),
+      DeviceChoice::scene_script());
+  World& world = *setup.world;
+  Device& device = *setup.device;
 };
 
 Knee& knee() {
@@ -42,12 +45,14 @@ void BM_KneeStep(benchmark::State& state) {
   o.publish_snapshots = publish;
   o.record_capacity = publish ? 4096 : 0;
   WorldHapticClient client(k.world, o);
-  const double end_s = k.device->duration_end_s();
+  // The run's length (the palpation script's: the scene sets no run.duration_s), lap after lap.
+  const double end_s = k.setup.duration_s;
+  const double dt = k.setup.scene.run.dt_s;
   std::uint64_t i = 0;
   for (auto _ : state) {
-    const double t = std::fmod(static_cast<double>(i) * 1e-3, end_s);
-    const DeviceInput in = k.device->read(t);
-    const DeviceCommand& command = client.step(in, 1e-3);
+    const double t = std::fmod(static_cast<double>(i) * dt, end_s);
+    const DeviceInput in = k.device.read(t);
+    const DeviceCommand& command = client.step(in, dt);
     if (publish) {
       HapticCycle cycle;
       cycle.index = i;

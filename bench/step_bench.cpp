@@ -1,12 +1,13 @@
 // Google Benchmark view of the haptic step (bench/step_cases.h): one benchmark per case and
 // contact method, named "step/<case>/<method>"; each iteration is one World::step on the next
 // sample of the scene's palpation script (looping), so deformation and proxy state evolve as in a
-// session. For the p50/p99 table and JSON, use `hapsim bench step`.
+// session. The world and its device are the ones `hapsim run --method` builds (make_run_setup,
+// scene/run_setup.h), as `hapsim bench step` builds them. For the p50/p99 table and JSON, use
+// `hapsim bench step`.
 #include "bench/collision_cases.h"
 #include "bench/step_cases.h"
 
-#include "hapsim/core/device_profile.h"
-#include "hapsim/scene/scene_device.h"
+#include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/world/world.h"
 
@@ -25,23 +26,20 @@ void run_case(benchmark::State& state, const bench::StepBenchCase& c, ContactMet
   if (c.data_dir) {
     load.data_dir = *c.data_dir;
   }
-  const SceneDescription scene = load_scene(c.scene, load);
-  WorldDescription description = scene.world;
-  for (BodyDescription& b : description.bodies) {
-    b.method = method;
-  }
-  WorldOptions options;
-  options.max_stiffness_n_per_m = device_profile(scene.device.profile).max_stiffness_n_per_m;
-  World world(std::move(description), options);
-  auto device = make_scene_device(scene, world);
-  const double dt = scene.run.dt_s;
-  const double end_s = device->duration_end_s();
+  RunSetupOptions options;
+  options.method = method;
+  RunSetup setup = make_run_setup(load_scene(c.scene, load), DeviceChoice::scene_script(), options);
+  World& world = *setup.world;
+  Device& device = *setup.device;
+  const double dt = setup.scene.run.dt_s;
+  // The run's length (the script's, unless the scene sets run.duration_s), then again from 0.
+  const double end_s = setup.duration_s;
   double t = 0.0;
   // A FEM body's updates run between steps, untimed, as on its own thread in a session.
   const bool fem = world.fem() != nullptr;
   world.set_fem_deferred(fem);
   for (auto _ : state) {
-    const DeviceInput input = device->read(t);
+    const DeviceInput input = device.read(t);
     const StepResult& r = world.step(input, dt);
     benchmark::DoNotOptimize(r.command.force_world_n.data());
     if (fem) {
