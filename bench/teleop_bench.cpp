@@ -5,7 +5,8 @@
 // percentiles of the whole scene come from `hapsim run scenes/teleop.json --json FILE`.
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
-#include "hapsim/script/pick_and_place_trajectory.h"
+#include "hapsim/scene/run_setup.h"
+#include "hapsim/scene/scene_file.h"
 #include "hapsim/world/world.h"
 
 #include <benchmark/benchmark.h>
@@ -32,44 +33,35 @@ bool have_gp7() {
                                  "motoman_gp7" / "gp7.urdf");
 }
 
-// Every cycle of the scripted pick-and-place, round and round (the world restarts each lap).
+// Every cycle of the scripted pick-and-place, round and round (the world restarts each lap): the
+// world and the master's script are the ones `hapsim run scenes/teleop.json` (teleop_gp7.json for
+// the GP7) builds, through make_run_setup.
 void BM_TeleopStep(benchmark::State& state) {
   const bool gp7 = state.range(0) != 0;
   if (gp7 && !have_gp7()) {
     state.SkipWithError("GP7 URDF not found");
     return;
   }
-  TeleopRigDescription d;
-  d.slave = slave(gp7);
-  d.environment.floor_z_m = 0.0;
-  d.environment.X_world_sheet = Iso3(Eigen::Translation3d(0.5, 0.25, 0.05));
-  PickAndPlaceScript script;
-  script.pick_world = d.ball_start_world;
-  script.grasp_depth_m =
-      grasp_depth_m(d.gripper.pad_depth_m, d.gripper.pad_half_m.z(), d.ball.radius_m);
-  const MasterArm master(d.master);
-  const PickAndPlacePlan plan =
-      make_pick_and_place_plan(script, master, d.mapping, d.follower.gripper_max_width_m);
-  const DeviceInput first = plan.trajectory.sample_at(0.0);
-  const Iso3 start = slave_target(
-      d.mapping,
-      master.hand_pose({first.joint_rad[0], first.joint_rad[1], first.joint_rad[2]}).translation(),
-      first.joint_rad[0]);
-  std::vector<double> seed(static_cast<std::size_t>(d.slave->dof()), 0.0);
-  d.slave_start_rad.assign(seed.size(), 0.0);
-  (void)solve_ik(*d.slave, start, seed, d.slave_start_rad);
-  const auto steps = static_cast<int>(plan.trajectory.end_time_s() / 1e-3);
+  const std::filesystem::path scenes(HAPSIM_BENCH_SCENES_DIR);
+  SceneLoadOptions load;
+  if (gp7) {
+    load.data_dir = std::filesystem::path(HAPSIM_BENCH_DEFAULT_DATA_DIR) / "motoman_gp7";
+  }
+  const SceneDescription scene =
+      load_scene(scenes / (gp7 ? "teleop_gp7.json" : "teleop.json"), load);
+  RunSetup setup = make_run_setup(scene, DeviceChoice::scene_script());
+  const double dt_s = setup.scene.run.dt_s;
+  const auto steps = static_cast<int>(setup.duration_s / dt_s);
   std::vector<DeviceInput> inputs;
   for (int k = 1; k <= steps; ++k) {
-    inputs.push_back(plan.trajectory.sample_at(k * 1e-3));
+    inputs.push_back(setup.device->read(k * dt_s));
   }
-  auto world = std::make_unique<World>(rig_world(d));
   std::size_t k = 0;
   for (auto _ : state) {
-    benchmark::DoNotOptimize(world->step(inputs[k], 1e-3));
+    benchmark::DoNotOptimize(setup.world->step(inputs[k], dt_s));
     if (++k == inputs.size()) {
       state.PauseTiming();
-      world = std::make_unique<World>(rig_world(d));
+      setup.world = make_run_setup(scene, DeviceChoice::scene_script()).world;
       k = 0;
       state.ResumeTiming();
     }
