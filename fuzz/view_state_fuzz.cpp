@@ -201,11 +201,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   HAPSIM_FUZZ_CHECK(seen.contact_count <= seen.contacts.size(), "more contacts than room");
   for (std::size_t i = 0; i < seen.contact_count; ++i) {
     const hapsim::WorldContact& c = seen.contacts[i];
-    HAPSIM_FUZZ_CHECK(c.tool >= 0 && static_cast<std::size_t>(c.tool) < seen.tools.size() &&
-                          c.body >= 0 && static_cast<std::size_t>(c.body) < v.world.body_count() &&
-                          c.segment >= 0 &&
-                          static_cast<std::size_t>(c.segment) <
-                              v.world.segment_count(static_cast<std::size_t>(c.body)),
+    HAPSIM_FUZZ_CHECK(c.tool.valid() && c.tool.index() < seen.tools.size() && c.body.valid() &&
+                          c.body.index() < v.world.body_count() && c.segment.valid() &&
+                          c.segment.index() < v.world.segment_count(c.body.index()),
                       "accepted contact names a tool, body or segment the scene lacks");
     HAPSIM_FUZZ_CHECK(finite(c.point_world) && finite(c.normal_world) && std::isfinite(c.force_n) &&
                           std::isfinite(c.depth_m),

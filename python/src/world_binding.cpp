@@ -202,9 +202,9 @@ py::dict contacts(const World& w) {
   auto x = proxy.mutable_unchecked<1>();
   for (py::ssize_t i = 0; i < n; ++i) {
     const WorldContact& k = c[static_cast<std::size_t>(i)];
-    t(i) = k.tool;
-    b(i) = k.body;
-    s(i) = k.segment;
+    t(i) = k.tool.value;
+    b(i) = k.body.value;
+    s(i) = k.segment.value;  // body-local, as Python's World.contacts() documents
     for (py::ssize_t j = 0; j < 3; ++j) {
       p(i, j) = k.point_world[j];
       nn(i, j) = k.normal_world[j];

@@ -115,7 +115,8 @@ TEST(SceneReference, KneeSegmentAndGroupColoursMatchTheReferences) {
   o.colouring = SegmentColouring::kSegments;
   WorldScene view(world, o);
   // The skin hides the rest: show what is under it, as the knee paper's Fig. 3 does.
-  view.set_segment_visible(world.flat_segment(0, world.segment_count(0) - 1), false);
+  view.set_segment_visible(
+      world.flat_segment(BodyIndex{0}, LocalSegment{world.segment_count(0) - 1}).index(), false);
   const OrbitCamera camera =
       framed_camera(view.rest_bounds_world(), static_cast<double>(kWidth) / kHeight, 1.95, 0.3);
   view.update_from_world(world);
@@ -214,7 +215,8 @@ TEST(SceneReference, BallsImprintInTheSheetMatchesTheReference) {
   view.update_from_world(*world);
   // Only the sheet, from above at the ball's side: its grid bends and darkens into the dent.
   for (std::size_t i = 0; i < view.segment_count(); ++i) {
-    view.set_segment_visible(i, i == world->flat_segment(rig.sheet_body, 0));
+    view.set_segment_visible(
+        i, i == world->flat_segment(BodyIndex{rig.sheet_body}, LocalSegment{0}).index());
   }
   view.scene().capsules.clear();
   view.scene().spheres.clear();
@@ -229,7 +231,8 @@ TEST(SceneReference, BallsImprintInTheSheetMatchesTheReference) {
   WorldScene rest(flat);
   rest.update_from_world(flat);
   for (std::size_t i = 0; i < rest.segment_count(); ++i) {
-    rest.set_segment_visible(i, i == flat.flat_segment(rig.sheet_body, 0));
+    rest.set_segment_visible(
+        i, i == flat.flat_segment(BodyIndex{rig.sheet_body}, LocalSegment{0}).index());
   }
   rest.scene().capsules.clear();
   rest.scene().spheres.clear();

@@ -88,7 +88,9 @@ TEST_F(WorldSceneRigTest, SheetMeshHoldsTheWorldsDentedHeights) {
   from_snapshot.update(make_world_snapshot(world));
   const auto heights = world.sheet(world.description().teleop->sheet_body)->surface_heights();
   const TriangleMesh& rest = world.sheet(world.description().teleop->sheet_body)->mesh();
-  const std::size_t flat = world.flat_segment(world.description().teleop->sheet_body, 0);
+  const std::size_t flat =
+      world.flat_segment(BodyIndex{world.description().teleop->sheet_body}, LocalSegment{0})
+          .index();
   for (const WorldScene* scene : {&from_world, &from_snapshot}) {
     const RenderMesh& sheet = scene->scene().mesh(scene->segment_mesh(flat));
     ASSERT_EQ(sheet.geometry().vertices.size(), heights.size());
@@ -141,7 +143,7 @@ TEST_F(WorldSceneRigTest, BallColourAppearsWhereItsCentreProjects) {
       << pixel_at(with_ball, kW, x, y).g << " " << pixel_at(with_ball, kW, x, y).b;
   // The ball is drawn where its body is; without it the red is gone (it was the ball, not the
   // robot or the background).
-  const std::size_t flat = world.flat_segment(ball_body, 0);
+  const std::size_t flat = world.flat_segment(BodyIndex{ball_body}, LocalSegment{0}).index();
   EXPECT_TRUE(scene.scene()
                   .mesh(scene.segment_mesh(flat))
                   .X_world_mesh.isApprox(world.body_pose(ball_body), 0.0));
@@ -169,7 +171,8 @@ TEST_F(WorldSceneRigTest, BallsImprintShowsInTheDrawnSheet) {
     scene.update_from_world(*w);
     RenderScene& rs = scene.scene();
     for (std::size_t i = 0; i < scene.segment_count(); ++i) {
-      scene.set_segment_visible(i, i == world.flat_segment(rig.sheet_body, 0));
+      scene.set_segment_visible(
+          i, i == world.flat_segment(BodyIndex{rig.sheet_body}, LocalSegment{0}).index());
     }
     rs.spheres.clear();
     rs.segments.clear();
@@ -195,7 +198,11 @@ TEST_F(WorldSceneRigTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
   scene.update_from_world(world);
   const auto pad_mesh = [&](int i) {
     return scene.segment_mesh(
-        world.flat_segment(world.description().teleop->pad_body[static_cast<std::size_t>(i)], 0));
+        world
+            .flat_segment(
+                BodyIndex{world.description().teleop->pad_body[static_cast<std::size_t>(i)]},
+                LocalSegment{0})
+            .index());
   };
   // Independent geometry: the tool from the chain's FK, the pads across its y at the pad depth.
   const Iso3 X_tool = world.rig()->slave->chain().forward(world.rig()->slave->q());
@@ -252,7 +259,8 @@ std::vector<MeshId> link_meshes(const World& world, const WorldScene& scene) {
   std::vector<MeshId> ids;
   for (const TeleopRigDescription::SlaveBody& s : world.description().teleop->slave_bodies) {
     if (s.frame != kToolFrame) {
-      ids.push_back(scene.segment_mesh(world.flat_segment(s.body, 0)));
+      ids.push_back(
+          scene.segment_mesh(world.flat_segment(BodyIndex{s.body}, LocalSegment{0}).index()));
     }
   }
   return ids;

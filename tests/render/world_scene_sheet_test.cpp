@@ -62,7 +62,8 @@ void expect_sheet_drawn_as_the_world_has_it(const WorldScene& view, const World&
                                             std::size_t sheet_body, double tolerance_m) {
   const BodyDescription& body = world.description().bodies[sheet_body];
   const TriangleMesh grid = make_sheet(body.sheet.nodes_per_side, body.sheet.side_m);
-  const RenderMesh& mesh = view.scene().mesh(view.segment_mesh(world.flat_segment(sheet_body, 0)));
+  const RenderMesh& mesh = view.scene().mesh(
+      view.segment_mesh(world.flat_segment(BodyIndex{sheet_body}, LocalSegment{0}).index()));
   ASSERT_EQ(mesh.geometry().vertices.size(), grid.vertices.size());
   for (std::size_t k = 0; k < grid.vertices.size(); ++k) {
     const Vec3 drawn = mesh.X_world_mesh * mesh.geometry().vertices[k];
@@ -88,7 +89,8 @@ TEST(WorldSceneSheet, HandBallSheetsDrawnVerticesAreTheWorldsSheet) {
   from_snapshot.update(make_world_snapshot(world));
   for (const WorldScene* view : {&at_build, &from_world, &from_snapshot}) {
     expect_sheet_drawn_as_the_world_has_it(*view, world, sheet, 1e-7);
-    const RenderMesh& mesh = view->scene().mesh(view->segment_mesh(world.flat_segment(sheet, 0)));
+    const RenderMesh& mesh = view->scene().mesh(
+        view->segment_mesh(world.flat_segment(BodyIndex{sheet}, LocalSegment{0}).index()));
     Box3 drawn;
     for (const Vec3& v : mesh.geometry().vertices) {
       drawn.extend(mesh.X_world_mesh * v);
@@ -101,8 +103,8 @@ TEST(WorldSceneSheet, HandBallSheetsDrawnVerticesAreTheWorldsSheet) {
     EXPECT_NEAR(drawn.max().z(), 0.05, 1e-7);
     // The table is drawn with its top at z = 0, 5 cm under the sheet.
     const std::size_t table = body_named(world.description(), "table");
-    const RenderMesh& table_mesh =
-        view->scene().mesh(view->segment_mesh(world.flat_segment(table, 0)));
+    const RenderMesh& table_mesh = view->scene().mesh(
+        view->segment_mesh(world.flat_segment(BodyIndex{table}, LocalSegment{0}).index()));
     Box3 table_drawn;
     for (const Vec3& v : table_mesh.geometry().vertices) {
       table_drawn.extend(table_mesh.X_world_mesh * v);

@@ -57,7 +57,10 @@ TEST(WorldHapticClientRig, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   EXPECT_EQ(s.held, world.rig()->result.held);
   const auto heights = world.sheet(world.description().teleop->sheet_body)->surface_heights();
   const std::vector<float>& sheet_xyz =
-      ws.positions_body[world.flat_segment(world.description().teleop->sheet_body, 0)];
+      ws.positions_body[world
+                            .flat_segment(BodyIndex{world.description().teleop->sheet_body},
+                                          LocalSegment{0})
+                            .index()];
   ASSERT_EQ(sheet_xyz.size(), 3 * heights.size());
   for (std::size_t k = 0; k < heights.size(); ++k) {
     ASSERT_EQ(sheet_xyz[3 * k + 2], static_cast<float>(heights[k])) << "node " << k;

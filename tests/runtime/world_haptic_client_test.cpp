@@ -107,7 +107,7 @@ TEST(WorldHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   ASSERT_TRUE(buffer.update());
   const WorldSnapshot& s = buffer.read_slot();
   EXPECT_EQ(s.cycle, 249u);
-  const std::size_t flat = world.flat_segment(1, 0);
+  const std::size_t flat = world.flat_segment(BodyIndex{1}, LocalSegment{0}).index();
   const TriangleMesh& surface = world.surface(1, 0);
   ASSERT_EQ(s.positions_body[flat].size(), 3 * surface.vertices.size());
   std::size_t moved = 0;
@@ -122,7 +122,8 @@ TEST(WorldHapticClient, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   }
   EXPECT_GT(moved, 10u);  // the dent is in the snapshot, not just the rest shape
   EXPECT_GT(s.positions_version[flat], 0u);
-  EXPECT_TRUE(s.positions_body[world.flat_segment(0, 0)].empty());  // rigid: nothing to copy
+  EXPECT_TRUE(s.positions_body[world.flat_segment(BodyIndex{0}, LocalSegment{0}).index()]
+                  .empty());  // rigid: nothing to copy
   EXPECT_NEAR(s.deflection_m[flat], world.current_deflection_m(1, 0), 0.0);
   EXPECT_GT(s.contact_count, 0u);
   EXPECT_GT(s.tool_force_n[0], 0.0);
@@ -194,9 +195,11 @@ TEST(WorldHapticClient, KneeSceneWithItsScriptedDeviceAllocatesNothingOnTheHapti
   loop.start();
   loop.wait();
   EXPECT_EQ(counting.allocations(), 0) << "the haptic thread allocated";
-  EXPECT_GT(world.current_deflection_m(0, world.segment_count(0) - 1) +
-                client.max_deflection_m()[world.flat_segment(0, world.segment_count(0) - 1)],
-            0.001);  // it did press the skin
+  EXPECT_GT(
+      world.current_deflection_m(0, world.segment_count(0) - 1) +
+          client.max_deflection_m()
+              [world.flat_segment(BodyIndex{0}, LocalSegment{world.segment_count(0) - 1}).index()],
+      0.001);  // it did press the skin
 }
 
 // Back from a pause with the device moved deep into the soft ball: no velocity from where the
@@ -317,7 +320,7 @@ TEST(WorldHapticClient, ResetAndPauseReachTheSnapshot) {
   again.wait();
   ASSERT_TRUE(client.snapshots()->update());
   const WorldSnapshot& s = client.snapshots()->read_slot();
-  const std::size_t flat = world.flat_segment(1, 0);
+  const std::size_t flat = world.flat_segment(BodyIndex{1}, LocalSegment{0}).index();
   const auto rest = world.deflection(1, 0)->rest_positions();
   for (std::size_t v = 0; v < rest.size(); ++v) {
     ASSERT_EQ(s.positions_body[flat][3 * v + 2], static_cast<float>(rest[v].z()));

@@ -63,7 +63,7 @@ DragResult drag_across_patella(const std::string& scene_file, double speed_m_per
   const double dt = 1e-3;
   const auto touches_patella = [&](const StepResult& r) {
     for (const WorldContact& c : r.contacts) {
-      if (c.proxy && c.body == patella_body && c.segment == static_cast<std::int32_t>(patella)) {
+      if (c.proxy && c.body == BodyIndex{patella_body} && c.segment == LocalSegment{patella}) {
         return true;
       }
     }

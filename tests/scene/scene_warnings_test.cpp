@@ -226,8 +226,10 @@ TEST(SceneWarnings, TheKneeMethodSaysItsProxySegmentsAnswerExactlyAndWhereItIsFa
   std::size_t proxy = 0;
   std::size_t penalty = 0;
   for (std::size_t s = 0; s < knee.segments.size(); ++s) {
-    const bool is_proxy = world.model().segments()[world.model().flat_segment(0, s)].response ==
-                          ContactResponse::kProxy;
+    const bool is_proxy =
+        world.model()
+            .segments()[world.model().flat_segment(BodyIndex{0}, LocalSegment{s}).index()]
+            .response == ContactResponse::kProxy;
     EXPECT_EQ(world.rest_query(0, s).method_name(), is_proxy ? "exact" : "knee")
         << knee.segments[s].name;
     (is_proxy ? proxy : penalty) += 1;

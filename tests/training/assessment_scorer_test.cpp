@@ -53,9 +53,9 @@ CycleRecord cycle(std::initializer_list<Touch> touches) {
   double total = 0.0;
   for (const Touch& t : touches) {
     WorldContact& c = r.contacts[static_cast<std::size_t>(r.contact_count++)];
-    c.tool = 0;
-    c.body = t.body;
-    c.segment = 0;
+    c.tool = ToolIndex{0};
+    c.body = BodyIndex{t.body};
+    c.segment = LocalSegment{0};
     c.point_world = t.point;
     c.force_n = t.force_n;
     total += t.force_n;

@@ -71,7 +71,7 @@ TEST(DynamicBody, BallDroppedOnTheFloorRestsWhereTheSpringCarriesItsWeight) {
   EXPECT_LT(world.state().bodies[1].v_world.norm(), 1e-4);
   ASSERT_EQ(world.last_result().body_contacts.size(), 1U);
   const BodyContact& c = world.last_result().body_contacts.front();
-  EXPECT_EQ(c.other_body, 0);
+  EXPECT_EQ(c.other_body, BodyIndex{0});
   EXPECT_NEAR(c.force_world_n.z(), kBallMass * kG, 1e-3);
   EXPECT_NEAR(c.normal_world.z(), 1.0, 1e-9);
 }

@@ -77,7 +77,7 @@ TEST(DynamicMesh, CubeDroppedOnTheFloorRestsOnItsFourCorners) {
   EXPECT_LT(world.state().bodies[1].v_world.norm(), 1e-4);
   ASSERT_EQ(world.last_result().body_contacts.size(), 1U) << "one contact per pair of segments";
   const BodyContact& c = world.last_result().body_contacts.front();
-  EXPECT_EQ(c.other_body, 0);
+  EXPECT_EQ(c.other_body, BodyIndex{0});
   EXPECT_NEAR(c.force_world_n.z(), mass * kG, 1e-4);
   EXPECT_NEAR(c.normal_world.z(), 1.0, 1e-9);
   EXPECT_NEAR(c.depth_m, x, 1e-6);
@@ -145,9 +145,9 @@ TEST(DynamicMesh, SmallCubeStackedOnACubeIsCarriedAndBothByTheFloor) {
   EXPECT_LT(world->state().bodies[2].v_world.norm(), 1e-4);
   ASSERT_EQ(world->last_result().body_contacts.size(), 2U);
   for (const BodyContact& c : world->last_result().body_contacts) {
-    const double carried = c.other_body == 0 ? (m_big + m_small) * kG : m_small * kG;
+    const double carried = c.other_body == BodyIndex{0} ? (m_big + m_small) * kG : m_small * kG;
     // The lower-numbered body answers for a pair: the big cube, pushed down by the small one.
-    const double sign = c.other_body == 0 ? 1.0 : -1.0;
+    const double sign = c.other_body == BodyIndex{0} ? 1.0 : -1.0;
     EXPECT_NEAR(sign * c.force_world_n.z(), carried, 1e-4) << "contact with " << c.other_body;
   }
   // The same run again gives the same bits.

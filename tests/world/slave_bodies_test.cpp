@@ -172,38 +172,38 @@ TEST(SlaveBodies, ALinkSweptIntoTheRestingBallPushesItAway) {
   d.ball_start_world = meet;
   World world(rig_world(d));
   const std::size_t ball = world.description().teleop->ball_body;
-  std::int32_t link = -1;  // the first body to touch the ball: one of the slave's links
+  BodyIndex link = kNoBody;  // the first body to touch the ball: one of the slave's links
   Vec3 link_velocity = Vec3::Zero();
   for (int k = 1; k <= 600; ++k) {
     const StepResult& r = world.step(swing(k), 1e-3);
     Vec3 on_ball_from_link = Vec3::Zero();
     bool link_contact = false;
     for (const BodyContact& c : r.body_contacts) {
-      ASSERT_EQ(c.body, static_cast<std::int32_t>(ball));
-      if (link < 0) {
+      ASSERT_EQ(c.body, BodyIndex{ball});
+      if (!link.valid()) {
         link = c.other_body;
         // The link's material point where the ball is, at first touch.
-        link_velocity = r.bodies[static_cast<std::size_t>(link)].velocity_at(meet, Vec3::Zero());
+        link_velocity = r.bodies[link.index()].velocity_at(meet, Vec3::Zero());
       }
       if (c.other_body == link) {
         on_ball_from_link += c.force_world_n;
         link_contact = true;
       }
     }
-    if (link < 0) {
+    if (!link.valid()) {
       // At rest until a link arrives.
       EXPECT_EQ(world.body_pose(ball).translation(), meet) << "step " << k;
     }
     if (link_contact) {
       // Equal and opposite: what the link took is what it gave the ball.
-      const Vec3& on_link = r.bodies[static_cast<std::size_t>(link)].force_world_n;
+      const Vec3& on_link = r.bodies[link.index()].force_world_n;
       EXPECT_LT((on_link + on_ball_from_link).norm(),
                 1e-9 * std::max(1.0, on_ball_from_link.norm()))
           << "step " << k;
     }
   }
-  ASSERT_GE(link, 0) << "no link met the ball";
-  const std::string& name = world.description().bodies[static_cast<std::size_t>(link)].name;
+  ASSERT_TRUE(link.valid()) << "no link met the ball";
+  const std::string& name = world.description().bodies[link.index()].name;
   EXPECT_EQ(name.rfind("slave_", 0), 0U) << name;
   ASSERT_GT(link_velocity.norm(), 0.05) << "the link should sweep";
   // Pushed ahead of the link, along the way it swept, by more than a centimetre.
@@ -264,8 +264,7 @@ TEST(SlaveBodies, TheBallPressingThePalmIsFeltAtTheMaster) {
     const StepResult& r = world.step(input, 1e-3);
     std::size_t palm_contacts = 0;
     for (const BodyContact& c : r.body_contacts) {
-      EXPECT_EQ(world.description().bodies[static_cast<std::size_t>(c.other_body)].name,
-                "slave_gripper_palm");
+      EXPECT_EQ(world.description().bodies[c.other_body.index()].name, "slave_gripper_palm");
       ++palm_contacts;
     }
     EXPECT_EQ(palm_contacts, under_palm ? 1U : 0U);
@@ -298,7 +297,7 @@ TEST(SlaveBodies, ShippedPickAndPlaceHoldsTheBallWithThePadsAlone) {
     const StepResult& r = world.step(t.sample_at(t.start_time_s() + k * 1e-3), 1e-3);
     ASSERT_EQ(r.teleop->slave_collisions, 0) << "at " << r.time_s << " s";
     for (const BodyContact& c : r.body_contacts) {
-      const auto other = static_cast<std::size_t>(c.other_body);
+      const std::size_t other = c.other_body.index();
       const bool pad = other == rig.pad_body[0] || other == rig.pad_body[1];
       pad_steps += pad ? 1 : 0;
       EXPECT_TRUE(pad || other == rig.floor_body || other == rig.sheet_body)

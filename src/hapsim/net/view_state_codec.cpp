@@ -116,9 +116,9 @@ const hapsim_msg_ViewState& ViewStateEncoder::encode(const WorldSnapshot& s,
   for (std::size_t i = 0; i < contacts_.size(); ++i) {
     const WorldContact& c = s.contacts[i];
     hapsim_msg_ContactView& v = contacts_[i];
-    v.tool = c.tool;
-    v.body = c.body;
-    v.segment = c.segment;
+    v.tool = c.tool.value;
+    v.body = c.body.value;
+    v.segment = c.segment.value;  // body-local
     put3(v.point_m, c.point_world);
     put3(v.normal, c.normal_world);
     v.depth_m = c.depth_m;
@@ -298,9 +298,9 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
   for (std::uint32_t i = 0; i < m.contacts._length; ++i) {
     const hapsim_msg_ContactView& c = m.contacts._buffer[i];
     WorldContact& w = s.contacts[i];
-    w.tool = c.tool;
-    w.body = c.body;
-    w.segment = c.segment;
+    w.tool = ToolIndex{c.tool};
+    w.body = BodyIndex{c.body};
+    w.segment = LocalSegment{c.segment};
     w.point_world = get3(c.point_m);
     w.normal_world = get3(c.normal);
     w.depth_m = c.depth_m;

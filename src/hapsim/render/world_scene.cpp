@@ -153,7 +153,7 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
           rest_bounds_world_.extend(body.X_world_body * v);
         }
       }
-      segments_[world.flat_segment(b, s)] = std::move(seg);
+      segments_[world.flat_segment(BodyIndex{b}, LocalSegment{s}).index()] = std::move(seg);
     }
     body_poses_.push_back(world.body_pose(b));
   }
@@ -195,7 +195,9 @@ void WorldScene::build_rig() {
   if (slave_figure_->draws_links()) {
     for (const TeleopRigDescription::SlaveBody& s : rig.slave_bodies) {
       if (s.frame != kToolFrame) {
-        scene_.mesh(segments_[world_.flat_segment(s.body, 0)]->mesh).visible = false;
+        scene_
+            .mesh(segments_[world_.flat_segment(BodyIndex{s.body}, LocalSegment{0}).index()]->mesh)
+            .visible = false;
       }
     }
   }

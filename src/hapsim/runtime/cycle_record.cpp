@@ -30,8 +30,8 @@ void fill_cycle_record(CycleRecord& record, std::uint64_t cycle, const DeviceInp
       record.dynamic_p_world[i] = result.bodies[b].X_world_body.translation();
       record.dynamic_touching[i] = 0;
       for (const BodyContact& c : result.body_contacts) {
-        if (c.body == static_cast<std::int32_t>(b) && c.other_body < 64) {
-          record.dynamic_touching[i] |= std::uint64_t{1} << c.other_body;
+        if (c.body == BodyIndex{b} && c.other_body.valid() && c.other_body.value < 64) {
+          record.dynamic_touching[i] |= std::uint64_t{1} << c.other_body.value;
         }
       }
     }
@@ -59,9 +59,10 @@ RecordedFrame to_recorded_frame(const CycleRecord& record, const DeviceProfile& 
   for (int i = 0; i < n; ++i) {
     const WorldContact& c = record.contacts[static_cast<std::size_t>(i)];
     RecordedContact& r = frame.contacts[static_cast<std::size_t>(i)];
-    r.tool_index = c.tool;
-    r.body_index = c.body;
-    r.segment_index = c.segment;
+    // The recording's fields stay plain integers (its on-disk format); segment is body-local.
+    r.tool_index = c.tool.value;
+    r.body_index = c.body.value;
+    r.segment_index = c.segment.value;
     r.point_world = c.point_world;
     r.normal_world = c.normal_world;
     r.depth_m = c.depth_m;

@@ -106,7 +106,8 @@ class SessionAccountant {
     summary_.segments.resize(world.flat_segment_count());
     for (std::size_t b = 0; b < desc.bodies.size(); ++b) {
       for (std::size_t s = 0; s < desc.bodies[b].segments.size(); ++s) {
-        SegmentSummary& seg = summary_.segments[world.flat_segment(b, s)];
+        SegmentSummary& seg =
+            summary_.segments[world.flat_segment(BodyIndex{b}, LocalSegment{s}).index()];
         seg.body = desc.bodies[b].name;
         seg.name = desc.bodies[b].segments[s].name;
       }
@@ -152,11 +153,10 @@ class SessionAccountant {
     std::fill(touched_.begin(), touched_.end(), std::uint8_t{0});
     for (std::int32_t i = 0; i < r.contact_count; ++i) {
       const WorldContact& c = r.contacts[static_cast<std::size_t>(i)];
-      const std::size_t flat = world_.flat_segment(static_cast<std::size_t>(c.body),
-                                                   static_cast<std::size_t>(c.segment));
+      const std::size_t flat = world_.flat_segment(c.body, c.segment).index();
       SegmentSummary& seg = summary_.segments[flat];
       seg.peak_force_n = std::max(seg.peak_force_n, c.force_n);
-      std::uint8_t& flag = touched_[flat * desc.tools.size() + static_cast<std::size_t>(c.tool)];
+      std::uint8_t& flag = touched_[flat * desc.tools.size() + c.tool.index()];
       if (flag == 0) {
         flag = 1;
         ++seg.contacts;
@@ -411,7 +411,8 @@ SessionSummary run_inline(World& world, Device& device, const SessionOptions& op
         continue;
       }
       for (std::size_t s = 0; s < desc.bodies[b].segments.size(); ++s) {
-        accountant.note_deflection(world.flat_segment(b, s), world.current_deflection_m(b, s));
+        accountant.note_deflection(world.flat_segment(BodyIndex{b}, LocalSegment{s}).index(),
+                                   world.current_deflection_m(b, s));
       }
     }
     if (options.after_cycle) {

@@ -21,7 +21,7 @@ WorldHapticClient::WorldHapticClient(World& world, WorldHapticClientOptions opti
   max_deflection_m_.assign(world_.flat_segment_count(), 0.0);
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
     if (world_.sheet(b) != nullptr) {
-      sheets_.emplace_back(world_.flat_segment(b, 0), b);
+      sheets_.emplace_back(world_.flat_segment(BodyIndex{b}, LocalSegment{0}).index(), b);
     }
     for (std::size_t s = 0; s < d.bodies[b].segments.size(); ++s) {
       const VertexDeflection* deflection = world_.deflection(b, s);
@@ -29,7 +29,7 @@ WorldHapticClient::WorldHapticClient(World& world, WorldHapticClientOptions opti
         continue;
       }
       DeformableSegment seg;
-      seg.flat = world_.flat_segment(b, s);
+      seg.flat = world_.flat_segment(BodyIndex{b}, LocalSegment{s}).index();
       seg.deflection = deflection;
       const std::size_t n = deflection->mesh().vertices.size();
       for (std::vector<std::uint32_t>& pending : seg.pending) {
@@ -125,7 +125,7 @@ void WorldHapticClient::after_cycle(const HapticCycle& cycle) noexcept {
   }
   for (const std::size_t body : world_.model().fem_bodies()) {
     // A FEM body's surface moves on the FEM thread: its newest update's largest displacement.
-    double& peak = max_deflection_m_[world_.flat_segment(body, 0)];
+    double& peak = max_deflection_m_[world_.flat_segment(BodyIndex{body}, LocalSegment{0}).index()];
     peak = std::max(peak, world_.current_deflection_m(body, 0));
   }
   if (snapshots_) {
@@ -184,7 +184,8 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
     fill_teleop_snapshot(t, world_);
   }
   for (const std::size_t body : world_.model().fem_bodies()) {
-    s.deflection_m[world_.flat_segment(body, 0)] = world_.current_deflection_m(body, 0);
+    s.deflection_m[world_.flat_segment(BodyIndex{body}, LocalSegment{0}).index()] =
+        world_.current_deflection_m(body, 0);
   }
   for (DeformableSegment& seg : deformable_) {
     std::vector<std::uint32_t>& pending = seg.pending[slot];

@@ -22,7 +22,8 @@ WorldSnapshot make_world_snapshot(const World& world) {
     s.body_poses_world[b] = world.body_pose(b);
     if (const VirtualSheet* sheet = world.sheet(b)) {
       const std::vector<Vec3>& vertices = sheet->mesh().vertices;
-      std::vector<float>& xyz = s.positions_body[world.flat_segment(b, 0)];
+      std::vector<float>& xyz =
+          s.positions_body[world.flat_segment(BodyIndex{b}, LocalSegment{0}).index()];
       xyz.resize(3 * vertices.size());
       for (std::size_t v = 0; v < vertices.size(); ++v) {
         for (int k = 0; k < 3; ++k) {
@@ -37,14 +38,16 @@ WorldSnapshot make_world_snapshot(const World& world) {
         continue;
       }
       const TriangleMesh& mesh = deflection->mesh();
-      std::vector<float>& xyz = s.positions_body[world.flat_segment(b, seg)];
+      std::vector<float>& xyz =
+          s.positions_body[world.flat_segment(BodyIndex{b}, LocalSegment{seg}).index()];
       xyz.resize(3 * mesh.vertices.size());
       for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
         for (int k = 0; k < 3; ++k) {
           xyz[3 * v + static_cast<std::size_t>(k)] = static_cast<float>(mesh.vertices[v][k]);
         }
       }
-      s.deflection_m[world.flat_segment(b, seg)] = deflection->max_deflection_m();
+      s.deflection_m[world.flat_segment(BodyIndex{b}, LocalSegment{seg}).index()] =
+          deflection->max_deflection_m();
     }
   }
   if (world.rig() != nullptr) {

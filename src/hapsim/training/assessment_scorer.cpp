@@ -31,7 +31,9 @@ AssessmentScorer::AssessmentScorer(const AssessmentDefinition& definition, const
   flat_count_ = world.flat_segment_count();
   body_first_flat_.resize(d.bodies.size(), 0);
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
-    body_first_flat_[b] = d.bodies[b].segments.empty() ? 0 : world.flat_segment(b, 0);
+    body_first_flat_[b] = d.bodies[b].segments.empty()
+                              ? 0
+                              : world.flat_segment(BodyIndex{b}, LocalSegment{0}).index();
   }
   // Flat segments by (body, segment) name, and the material of each.
   const auto segment_flat = [&](const std::string& body,
@@ -42,7 +44,7 @@ AssessmentScorer::AssessmentScorer(const AssessmentDefinition& definition, const
       }
       for (std::size_t s = 0; s < d.bodies[b].segments.size(); ++s) {
         if (d.bodies[b].segments[s].name == segment) {
-          return world.flat_segment(b, s);
+          return world.flat_segment(BodyIndex{b}, LocalSegment{s}).index();
         }
       }
     }
@@ -56,7 +58,7 @@ AssessmentScorer::AssessmentScorer(const AssessmentDefinition& definition, const
         for (std::size_t s = 0; s < d.bodies[b].segments.size(); ++s) {
           const std::uint32_t m = d.bodies[b].segments[s].material;
           if (m < d.materials.size() && d.materials[m].name == material) {
-            member[world.flat_segment(b, s)] = true;
+            member[world.flat_segment(BodyIndex{b}, LocalSegment{s}).index()] = true;
           }
         }
       }
@@ -103,12 +105,11 @@ AssessmentScorer::AssessmentScorer(const AssessmentDefinition& definition, const
   scratch_segment_best_n_.resize(flat_count_);
 }
 
-std::size_t AssessmentScorer::flat(std::int32_t body, std::int32_t segment) const {
-  if (body < 0 || segment < 0 || static_cast<std::size_t>(body) >= body_first_flat_.size()) {
+std::size_t AssessmentScorer::flat(BodyIndex body, LocalSegment segment) const {
+  if (!body.valid() || !segment.valid() || body.index() >= body_first_flat_.size()) {
     return flat_count_;
   }
-  const std::size_t f =
-      body_first_flat_[static_cast<std::size_t>(body)] + static_cast<std::size_t>(segment);
+  const std::size_t f = body_first_flat_[body.index()] + segment.index();
   return f < flat_count_ ? f : flat_count_;
 }
 

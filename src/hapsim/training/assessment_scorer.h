@@ -53,7 +53,8 @@ class AssessmentScorer {
     std::size_t open_cycles = 0;
   };
 
-  [[nodiscard]] std::size_t flat(std::int32_t body, std::int32_t segment) const;
+  /// The flat index of a contact's (body, body-local segment), or flat_count_ when out of range.
+  [[nodiscard]] std::size_t flat(BodyIndex body, LocalSegment segment) const;
   void close_breach(std::size_t limit_index);
 
   AssessmentDefinition definition_;

@@ -44,8 +44,7 @@ void fill_world_readout(const World& world, const WorldScene& view, const WorldS
   std::string touched;
   for (std::size_t i = 0; i < s.contact_count; ++i) {
     const WorldContact& c = s.contacts[i];
-    const std::string& label = view.segment_label(
-        world.flat_segment(static_cast<std::size_t>(c.body), static_cast<std::size_t>(c.segment)));
+    const std::string& label = view.segment_label(world.flat_segment(c.body, c.segment).index());
     if (touched.find(label) == std::string::npos) {
       touched += (touched.empty() ? "" : ", ") + label;
     }

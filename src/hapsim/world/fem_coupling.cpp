@@ -102,7 +102,8 @@ std::vector<std::uint32_t> fem_fixed_nodes(const WorldModel& model, const BodyDe
           continue;
         }
         ++matched;
-        const SegmentModel& seg = model.segments()[model.flat_segment(ob, s)];
+        const SegmentModel& seg =
+            model.segments()[model.flat_segment(BodyIndex{ob}, LocalSegment{s}).index()];
         // Both bodies stand still (a FEM body and what holds it are not dynamic): one transform.
         const Iso3 X_other_fem = seg.X_body_world * body.X_world_body;
         for (std::size_t i = 0; i < tets.nodes.size(); ++i) {
@@ -242,7 +243,7 @@ FemCoupling::FemCoupling(const WorldModel& model) {
     }
     auto body = std::make_unique<Body>();
     body->world_body = b;
-    body->flat_segment = model.flat_segment(b, 0);
+    body->flat_segment = model.flat_segment(BodyIndex{b}, LocalSegment{0}).index();
     body->X_world_body = bd.X_world_body;
     body->X_body_world = bd.X_world_body.inverse();
     body->description = &fd;

@@ -50,12 +50,11 @@ void LocalModelBuilder::build(const WorldState& state, std::uint64_t sequence,
   std::array<bool, 64> proxy_capped{};  // per tool (a world has a handful)
   for (std::size_t i = 0; i < state.contact_count; ++i) {
     const WorldContact& c = state.contacts[i];
-    const auto t = static_cast<std::size_t>(c.tool);
-    if (c.tool < 0 || t >= tools || !c.normal_world.allFinite()) {
+    const std::size_t t = c.tool.index();
+    if (!c.tool.valid() || t >= tools || !c.normal_world.allFinite()) {
       continue;
     }
-    const std::size_t flat =
-        model_->flat_segment(static_cast<std::size_t>(c.body), static_cast<std::size_t>(c.segment));
+    const std::size_t flat = model_->flat_segment(c.body, c.segment).index();
     const ContactMaterial& material = state.materials[model_->segments()[flat].material];
     LocalContactModel& m = out[t];
     const Mat3 nn = c.normal_world * c.normal_world.transpose();
@@ -64,8 +63,7 @@ void LocalModelBuilder::build(const WorldState& state, std::uint64_t sequence,
       // the tissue's compliance from the FEM) and its cap travel on.
       const auto& fem_bodies = model_->fem_bodies();
       const auto b = static_cast<std::size_t>(
-          std::find(fem_bodies.begin(), fem_bodies.end(), static_cast<std::size_t>(c.body)) -
-          fem_bodies.begin());
+          std::find(fem_bodies.begin(), fem_bodies.end(), c.body.index()) - fem_bodies.begin());
       const LocalContactModel& fm = state.fem_contacts[t * kMaxFemBodies + b].model;
       const double cap = std::min(fm.max_normal_force_n, material.max_force_n);
       if (c.force_n < cap * (1.0 - 1e-9)) {

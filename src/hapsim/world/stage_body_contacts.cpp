@@ -450,14 +450,9 @@ void finish_pair(const WorldModel& model, WorldState& state, const SegmentModel&
     add_sheet_push(state.segments[flat], other.X_body_world, c.p_b_world, f_total);
   }
   if (state.body_contact_count < state.body_contacts.size()) {
-    state.body_contacts[state.body_contact_count++] =
-        BodyContact{static_cast<std::int32_t>(body),
-                    static_cast<std::int32_t>(seg.body),
-                    static_cast<std::int32_t>(seg.index_in_body),
-                    c.p_b_world,
-                    c.n_world,
-                    c.depth_m,
-                    f_total};
+    state.body_contacts[state.body_contact_count++] = BodyContact{
+        BodyIndex{body}, BodyIndex{seg.body}, seg.index_in_body, c.p_b_world, c.n_world, c.depth_m,
+        f_total};
   } else {
     ++state.dropped_body_contacts;
   }

@@ -16,12 +16,12 @@ void deform_sheet(const WorldModel& model, WorldState& state, const SegmentModel
   const Iso3& X_sheet_world = state.X_body_world(seg);
   for (std::size_t k = 0; k < state.body_contact_count; ++k) {
     const BodyContact& c = state.body_contacts[k];
-    if (c.other_body != static_cast<std::int32_t>(seg.body)) {
+    if (c.other_body != BodyIndex{seg.body}) {
       continue;
     }
     // A sphere resting on the sheet transcribes its lower cap (paper 000 §3.2.2, Fig. 2); a
     // mesh presses it through its pushes only.
-    const auto b = static_cast<std::size_t>(c.body);
+    const std::size_t b = c.body.index();
     if (!model.bodies()[b].sphere) {
       continue;
     }
@@ -43,7 +43,10 @@ void deform(const WorldModel& model, WorldState& state, double dt_s) noexcept {
     if (seg.sheet) {
       deform_sheet(model, state, segs[i], seg);
       state.sheet_depth_m[sheet_index++] = seg.sheet->max_depth_m();
-      if (state.rig && i == model.flat_segment(model.description().teleop->sheet_body, 0)) {
+      if (state.rig &&
+          i ==
+              model.flat_segment(BodyIndex{model.description().teleop->sheet_body}, LocalSegment{0})
+                  .index()) {
         state.rig->result.sheet_depth_m = seg.sheet->max_depth_m();
       }
       continue;

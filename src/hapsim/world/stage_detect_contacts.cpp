@@ -177,7 +177,7 @@ void detect_contacts(const WorldModel& model, WorldState& state, double dt_s) no
       }
       side.in_contact = true;
       tool.penalty[tool.penalty_count++] = PenaltyCandidate{
-          static_cast<std::uint32_t>(i), depth, rest_depth, n_world, point_world, rest_point_body};
+          FlatSegment{i}, depth, rest_depth, n_world, point_world, rest_point_body};
     }
   }
 }

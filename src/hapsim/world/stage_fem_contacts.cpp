@@ -71,7 +71,8 @@ void fem_contacts(const WorldModel& model, WorldState& state, double dt_s) noexc
         fc.blend_offset_n.setZero();
         continue;
       }
-      const SegmentModel& seg = model.segments()[model.flat_segment(fem_bodies[b], 0)];
+      const SegmentModel& seg =
+          model.segments()[model.flat_segment(BodyIndex{fem_bodies[b]}, LocalSegment{0}).index()];
       const ContactMaterial& material = state.materials[seg.material];
       // One FEM period, in steps: the blend ends as the next model arrives.
       const FemBodyDescription* fem = d.bodies[fem_bodies[b]].fem.get();
@@ -120,15 +121,14 @@ void fem_contacts(const WorldModel& model, WorldState& state, double dt_s) noexc
       const double k_n = n.dot(m.stiffness_n_per_m * n);
       const double depth_m = k_n > 0.0 ? spring_n / k_n : 0.0;
       if (state.contact_count < state.contacts.size()) {
-        state.contacts[state.contact_count++] =
-            WorldContact{static_cast<std::int32_t>(t),
-                         static_cast<std::int32_t>(fem_bodies[b]),
-                         0,
-                         tool.p_world - radius * n,
-                         n,
-                         depth_m,
-                         f.dot(n),
-                         false};
+        state.contacts[state.contact_count++] = WorldContact{ToolIndex{t},
+                                                             BodyIndex{fem_bodies[b]},
+                                                             LocalSegment{0},
+                                                             tool.p_world - radius * n,
+                                                             n,
+                                                             depth_m,
+                                                             f.dot(n),
+                                                             false};
       } else {
         ++state.dropped_contacts;
       }

@@ -223,16 +223,16 @@ void integrate(const WorldModel& model, WorldState& state, double dt_s) noexcept
   b = BallContactReport{};
   for (std::size_t k = 0; k < state.body_contact_count; ++k) {
     const BodyContact& c = state.body_contacts[k];
-    if (c.body != static_cast<std::int32_t>(d.ball_body)) {
+    if (c.body != BodyIndex{d.ball_body}) {
       continue;
     }
-    if (c.other_body == static_cast<std::int32_t>(d.sheet_body)) {
+    if (c.other_body == BodyIndex{d.sheet_body}) {
       b.on_sheet = c.force_world_n.squaredNorm() > 0.0;
       b.sheet_force_world_n += c.force_world_n;
       const Iso3& X_sheet_world = state.bodies[d.sheet_body].X_body_world;
       b.sheet_contact_sheet = X_sheet_world * c.point_world;
       b.sheet_push_n = std::max(0.0, (X_sheet_world.linear() * c.force_world_n).z());
-    } else if (c.other_body == static_cast<std::int32_t>(d.floor_body)) {
+    } else if (c.other_body == BodyIndex{d.floor_body}) {
       b.on_floor = c.force_world_n.squaredNorm() > 0.0;
       b.floor_force_world_n += c.force_world_n;
     }

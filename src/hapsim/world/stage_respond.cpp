@@ -53,8 +53,7 @@ void respond_rig(const WorldModel& model, WorldState& state) noexcept {
   for (std::size_t k = 0; k < state.body_contact_count; ++k) {
     const BodyContact& c = state.body_contacts[k];
     for (std::size_t i = 0; i < 2; ++i) {
-      if (c.body == static_cast<std::int32_t>(d.ball_body) &&
-          c.other_body == static_cast<std::int32_t>(d.pad_body[i])) {
+      if (c.body == BodyIndex{d.ball_body} && c.other_body == BodyIndex{d.pad_body[i]}) {
         g.pad_force_n[i] = std::max(0.0, c.force_world_n.dot(c.normal_world));
         normals[i] = c.normal_world;
         g.force_on_ball_world_n += c.force_world_n;
@@ -146,7 +145,7 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
     }
     ToolState& out = state.tool_states[t];
     const double radius = d.tools[t].radius_m;
-    const auto tool_index = static_cast<std::int32_t>(t);
+    const ToolIndex tool_index{t};
     out.p_world = tool.p_world;
     out.contact_count = 0;
 
@@ -165,8 +164,7 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
           std::max(0.0, (tool.proxy.proxy_world() - tool.p_world).dot(c.normal_world));
       // proxy_force() renders the first contact's material along the spring; report it there.
       add_contact(
-          state, WorldContact{tool_index, static_cast<std::int32_t>(seg.body),
-                              static_cast<std::int32_t>(seg.index_in_body), c.point_world,
+          state, WorldContact{tool_index, BodyIndex{seg.body}, seg.index_in_body, c.point_world,
                               c.normal_world, depth, first ? proxy_force_world.norm() : 0.0, true});
       first = false;
       ++out.contact_count;
@@ -182,17 +180,18 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
     std::size_t sheet_push_count = 0;
     std::size_t next = 0;  // penalty candidates come in segment order
     for (std::size_t i = 0; i < segs.size(); ++i) {
-      while (next < tool.penalty_count && tool.penalty[next].segment < i) {
+      while (next < tool.penalty_count && tool.penalty[next].segment.index() < i) {
         ++next;
       }
-      if (next < tool.penalty_count && tool.penalty[next].segment == i) {
+      if (next < tool.penalty_count && tool.penalty[next].segment.index() == i) {
         continue;
       }
       tool.stick_body[i].active = false;  // not pressing this segment: nothing sticks
     }
     for (std::size_t k = 0; k < tool.penalty_count; ++k) {
       const PenaltyCandidate& c = tool.penalty[k];
-      const SegmentModel& seg = segs[c.segment];
+      const std::size_t flat = c.segment.index();
+      const SegmentModel& seg = segs[flat];
       const ContactMaterial& material = state.materials[seg.material];
       BodyState& body = state.bodies[seg.body];
       const BodyModel& body_model = model.bodies()[seg.body];
@@ -203,12 +202,11 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
       // Friction follows the tool's own contact point (its sphere's surface towards the segment)
       // against the material point of the segment where it stuck: what slips is the one over
       // the other (the closest point on the segment slides over it as the geometry changes).
-      StickPoint stick{tool.stick_body[c.segment].active,
-                       body.X_world_body * tool.stick_body[c.segment].p};
+      StickPoint stick{tool.stick_body[flat].active, body.X_world_body * tool.stick_body[flat].p};
       const Vec3 f_friction = contact_friction_force(material, f_normal.norm(), c.n_world, v_rel,
                                                      tool.p_world - radius * c.n_world, stick);
       const Vec3 f = f_normal + f_friction;
-      tool.stick_body[c.segment] = {stick.active, body.X_body_world * stick.p};
+      tool.stick_body[flat] = {stick.active, body.X_body_world * stick.p};
       if (seg.dynamic) {
         body.force_world_n -= f;
         body.torque_world_nm -= (c.point_world - body.com_world(body_model.com_body)).cross(f);
@@ -219,7 +217,7 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
                            f_friction, tool.v_world);
       }
       if (seg.sheet) {
-        SegmentState& sheet = state.segments[c.segment];
+        SegmentState& sheet = state.segments[flat];
         if (sheet_push_count < sheet_pushes.size() &&
             sheet.sheet_push_count < sheet.sheet_pushes.size()) {
           sheet_pushes[sheet_push_count++] = {&sheet, sheet.sheet_push_count};
@@ -227,16 +225,14 @@ void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexce
         add_sheet_push(sheet, body.X_body_world, c.point_world, f);
       }
       total += f;
-      add_contact(state, WorldContact{tool_index, static_cast<std::int32_t>(seg.body),
-                                      static_cast<std::int32_t>(seg.index_in_body), c.point_world,
-                                      c.n_world, c.depth_m, f.norm(), false});
+      add_contact(state, WorldContact{tool_index, BodyIndex{seg.body}, seg.index_in_body,
+                                      c.point_world, c.n_world, c.depth_m, f.norm(), false});
       ++out.contact_count;
       // The surface deflects to reach the tool: eq. 1 about the rest point, to the rest depth.
-      SegmentState& seg_state = state.segments[c.segment];
+      SegmentState& seg_state = state.segments[flat];
       add_pending(seg_state, DeflectionContact{c.rest_point_body, c.rest_depth_m, radius, 0});
       if (seg_state.deflection) {
-        tool.own_dent[c.segment] =
-            OwnDent{c.rest_point_body, c.rest_depth_m, radius, state.step_index};
+        tool.own_dent[flat] = OwnDent{c.rest_point_body, c.rest_depth_m, radius, state.step_index};
       }
     }
     out.force_world_n = total;

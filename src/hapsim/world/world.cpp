@@ -36,16 +36,25 @@ std::size_t World::segment_count(std::size_t body) const {
   return description().bodies.at(body).segments.size();
 }
 
-std::size_t World::flat_segment(std::size_t body, std::size_t segment) const {
+FlatSegment World::flat_segment(BodyIndex body, LocalSegment segment) const {
   return model_.flat_segment(body, segment);
 }
 
+namespace {
+
+// The flat index of the World API's plain (body, segment) pair.
+std::size_t flat_of(const WorldModel& model, std::size_t body, std::size_t segment) {
+  return model.flat_segment(BodyIndex{body}, LocalSegment{segment}).index();
+}
+
+}  // namespace
+
 const ProximityQuery& World::rest_query(std::size_t body, std::size_t segment) const {
-  return *model_.segments().at(flat_segment(body, segment)).rest_query;
+  return *model_.segments().at(flat_of(model_, body, segment)).rest_query;
 }
 
 const TriangleMesh& World::surface(std::size_t body, std::size_t segment) const {
-  const std::size_t flat = flat_segment(body, segment);
+  const std::size_t flat = flat_of(model_, body, segment);
   const SegmentState& seg = state_.segments.at(flat);
   if (seg.sheet) {
     return seg.sheet->mesh();
@@ -67,12 +76,12 @@ bool World::advance_fem() {
 }
 
 const VirtualSheet* World::sheet(std::size_t body) const {
-  const std::size_t flat = flat_segment(body, 0);
+  const std::size_t flat = flat_of(model_, body, 0);
   return state_.segments.at(flat).sheet.get();
 }
 
 const ProximityQuery& World::deformed_query(std::size_t body, std::size_t segment) {
-  const std::size_t flat = flat_segment(body, segment);
+  const std::size_t flat = flat_of(model_, body, segment);
   SegmentState& seg = state_.segments.at(flat);
   if (!seg.deflection) {
     return *model_.segments()[flat].rest_query;
@@ -90,11 +99,11 @@ const ProximityQuery& World::deformed_query(std::size_t body, std::size_t segmen
 }
 
 const VertexDeflection* World::deflection(std::size_t body, std::size_t segment) const {
-  return state_.segments.at(flat_segment(body, segment)).deflection.get();
+  return state_.segments.at(flat_of(model_, body, segment)).deflection.get();
 }
 
 double World::current_deflection_m(std::size_t body, std::size_t segment) const {
-  if (state_.fem && model_.segments().at(flat_segment(body, segment)).fem) {
+  if (state_.fem && model_.segments().at(flat_of(model_, body, segment)).fem) {
     const auto& fem_bodies = model_.fem_bodies();
     const auto it = std::find(fem_bodies.begin(), fem_bodies.end(), body);
     return state_.fem->max_displacement_m(static_cast<std::size_t>(it - fem_bodies.begin()));

@@ -14,6 +14,7 @@
 #include "hapsim/core/device_io.h"
 #include "hapsim/core/stopwatch.h"
 #include "hapsim/core/types.h"
+#include "hapsim/world/indices.h"
 #include "hapsim/world/world_description.h"
 #include "hapsim/world/world_model.h"
 #include "hapsim/world/world_state.h"
@@ -109,8 +110,9 @@ class World {
   }
   /// The virtual sheet of a sheet body (BodyDeformation::kGaussianSheet), or null.
   [[nodiscard]] const VirtualSheet* sheet(std::size_t body) const;
-  /// Flat index of (body, segment) over all bodies, for per-segment statistics.
-  [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const;
+  /// Flat index of (body, body-local segment) over all bodies, for per-segment statistics and
+  /// the per-flat-segment arrays (WorldSnapshot, WorldModel::segments()).
+  [[nodiscard]] FlatSegment flat_segment(BodyIndex body, LocalSegment segment) const;
   [[nodiscard]] std::size_t flat_segment_count() const { return model_.segments().size(); }
 
   /// The rest-shape query of a segment (body frame): the one step() uses.

@@ -213,7 +213,7 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
   }
   for (std::size_t b = 0; b < description_.bodies.size(); ++b) {
     const BodyDescription& body = description_.bodies[b];
-    body_first_segment_.push_back(segments_.size());
+    body_first_segment_.push_back(FlatSegment{segments_.size()});
     if (body.segments.empty()) {
       throw Error("body '" + body.name + "'", "has no segments");
     }
@@ -252,7 +252,7 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
       seg.fem = fem;
       seg.dynamic = body.kind == BodyKind::kDynamic;
       seg.body = b;
-      seg.index_in_body = s;
+      seg.index_in_body = LocalSegment{s};
       seg.description = &sd;
       seg.material = sd.material;
       seg.response = description_.materials[sd.material].response;
@@ -307,7 +307,7 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
     bm.kind = body.kind;
     bm.first_segment = body_first_segment_[b];
     bm.segment_count = body.segments.size();
-    bm.sheet = segments_[bm.first_segment].sheet;
+    bm.sheet = segments_[bm.first_segment.index()].sheet;
     if (bm.sheet) {
       bm.sheet_compliance_m_per_n = GaussianSheetProfile(body.sheet_profile).depth_m(0.0, 1.0);
     }
@@ -324,7 +324,7 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
       bm.dynamic_index = static_cast<std::int32_t>(dynamic_bodies_.size());
       dynamic_bodies_.push_back(b);
       for (std::size_t s = 0; s < bm.segment_count; ++s) {
-        dynamic_segments_.push_back(bm.first_segment + s);
+        dynamic_segments_.push_back(bm.first_segment.index() + s);
       }
     }
     bodies_.push_back(bm);
@@ -385,7 +385,7 @@ bool WorldModel::sheet_presses_settle(std::span<const ContactMaterial> materials
       continue;
     }
     const double compliance_m_per_n = bodies_[b].sheet_compliance_m_per_n;
-    const ContactMaterial& own = materials[segments_[bodies_[b].first_segment].material];
+    const ContactMaterial& own = materials[segments_[bodies_[b].first_segment.index()].material];
     // Each spring that presses the sheet must be softer than the sheet gives way under it, or the
     // press overshoots further each step.
     const auto settles = [&](double k, std::ptrdiff_t presser) {

@@ -6,6 +6,7 @@
 
 #include "hapsim/collision/proximity_query.h"
 #include "hapsim/core/types.h"
+#include "hapsim/world/indices.h"
 #include "hapsim/world/world_description.h"
 
 #include <cstddef>
@@ -32,7 +33,7 @@ class SphereTree;
 /// its mass properties.
 struct BodyModel {
   BodyKind kind = BodyKind::kStatic;
-  std::size_t first_segment = 0;
+  FlatSegment first_segment{0};  ///< its segment 0's flat index
   std::size_t segment_count = 0;
   bool sheet = false;  ///< a Gaussian sheet (one segment)
   /// A sheet: how deep its elastic field sinks under a 1 N push, metres (its profile at d = 0).
@@ -57,7 +58,7 @@ struct BodyModel {
 /// the segment's index in its body).
 struct SegmentModel {
   std::size_t body = 0;
-  std::size_t index_in_body = 0;
+  LocalSegment index_in_body{0};
   const SegmentDescription* description = nullptr;
   std::uint32_t material = 0;
   ContactResponse response = ContactResponse::kProxy;
@@ -119,8 +120,9 @@ class WorldModel {
   [[nodiscard]] const std::vector<std::size_t>& fem_bodies() const { return fem_bodies_; }
   /// Whether some dynamic body is not an exact sphere (it meets others through its vertices).
   [[nodiscard]] bool has_dynamic_meshes() const { return has_dynamic_meshes_; }
-  [[nodiscard]] std::size_t flat_segment(std::size_t body, std::size_t segment) const {
-    return body_first_segment_.at(body) + segment;
+  /// The flat index of `body`'s segment `segment` (body-local): its first segment + segment.
+  [[nodiscard]] FlatSegment flat_segment(BodyIndex body, LocalSegment segment) const {
+    return FlatSegment{body_first_segment_.at(body.index()).value + segment.index()};
   }
   [[nodiscard]] std::size_t tool_count() const { return description_.tools.size(); }
   [[nodiscard]] std::size_t proxy_segment_count() const { return proxy_segments_; }
@@ -158,7 +160,7 @@ class WorldModel {
   std::vector<std::size_t> dynamic_segments_;
   std::vector<std::size_t> fem_bodies_;
   bool has_dynamic_meshes_ = false;
-  std::vector<std::size_t> body_first_segment_;
+  std::vector<FlatSegment> body_first_segment_;
   std::size_t proxy_segments_ = 0;
   std::size_t penalty_segments_ = 0;
   double max_tool_radius_m_ = 0.0;

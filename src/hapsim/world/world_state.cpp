@@ -141,7 +141,8 @@ void find_slave_collision_pairs(const WorldModel& model, RigState& rig) {
   const TeleopRigDescription& d = *model.description().teleop;
   const auto add_collider = [&](std::size_t b) {
     const BodyModel& bm = model.bodies()[b];
-    for (std::size_t flat = bm.first_segment; flat < bm.first_segment + bm.segment_count; ++flat) {
+    const std::size_t first = bm.first_segment.index();
+    for (std::size_t flat = first; flat < first + bm.segment_count; ++flat) {
       const SphereTree* tree = model.segments()[flat].body_tree.get();
       if (tree == nullptr) {
         continue;  // no body trees: the world has no dynamic body (cannot be a rig's)

@@ -16,6 +16,7 @@
 #include "hapsim/force/god_object.h"
 #include "hapsim/force/local_contact_model.h"
 #include "hapsim/kinematics/slave_follower.h"
+#include "hapsim/world/indices.h"
 #include "hapsim/world/world_description.h"
 #include "hapsim/world/world_model.h"
 
@@ -32,9 +33,9 @@ class FemCoupling;
 
 /// One contact of one tool with one segment this step.
 struct WorldContact {
-  std::int32_t tool = -1;
-  std::int32_t body = -1;
-  std::int32_t segment = -1;  ///< within the body
+  ToolIndex tool = kNoTool;
+  BodyIndex body = kNoBody;
+  LocalSegment segment = kNoSegment;  ///< within the body (not flat)
   Vec3 point_world = Vec3::Zero();
   Vec3 normal_world = Vec3::Zero();  ///< unit, out of the segment towards the tool
   double depth_m = 0.0;              ///< tool depth below the rest surface (≥ 0)
@@ -45,11 +46,11 @@ struct WorldContact {
 /// One contact of a dynamic body with another body's segment this step (body contacts stage):
 /// the force on the dynamic body; the other body gets the opposite.
 struct BodyContact {
-  std::int32_t body = -1;        ///< the dynamic body
-  std::int32_t other_body = -1;  ///< the body it touches
-  std::int32_t other_segment = -1;
-  Vec3 point_world = Vec3::Zero();   ///< on the other body's surface
-  Vec3 normal_world = Vec3::Zero();  ///< unit, out of the other body towards the dynamic one
+  BodyIndex body = kNoBody;                 ///< the dynamic body
+  BodyIndex other_body = kNoBody;           ///< the body it touches
+  LocalSegment other_segment = kNoSegment;  ///< within other_body (not flat)
+  Vec3 point_world = Vec3::Zero();          ///< on the other body's surface
+  Vec3 normal_world = Vec3::Zero();         ///< unit, out of the other body towards the dynamic one
   double depth_m = 0.0;
   Vec3 force_world_n = Vec3::Zero();  ///< on the dynamic body (normal and friction)
 };
@@ -196,7 +197,7 @@ struct PenaltySide {
 
 /// A penalty contact found by the detection stage, answered by the response stage.
 struct PenaltyCandidate {
-  std::uint32_t segment = 0;  ///< flat segment
+  FlatSegment segment{0};  ///< flat (not within its body)
   /// Below the surface the tool feels: the rest surface, less the dent other contacts left there.
   double depth_m = 0.0;
   /// Below the rest surface: how far this contact itself deflects the surface (eq. 1's x).
