@@ -36,6 +36,9 @@ HAPSIM_PACKAGES=(
   # secure sessions (net/security_keys): find_package(OpenSSL) for keys, X.509 and S/MIME
   # signatures; Cyclone's own security plugins (libddsc0debian) already depend on libssl3
   libssl-dev
+  # the Debian packages (cpack's DEB generator, and its test): `file` tells cpack which files are
+  # binaries for dpkg-shlibdeps (itself in dpkg-dev, which build-essential brings)
+  file
   # tests and benchmarks: find_package(GTest) with GMock, find_package(benchmark), and
   # find_package(ZLIB) for the golden run traces (tests/golden/*.trace.gz)
   libgtest-dev libgmock-dev libbenchmark-dev zlib1g-dev
