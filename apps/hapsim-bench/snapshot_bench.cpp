@@ -12,6 +12,7 @@
 #include "hapsim/render/png_image.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/ui/render_cpu_time.h"
@@ -55,8 +56,9 @@ void run_snapshot_bench(const SnapshotBenchArgs& args) {
   SnapshotWriter writer(w, h, args.samples);
   WorldSceneOptions o;
   o.force_full_scale_n = force_display_scale_n(
-      world.description(), world.rig() != nullptr ? world.description().teleop->gripper.max_force_n
-                                                  : device_rated_force_n(*setup.profile));
+      world.description(), rig_state(world) != nullptr
+                               ? rig_description(world.description())->gripper.max_force_n
+                               : device_rated_force_n(*setup.profile));
   WorldScene drawn(world, o);
   const OrbitCamera camera = framed_camera(drawn.rest_bounds_world(), static_cast<double>(w) / h,
                                            snapshot_yaw_rad(world), snapshot_pitch_rad(world));

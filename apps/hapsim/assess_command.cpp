@@ -20,6 +20,7 @@
 #include "hapsim/render/force_scale.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/training/assessment_json.h"
 #include "hapsim/training/recording_assessment.h"
@@ -120,8 +121,9 @@ void write_picture(const World& world, const RunSetup& setup, const AssessmentDe
                    const AssessmentResult& result, const fs::path& path) {
   WorldSceneOptions o;
   o.force_full_scale_n = force_display_scale_n(
-      world.description(), world.rig() != nullptr ? world.description().teleop->gripper.max_force_n
-                                                  : device_rated_force_n(*setup.profile));
+      world.description(), rig_state(world) != nullptr
+                               ? rig_description(world.description())->gripper.max_force_n
+                               : device_rated_force_n(*setup.profile));
   WorldScene drawn(world, o);
   constexpr int kWidth = 1280;
   constexpr int kHeight = 720;
@@ -155,7 +157,7 @@ void write_picture(const World& world, const RunSetup& setup, const AssessmentDe
   // A rig's task spans the whole scene; landmarks are framed with a margin of a twentieth of the
   // scene's size.
   Box3 framed = drawn.rest_bounds_world();
-  if (!marked.isEmpty() && world.rig() == nullptr) {
+  if (!marked.isEmpty() && rig_state(world) == nullptr) {
     const double margin = 0.05 * drawn.rest_bounds_world().sizes().norm();
     framed = Box3(marked.min() - Vec3::Constant(margin), marked.max() + Vec3::Constant(margin));
   }

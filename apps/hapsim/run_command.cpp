@@ -16,6 +16,7 @@
 #include "hapsim/render/force_scale.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/runtime/session.h"
 #include "hapsim/runtime/session_json.h"
 #include "hapsim/scene/run_setup.h"
@@ -408,7 +409,7 @@ void run(const RunArgs& args) {
   check_segment_names(scene.world, args);
   PluginDevice* driven_by_plugin = plugin_device.get();
   if (plugin_device) {
-    if (setup.world->rig() != nullptr) {
+    if (rig_state(*setup.world) != nullptr) {
       throw CommandError("--device " + args.device + ": " + args.scene +
                          " is a teleoperation scene, whose master arm its script drives; a "
                          "plugin drives probe and glove scenes");
@@ -424,9 +425,9 @@ void run(const RunArgs& args) {
   std::unique_ptr<Device>& device = setup.device;
   const std::string& device_name = setup.device_name;
   const std::optional<RecordingScan>& replayed = setup.replayed;
-  const bool teleop = world->rig() != nullptr;
+  const bool teleop = rig_state(*world) != nullptr;
   if (teleop) {
-    const RigState& rig = *world->rig();
+    const RigState& rig = *rig_state(*world);
     std::printf(
         "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
         "sheet %dx%d\n",
@@ -503,8 +504,9 @@ void run(const RunArgs& args) {
         [&args, &setup](const World& w) {
           WorldSceneOptions o;
           o.force_full_scale_n = force_display_scale_n(
-              w.description(), w.rig() != nullptr ? w.description().teleop->gripper.max_force_n
-                                                  : device_rated_force_n(*setup.profile));
+              w.description(), rig_state(w) != nullptr
+                                   ? rig_description(w.description())->gripper.max_force_n
+                                   : device_rated_force_n(*setup.profile));
           o.colouring = parse_colouring(args.colours);
           o.show_room = args.room;
           o.sphere_tree_level = args.sphere_tree_level;

@@ -9,6 +9,7 @@
 #include "hapsim/core/error.h"
 #include "hapsim/render/camera.h"
 #include "hapsim/render/snapshot_writer.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/scene/scene_description.h"
 #include "hapsim/world/world.h"
 
@@ -30,7 +31,7 @@ constexpr double kTableTopPitch = 0.75;
 
 // Whether the world has bodies that move or a sheet, and no rig: a table-top scene.
 inline bool table_top(const World& world) {
-  if (world.rig() != nullptr) {
+  if (rig_state(world) != nullptr) {
     return false;
   }
   for (const BodyDescription& b : world.description().bodies) {
@@ -43,10 +44,11 @@ inline bool table_top(const World& world) {
 
 /// The snapshot camera's azimuth and elevation for `world`.
 inline double snapshot_yaw_rad(const World& world) {
-  return world.rig() != nullptr ? kTeleopYaw : kKneeYaw;
+  return rig_state(world) != nullptr ? kTeleopYaw : kKneeYaw;
 }
 inline double snapshot_pitch_rad(const World& world) {
-  return world.rig() != nullptr ? kTeleopPitch : (table_top(world) ? kTableTopPitch : kKneePitch);
+  return rig_state(world) != nullptr ? kTeleopPitch
+                                     : (table_top(world) ? kTableTopPitch : kKneePitch);
 }
 
 /// The camera --view NAME or --camera SPEC chose (render/snapshot_writer.h chosen_camera), none

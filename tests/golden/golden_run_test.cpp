@@ -9,6 +9,7 @@
 #include "hapsim/core/data_dir.h"
 #include "hapsim/core/device_profile.h"
 #include "hapsim/device/recording.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
@@ -63,8 +64,8 @@ test::GoldenTrace run_scene(SceneDescription scene, const std::string& name) {
     options.duration_s = setup.duration_s;
     options.dt_s = setup.scene.run.dt_s;
     options.recorder = &recorder;
-    if (world.rig() != nullptr) {
-      options.after_cycle = [&](std::size_t) { rig_steps.push_back(world.rig()->result); };
+    if (rig_state(world) != nullptr) {
+      options.after_cycle = [&](std::size_t) { rig_steps.push_back(rig_state(world)->result); };
     }
     (void)run_session(world, *setup.device, options);
     recorder.close();
@@ -75,7 +76,7 @@ test::GoldenTrace run_scene(SceneDescription scene, const std::string& name) {
   test::GoldenTrace trace;
   trace.scene = name;
   trace.cycle_count = frames.size();
-  if (world.rig() == nullptr) {
+  if (rig_state(world) == nullptr) {
     trace.columns = {"force_x_n", "force_y_n", "force_z_n", "finger0_n",
                      "finger1_n", "finger2_n", "finger3_n", "finger4_n"};
     for (const RecordedFrame& f : frames) {

@@ -9,6 +9,7 @@
 #include "hapsim/render/png_image.h"
 #include "hapsim/render/snapshot_writer.h"
 #include "hapsim/render/world_scene.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_device.h"
 #include "hapsim/scene/scene_file.h"
@@ -141,7 +142,7 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
   for (int k = 1; k <= 6000; ++k) {
     world.step(setup.trajectory.sample_at(setup.trajectory.start_time_s() + k * dt), dt);
   }
-  ASSERT_TRUE(world.rig()->held);
+  ASSERT_TRUE(rig_state(world)->held);
   WorldScene view(world);
   view.update_from_world(world);
   const OrbitCamera camera =
@@ -156,8 +157,9 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
   EXPECT_GT(compare_images(pictures[0], pictures[1], kWidth, kHeight).differing_fraction, 0.002);
   EXPECT_GT(compare_images(pictures[1], pictures[2], kWidth, kHeight).differing_fraction, 0.005);
   // The ball is where the world says, in its colour (red), in the face picture.
-  const Vec3 px = camera.project(
-      world.body_pose(world.description().teleop->ball_body).translation(), kWidth, kHeight);
+  const Vec3 px =
+      camera.project(world.body_pose(rig_description(world.description())->ball_body).translation(),
+                     kWidth, kHeight);
   const auto x = static_cast<int>(px.x());
   const auto y = static_cast<int>(px.y());
   ASSERT_TRUE(x >= 0 && x < kWidth && y >= 0 && y < kHeight);
@@ -209,7 +211,7 @@ TEST(SceneReference, BallsImprintInTheSheetMatchesTheReference) {
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
   // The whole pick-and-place: the ball rests in its dent on the sheet (the ball hidden).
   auto world = stepped_teleop(scene, -1);
-  const TeleopRigDescription& rig = *world->description().teleop;
+  const TeleopRigDescription& rig = *rig_description(world->description());
   const Vec3 ball = world->body_pose(rig.ball_body).translation();
   WorldScene view(*world);
   view.update_from_world(*world);

@@ -11,6 +11,8 @@
 #include "hapsim/render/image_compare.h"
 #include "hapsim/render/renderer.h"
 #include "hapsim/render/slave_figure.h"
+#include "hapsim/rig/rig_controller.h"
+#include "hapsim/rig/rig_world.h"
 #include "hapsim/runtime/world_snapshot.h"
 #include "hapsim/scene/scene_file.h"
 #include "hapsim/scene/teleop_setup.h"
@@ -80,16 +82,19 @@ test::SharedGl WorldSceneRigTest::gl_;
 
 TEST_F(WorldSceneRigTest, SheetMeshHoldsTheWorldsDentedHeights) {
   const World& world = *world_;
-  ASSERT_GT(world.sheet(world.description().teleop->sheet_body)->max_depth_m(), 1e-4)
+  ASSERT_GT(world.sheet(rig_description(world.description())->sheet_body)->max_depth_m(), 1e-4)
       << "the ball should rest in a dent";
   WorldScene from_world(world);
   from_world.update_from_world(world);
   WorldScene from_snapshot(world);
   from_snapshot.update(make_world_snapshot(world));
-  const auto heights = world.sheet(world.description().teleop->sheet_body)->surface_heights();
-  const TriangleMesh& rest = world.sheet(world.description().teleop->sheet_body)->mesh();
+  const auto heights =
+      world.sheet(rig_description(world.description())->sheet_body)->surface_heights();
+  const TriangleMesh& rest = world.sheet(rig_description(world.description())->sheet_body)->mesh();
   const std::size_t flat =
-      world.flat_segment(BodyIndex{world.description().teleop->sheet_body}, LocalSegment{0})
+      world
+          .flat_segment(BodyIndex{rig_description(world.description())->sheet_body},
+                        LocalSegment{0})
           .index();
   for (const WorldScene* scene : {&from_world, &from_snapshot}) {
     const RenderMesh& sheet = scene->scene().mesh(scene->segment_mesh(flat));
@@ -103,21 +108,26 @@ TEST_F(WorldSceneRigTest, SheetMeshHoldsTheWorldsDentedHeights) {
       ASSERT_NEAR(v.x(), rest.vertices[k].x(), exact ? 0.0 : 1e-7);
       ASSERT_NEAR(v.y(), rest.vertices[k].y(), exact ? 0.0 : 1e-7);
     }
-    EXPECT_TRUE(
-        sheet.X_world_mesh.isApprox(world.description().teleop->environment.X_world_sheet, 0.0));
+    EXPECT_TRUE(sheet.X_world_mesh.isApprox(
+        rig_description(world.description())->environment.X_world_sheet, 0.0));
   }
   // The dent is under the ball: the node nearest the ball's footprint is the deepest around.
-  const Vec3 ball_sheet = world.description().teleop->environment.X_world_sheet.inverse() *
-                          world.body_pose(world.description().teleop->ball_body).translation();
-  const int n = world.sheet(world.description().teleop->sheet_body)->nodes_per_side();
-  const double h = world.sheet(world.description().teleop->sheet_body)->spacing_m();
-  const auto i = static_cast<int>(std::lround(
-      (ball_sheet.x() + 0.5 * world.sheet(world.description().teleop->sheet_body)->side_m()) / h));
-  const auto j = static_cast<int>(std::lround(
-      (ball_sheet.y() + 0.5 * world.sheet(world.description().teleop->sheet_body)->side_m()) / h));
+  const Vec3 ball_sheet =
+      rig_description(world.description())->environment.X_world_sheet.inverse() *
+      world.body_pose(rig_description(world.description())->ball_body).translation();
+  const int n = world.sheet(rig_description(world.description())->sheet_body)->nodes_per_side();
+  const double h = world.sheet(rig_description(world.description())->sheet_body)->spacing_m();
+  const auto i = static_cast<int>(
+      std::lround((ball_sheet.x() +
+                   0.5 * world.sheet(rig_description(world.description())->sheet_body)->side_m()) /
+                  h));
+  const auto j = static_cast<int>(
+      std::lround((ball_sheet.y() +
+                   0.5 * world.sheet(rig_description(world.description())->sheet_body)->side_m()) /
+                  h));
   ASSERT_TRUE(i >= 0 && i < n && j >= 0 && j < n);
   EXPECT_LT(heights[static_cast<std::size_t>(j * n + i)],
-            -0.5 * world.sheet(world.description().teleop->sheet_body)->max_depth_m());
+            -0.5 * world.sheet(rig_description(world.description())->sheet_body)->max_depth_m());
 }
 
 TEST_F(WorldSceneRigTest, BallColourAppearsWhereItsCentreProjects) {
@@ -126,7 +136,7 @@ TEST_F(WorldSceneRigTest, BallColourAppearsWhereItsCentreProjects) {
   WorldScene scene(world);
   scene.update_from_world(world);
   // Look at the ball from beyond it (the robot behind it), a little from above.
-  const std::size_t ball_body = world.description().teleop->ball_body;
+  const std::size_t ball_body = rig_description(world.description())->ball_body;
   const Vec3 ball = world.body_pose(ball_body).translation();
   OrbitCamera cam;
   cam.target_world = ball;
@@ -155,7 +165,7 @@ TEST_F(WorldSceneRigTest, BallColourAppearsWhereItsCentreProjects) {
 TEST_F(WorldSceneRigTest, BallsImprintShowsInTheDrawnSheet) {
   require_gl();
   const World& world = *world_;
-  const TeleopRigDescription& rig = *world.description().teleop;
+  const TeleopRigDescription& rig = *rig_description(world.description());
   // Only the sheet, from a little above, around where the ball rests: once as the world left it
   // (the ball's dent), once at rest (a world not stepped).
   const World flat(world.description());
@@ -200,14 +210,15 @@ TEST_F(WorldSceneRigTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
     return scene.segment_mesh(
         world
             .flat_segment(
-                BodyIndex{world.description().teleop->pad_body[static_cast<std::size_t>(i)]},
+                BodyIndex{
+                    rig_description(world.description())->pad_body[static_cast<std::size_t>(i)]},
                 LocalSegment{0})
             .index());
   };
   // Independent geometry: the tool from the chain's FK, the pads across its y at the pad depth.
-  const Iso3 X_tool = world.rig()->slave->chain().forward(world.rig()->slave->q());
-  const ParallelGripperParams& p = world.description().teleop->gripper;
-  const double w = world.rig()->result.gripper.width_m;
+  const Iso3 X_tool = rig_state(world)->slave->chain().forward(rig_state(world)->slave->q());
+  const ParallelGripperParams& p = rig_description(world.description())->gripper;
+  const double w = rig_state(world)->result.gripper.width_m;
   const Vec3 pad_world[2] = {X_tool * Vec3(0.0, 0.5 * w + p.pad_half_m.y(), p.pad_depth_m),
                              X_tool * Vec3(0.0, -(0.5 * w + p.pad_half_m.y()), p.pad_depth_m)};
   for (int i = 0; i < 2; ++i) {
@@ -257,7 +268,8 @@ TEST_F(WorldSceneRigTest, PadsAreDrawnWhereTheChainsForwardKinematicsPutsThem) {
 // The render meshes of the slave's links (its bodies off the tool frame), in chain order.
 std::vector<MeshId> link_meshes(const World& world, const WorldScene& scene) {
   std::vector<MeshId> ids;
-  for (const TeleopRigDescription::SlaveBody& s : world.description().teleop->slave_bodies) {
+  for (const TeleopRigDescription::SlaveBody& s :
+       rig_description(world.description())->slave_bodies) {
     if (s.frame != kToolFrame) {
       ids.push_back(
           scene.segment_mesh(world.flat_segment(BodyIndex{s.body}, LocalSegment{0}).index()));
@@ -291,12 +303,13 @@ TEST(WorldSceneRig, LinkMeshesFollowTheirChainFrames) {
   WorldScene scene(world);
   ASSERT_EQ(link_meshes(world, scene).size(), 1u);
   std::array<Iso3, kMaxChainJoints> frames;
-  static_cast<void>(world.rig()->slave->chain().frames(world.rig()->slave->q(), frames));
+  static_cast<void>(rig_state(world)->slave->chain().frames(rig_state(world)->slave->q(), frames));
   const RenderMesh& mesh = scene.scene().mesh(link_meshes(world, scene)[0]);
   EXPECT_TRUE(mesh.X_world_mesh.isApprox(frames[2] * g.X_frame_mesh, 1e-12));
   // The bounds frame the whole scene: the ball, the sheet and the master drawn beside.
   const Box3& b = scene.rest_bounds_world();
-  EXPECT_TRUE(b.contains(world.body_pose(world.description().teleop->ball_body).translation()));
+  EXPECT_TRUE(
+      b.contains(world.body_pose(rig_description(world.description())->ball_body).translation()));
   EXPECT_TRUE(b.contains(scene.master_display_origin_world()));
 }
 
@@ -306,9 +319,9 @@ TEST(WorldSceneRig, BoxLinksJoinTheJointOrigins) {
   d.slave_start_rad = {0.3, -0.2, 0.4, 0.1, 0.5, -0.2};
   World world(rig_world(d));
   WorldScene scene(world);
-  const SerialChain& chain = world.rig()->slave->chain();
+  const SerialChain& chain = rig_state(world)->slave->chain();
   std::array<Iso3, kMaxChainJoints> frames;
-  const Iso3 tip = chain.frames(world.rig()->slave->q(), frames);
+  const Iso3 tip = chain.frames(rig_state(world)->slave->q(), frames);
   // A box spans one joint origin to the next (base, joints 0..n−1, tip; coinciding origins
   // get no box): its centroid is their midpoint, in chain order.
   std::vector<Vec3> origins{Vec3::Zero()};
@@ -366,12 +379,12 @@ TEST(WorldSceneRig, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
   const SceneDescription scene =
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop_gp7.json", o);
   const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/true);
-  const SerialChain& chain = *setup.description.teleop->slave;
+  const SerialChain& chain = *rig_description(setup.description)->slave;
   ASSERT_FALSE(chain.link_geometry().empty());
   World world(setup.description);
   WorldScene drawn(world);
   std::array<Iso3, kMaxChainJoints> frames;
-  static_cast<void>(chain.frames(world.rig()->slave->q(), frames));
+  static_cast<void>(chain.frames(rig_state(world)->slave->q(), frames));
   const std::vector<MeshId> links = link_meshes(world, drawn);
   std::size_t l = 0;
   for (const ChainLinkGeometry& g : chain.link_geometry()) {

@@ -9,6 +9,7 @@
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/render/renderer.h"
 #include "hapsim/render/snapshot_writer.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/runtime/world_snapshot.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
@@ -118,7 +119,7 @@ TEST(WorldSceneSheet, HandBallSheetsDrawnVerticesAreTheWorldsSheet) {
 TEST(WorldSceneSheet, TeleopSheetsDrawnVerticesAreTheWorldsSheet) {
   const SceneRun s("teleop.json");
   const World& world = s.world;
-  const std::size_t sheet = world.description().teleop->sheet_body;
+  const std::size_t sheet = rig_description(world.description())->sheet_body;
   EXPECT_TRUE(world.body_pose(sheet).isApprox(Iso3(Eigen::Translation3d(0.5, 0.25, 0.05)), 0.0));
   WorldScene at_build(world);
   WorldScene from_world(world);

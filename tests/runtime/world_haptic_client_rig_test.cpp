@@ -3,6 +3,7 @@
 // joints and tool, sheet), the world went through exactly what an inline run with the same inputs
 // goes through, a reader thread never sees a torn snapshot, the haptic thread allocates nothing,
 // and a paused client holds the world.
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/runtime/world_haptic_client.h"
 
 #include "hapsim/core/device_profile.h"
@@ -45,21 +46,23 @@ TEST(WorldHapticClientRig, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
   const TeleopSnapshot& s = *ws.teleop;
   EXPECT_EQ(s.cycle, 299u);
   // The ball and the sheet are bodies: the world snapshot's poses and surfaces carry them.
-  const std::size_t ball = world.description().teleop->ball_body;
+  const std::size_t ball = rig_description(world.description())->ball_body;
   EXPECT_TRUE(ws.body_poses_world[ball].isApprox(world.body_pose(ball), 0.0));
-  const auto q = world.rig()->slave->q();
+  const auto q = rig_state(world)->slave->q();
   ASSERT_EQ(s.slave_q.size(), q.size());
   for (std::size_t i = 0; i < q.size(); ++i) {
     EXPECT_EQ(s.slave_q[i], q[i]) << "joint " << i;
   }
-  EXPECT_TRUE(s.X_world_tool.isApprox(world.rig()->slave->tip_pose(), 0.0));
-  EXPECT_EQ(s.gripper_width_m, world.rig()->result.gripper.width_m);
-  EXPECT_EQ(s.held, world.rig()->result.held);
-  const auto heights = world.sheet(world.description().teleop->sheet_body)->surface_heights();
+  EXPECT_TRUE(s.X_world_tool.isApprox(rig_state(world)->slave->tip_pose(), 0.0));
+  EXPECT_EQ(s.gripper_width_m, rig_state(world)->result.gripper.width_m);
+  EXPECT_EQ(s.held, rig_state(world)->result.held);
+  const auto heights =
+      world.sheet(rig_description(world.description())->sheet_body)->surface_heights();
   const std::vector<float>& sheet_xyz =
       ws.positions_body[world
-                            .flat_segment(BodyIndex{world.description().teleop->sheet_body},
-                                          LocalSegment{0})
+                            .flat_segment(
+                                BodyIndex{rig_description(world.description())->sheet_body},
+                                LocalSegment{0})
                             .index()];
   ASSERT_EQ(sheet_xyz.size(), 3 * heights.size());
   for (std::size_t k = 0; k < heights.size(); ++k) {
@@ -78,12 +81,14 @@ TEST(WorldHapticClientRig, SnapshotMatchesTheWorldExactlyAfterTheLoop) {
     static_cast<void>(inline_world.step(
         setup.trajectory.sample_at(static_cast<double>(i) * o.period_s), o.period_s));
   }
-  EXPECT_EQ(inline_world.body_pose(inline_world.description().teleop->ball_body).translation(),
-            world.body_pose(world.description().teleop->ball_body).translation());
+  EXPECT_EQ(
+      inline_world.body_pose(rig_description(inline_world.description())->ball_body).translation(),
+      world.body_pose(rig_description(world.description())->ball_body).translation());
   for (std::size_t i = 0; i < q.size(); ++i) {
-    EXPECT_EQ(inline_world.rig()->slave->q()[i], q[i]) << "joint " << i;
+    EXPECT_EQ(rig_state(inline_world)->slave->q()[i], q[i]) << "joint " << i;
   }
-  EXPECT_EQ(inline_world.rig()->slave->gripper_width_m(), world.rig()->slave->gripper_width_m());
+  EXPECT_EQ(rig_state(inline_world)->slave->gripper_width_m(),
+            rig_state(world)->slave->gripper_width_m());
 }
 
 TEST(WorldHapticClientRig, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAllocate) {
@@ -110,7 +115,9 @@ TEST(WorldHapticClientRig, ReaderSeesConsistentSnapshotsAndHapticThreadDoesNotAl
         // One cycle's data: the master joints the world followed are that cycle's input.
         if (s.master_joint_rad[0] != s.input.joint_rad[0] ||
             s.master_joint_rad[2] != s.input.joint_rad[2] || s.cycle < last_cycle ||
-            !ws.body_poses_world[world.description().teleop->ball_body].translation().allFinite()) {
+            !ws.body_poses_world[rig_description(world.description())->ball_body]
+                 .translation()
+                 .allFinite()) {
           inconsistent.fetch_add(1);
         }
         last_cycle = s.cycle;
@@ -139,15 +146,15 @@ TEST(WorldHapticClientRig, PausedClientHoldsTheWorldAndSendsNoTorque) {
   HapticLoop loop(device, client, o);
   loop.start();
   loop.wait();
-  EXPECT_EQ(world.rig()->result.time_s, 0.0);  // never stepped
+  EXPECT_EQ(rig_state(world)->result.time_s, 0.0);  // never stepped
   ASSERT_TRUE(client.snapshots()->update());
   const TeleopSnapshot& s = *client.snapshots()->read_slot().teleop;
   EXPECT_EQ(s.cycle, 49u);
   EXPECT_EQ(client.snapshots()
                 ->read_slot()
-                .body_poses_world[setup.description.teleop->ball_body]
+                .body_poses_world[rig_description(setup.description)->ball_body]
                 .translation(),
-            setup.description.teleop->ball_start_world);
+            rig_description(setup.description)->ball_start_world);
   for (int j = 0; j < kMaxDeviceJoints; ++j) {
     EXPECT_EQ(s.output.joint_torque_nm[static_cast<std::size_t>(j)], 0.0);
   }

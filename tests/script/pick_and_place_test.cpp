@@ -4,6 +4,8 @@
 // the sheet dented under it.
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
+#include "hapsim/rig/rig_controller.h"
+#include "hapsim/rig/rig_world.h"
 #include "hapsim/script/pick_and_place_trajectory.h"
 #include "hapsim/world/world.h"
 
@@ -57,7 +59,7 @@ Outcome run(TeleopRigDescription d, const PickAndPlaceScript& script) {
   const double dt = 1e-3;
   const auto steps = static_cast<int>(plan.trajectory.end_time_s() / dt);
   for (int k = 1; k <= steps; ++k) {
-    const TeleopStepResult& r = *world.step(plan.trajectory.sample_at(k * dt), dt).teleop;
+    const TeleopStepResult& r = *rig_result(world.step(plan.trajectory.sample_at(k * dt), dt));
     EXPECT_TRUE(r.ball_p_world.allFinite());
     if (r.gripper.grasped_now && !o.grasped) {
       o.grasped = true;
@@ -72,11 +74,12 @@ Outcome run(TeleopRigDescription d, const PickAndPlaceScript& script) {
       EXPECT_TRUE(std::isfinite(r.command.joint_torque_nm[static_cast<std::size_t>(j)]));
     }
   }
-  o.ball_final = world.body_pose(world.description().teleop->ball_body).translation();
-  o.final_sheet_depth_m = world.sheet(world.description().teleop->sheet_body)->max_depth_m();
+  o.ball_final = world.body_pose(rig_description(world.description())->ball_body).translation();
+  o.final_sheet_depth_m =
+      world.sheet(rig_description(world.description())->sheet_body)->max_depth_m();
   o.final_kinetic_energy_j =
-      (0.5 * world.description().teleop->ball.mass_kg *
-       world.state().bodies[world.description().teleop->ball_body].v_world.squaredNorm());
+      (0.5 * rig_description(world.description())->ball.mass_kg *
+       world.state().bodies[rig_description(world.description())->ball_body].v_world.squaredNorm());
   return o;
 }
 

@@ -5,6 +5,7 @@
 // mapping reaches what the arm reaches, maps the grasp button onto the fingers and allocates
 // nothing on the haptic thread.
 #include "hapsim/device/master_probe_device.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/ui/viewer_scenes.h"
 
 #include "hapsim/device/interactive_device.h"
@@ -124,12 +125,13 @@ TEST(TeleopViewerSession, MouseProbeIsTheSlaveToolsTargetAndTheSlaveFollowsIt) {
   const std::unique_ptr<ViewerSession> session = make_viewer_session(config_for("mouse"), scene);
   InteractiveDevice* mouse = session->mouse_device();
   ASSERT_NE(mouse, nullptr);
-  const MasterArm master(setup.description.teleop->master);
+  const MasterArm master(rig_description(setup.description)->master);
   const Vec3 p0 = session->probe_start_world();
   const Vec3 hand0 = master.hand_pose(first_arm_rad(setup)).translation();
   // The probe starts on the slave tool's target for the master's first pose.
   const Vec3 start_target =
-      slave_target(setup.description.teleop->mapping, hand0, first_arm_rad(setup)[0]).translation();
+      slave_target(rig_description(setup.description)->mapping, hand0, first_arm_rad(setup)[0])
+          .translation();
   EXPECT_LT((p0 - start_target).norm(), 1e-9);
 
   // At the start the slave is still, at its solved start pose.
@@ -146,14 +148,15 @@ TEST(TeleopViewerSession, MouseProbeIsTheSlaveToolsTargetAndTheSlaveFollowsIt) {
 
   // Independent: the same conversion, then the master's and the slave's geometry.
   MasterHandMapping mapping(master, first_arm_rad(setup));
-  mapping.set_probe_in_slave_frame(setup.description.teleop->mapping);
+  mapping.set_probe_in_slave_frame(rig_description(setup.description)->mapping);
   const DeviceInput converted = mapping.master_input(in);
   ASSERT_EQ(converted.joint_count, 3);
   const std::array<double, 3> q{converted.joint_rad[0], converted.joint_rad[1],
                                 converted.joint_rad[2]};
   const Vec3 hand = master.hand_pose(q).translation();
   EXPECT_LT((tool(r, "master hand")->p_world - hand).norm(), 1e-3);
-  const Vec3 target = slave_target(setup.description.teleop->mapping, hand, q[0]).translation();
+  const Vec3 target =
+      slave_target(rig_description(setup.description)->mapping, hand, q[0]).translation();
   // The slave's target is where the cursor put the probe (the master reaches it).
   EXPECT_LT((target - in.p_world).norm(), 1e-3);
   const Vec3 tool1 = tool(r, "slave tool")->p_world;
@@ -166,7 +169,7 @@ TEST(TeleopViewerSession, MouseProbeIsTheSlaveToolsTargetAndTheSlaveFollowsIt) {
 TEST(MasterHandMapping, HandLandsOnReachableProbePositionsAndGraspFollowsTheButton) {
   const SceneDescription scene = load_scene(kScene);
   const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, false);
-  const MasterArm master(setup.description.teleop->master);
+  const MasterArm master(rig_description(setup.description)->master);
   MasterHandMapping mapping(master, first_arm_rad(setup));
   const Vec3 p0 = master.hand_pose(first_arm_rad(setup)).translation();
   // A drag: small steps along a loop around the start, as the viewer sends them frame by frame.
@@ -211,7 +214,7 @@ TEST(MasterHandMapping, HandLandsOnReachableProbePositionsAndGraspFollowsTheButt
 TEST(MasterHandMapping, ConvertingAllocatesNothing) {
   const SceneDescription scene = load_scene(kScene);
   const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, false);
-  const MasterArm master(setup.description.teleop->master);
+  const MasterArm master(rig_description(setup.description)->master);
   MasterHandMapping mapping(master, first_arm_rad(setup));
   const Vec3 p0 = master.hand_pose(first_arm_rad(setup)).translation();
   DeviceInput in;

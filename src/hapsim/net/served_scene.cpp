@@ -2,6 +2,7 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/net/scene_hash.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/scene/scene_file.h"
 
 #include <chrono>
@@ -90,7 +91,7 @@ RunSetup build_served_scene(const SceneInfoSample& info, const DeviceChoice& cho
                                      ") is not the one served (hash " + hex(info.scene_hash) +
                                      "): give this machine the host's data folder (--data)");
   }
-  if (setup.world->rig() != nullptr) {
+  if (rig_state(*setup.world) != nullptr) {
     throw Error(info.scene_file, "a teleoperation rig is not served over the network yet");
   }
   return setup;

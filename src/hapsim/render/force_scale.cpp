@@ -1,4 +1,5 @@
 #include "hapsim/render/force_scale.h"
+#include "hapsim/rig/rig_controller.h"
 
 #include <algorithm>
 #include <array>
@@ -31,8 +32,8 @@ double device_rated_force_n(const DeviceProfile& profile) {
 
 double force_display_scale_n(const WorldDescription& world, double rated_n) {
   double ceiling_n = 0.0;
-  if (world.teleop) {
-    ceiling_n = world.teleop->gripper.max_force_n;
+  if (const TeleopRigDescription* rig = rig_description(world)) {
+    ceiling_n = rig->gripper.max_force_n;
   } else {
     for (const BodyDescription& body : world.bodies) {
       for (const SegmentDescription& seg : body.segments) {

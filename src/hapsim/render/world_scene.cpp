@@ -1,16 +1,17 @@
 #include "hapsim/render/world_scene.h"
 
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/world/fem_coupling.h"
 
 #include "hapsim/collision/knee_index.h"
 #include "hapsim/collision/sphere_tree.h"
 #include "hapsim/core/error.h"
-#include "hapsim/kinematics/slave_shapes.h"
 #include "hapsim/render/creased_normals.h"
 #include "hapsim/render/force_scale.h"
 #include "hapsim/render/hand_figure.h"
 #include "hapsim/render/slave_figure.h"
 #include "hapsim/render/user_colour.h"
+#include "hapsim/rig/slave_shapes.h"
 
 #include <algorithm>
 #include <array>
@@ -55,10 +56,10 @@ struct RigRole {
 
 RigRole rig_role(const WorldDescription& d, std::size_t b, const RigColours& c) {
   RigRole role;
-  if (!d.teleop) {
+  if (rig_description(d) == nullptr) {
     return role;
   }
-  const TeleopRigDescription& rig = *d.teleop;
+  const TeleopRigDescription& rig = *rig_description(d);
   // Boxes: the pads, the palm and stem, and the links of a chain without meshes.
   const bool box_links =
       std::all_of(rig.slave->link_geometry().begin(), rig.slave->link_geometry().end(),
@@ -162,7 +163,7 @@ WorldScene::WorldScene(const World& world, WorldSceneOptions options)
   hand_ = world.hand_reading();
   tools_.resize(d.tools.size());
   tool_force_n_.assign(d.tools.size(), 0.0);
-  if (d.teleop) {
+  if (rig_description(d) != nullptr) {
     build_rig();
     apply_colouring();
     rebuild_overlays(tools_, tool_force_n_);
@@ -186,7 +187,7 @@ WorldScene::~WorldScene() = default;
 // The rig's part: its state at the start, the joint spheres of a slave drawn as boxes, the master
 // beside the slave's −y side (clear of the ball), on the floor, and a floor under everything.
 void WorldScene::build_rig() {
-  const TeleopRigDescription& rig = *world_.description().teleop;
+  const TeleopRigDescription& rig = *rig_description(world_.description());
   rig_ = make_teleop_snapshot(world_);
   frames_.resize(static_cast<std::size_t>(rig.slave->dof()));
   slave_figure_ = std::make_unique<SlaveFigure>(*rig.slave, scene_,
@@ -206,7 +207,7 @@ void WorldScene::build_rig() {
   const BallEnvironmentOptions& env = rig.environment;
   const double floor_z = env.has_floor ? env.floor_z_m : bounds.min().z();
   bounds.extend(Vec3(bounds.min().x(), bounds.min().y(), floor_z));
-  const MasterArmGeometry& g = world_.model().master()->geometry();
+  const MasterArmGeometry& g = rig_controller(world_.description())->master().geometry();
   const double master_reach =
       options_.master_display_scale * (g.upper_arm_m + g.forearm_m + g.finger_m);
   master_origin_world_ = Vec3(bounds.center().x(), bounds.min().y() - 0.6 * master_reach, floor_z);
@@ -550,7 +551,7 @@ void WorldScene::update_from_world(const World& world) {
   }
   hand_ = world.hand_reading();
   if (rig_) {
-    rig_->time_s = world.rig()->result.time_s;
+    rig_->time_s = rig_state(world)->result.time_s;
     fill_teleop_snapshot(*rig_, world);
   }
   const StepResult& r = world.last_result();
@@ -659,7 +660,7 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
 // the shadow mark under the gripper's tool point (between the pads), the master.
 void WorldScene::add_rig_overlays() {
   const TeleopSnapshot& s = *rig_;
-  const TeleopRigDescription& rig = *world_.description().teleop;
+  const TeleopRigDescription& rig = *rig_description(world_.description());
   if (options_.colouring == SegmentColouring::kTissue) {
     for (const auto& seg : segments_) {
       if (seg->pad >= 0) {
@@ -681,7 +682,7 @@ void WorldScene::add_rig_overlays() {
 // The master arm at master_display_scale beside the slave: its links as rods from the base
 // through the shoulder and elbow to the hand, its two fingers as thin rods.
 void WorldScene::add_master(const TeleopSnapshot& s) {
-  const MasterArm& master = *world_.model().master();
+  const MasterArm& master = rig_controller(world_.description())->master();
   const MasterArmGeometry& g = master.geometry();
   std::array<Iso3, 3> f;
   const Iso3 hand = master.arm().frames(s.master_joint_rad, f);

@@ -1,6 +1,7 @@
 #include "hapsim/runtime/cycle_record.h"
 
 #include "hapsim/device/force_safety.h"
+#include "hapsim/rig/rig_controller.h"
 
 #include <algorithm>
 
@@ -42,9 +43,10 @@ void fill_cycle_record(CycleRecord& record, std::uint64_t cycle, const DeviceInp
       record.sheet_depth_m[static_cast<std::size_t>(record.sheet_count++)] = depth;
     }
   }
-  record.has_teleop = result.teleop != nullptr;
-  if (record.has_teleop) {
-    record.teleop = *result.teleop;
+  const TeleopStepResult* rig = rig_result(result);
+  record.has_teleop = rig != nullptr;
+  if (rig != nullptr) {
+    record.teleop = *rig;
   }
   record.cost_us = cost_us;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "hapsim/device/recording.h"
+#include "hapsim/rig/rig_step_result.h"
 #include "hapsim/world/world.h"
 
 #include <array>

@@ -5,6 +5,7 @@
 #include "hapsim/core/statistics.h"
 #include "hapsim/deform/fem_body.h"
 #include "hapsim/device/force_safety.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/runtime/fem_thread.h"
 #include "hapsim/runtime/ramp_warning.h"
 #include "hapsim/runtime/record_drain.h"
@@ -131,9 +132,9 @@ class SessionAccountant {
         summary_.sheets.push_back(SheetSummary{desc.bodies[b].name, 0.0, 0.0});
       }
     }
-    if (world.rig() != nullptr) {
+    if (rig_state(world) != nullptr) {
       summary_.teleop.emplace();
-      ball_start_z_ = world.body_pose(desc.teleop->ball_body).translation().z();
+      ball_start_z_ = world.body_pose(rig_description(desc)->ball_body).translation().z();
     }
     // A served world runs until stopped: reserve a run of up to an hour, grow beyond.
     cost_us_.reserve(std::min<std::size_t>(steps, 3'600'000));
@@ -329,7 +330,7 @@ class SessionAccountant {
     }
     if (summary_.teleop) {
       TeleopSummary& t = *summary_.teleop;
-      t.ball_final_world = world_.body_pose(desc.teleop->ball_body).translation();
+      t.ball_final_world = world_.body_pose(rig_description(desc)->ball_body).translation();
       if (options_.teleop_target_world) {
         t.target_error_m = (t.ball_final_world - *options_.teleop_target_world).norm();
       }

@@ -1,6 +1,7 @@
 #include "hapsim/runtime/teleop_snapshot.h"
 
 #include "hapsim/deform/virtual_sheet.h"
+#include "hapsim/rig/rig_controller.h"
 
 #include <algorithm>
 
@@ -8,7 +9,7 @@ namespace hapsim {
 
 TeleopSnapshot make_teleop_snapshot(const World& world) {
   TeleopSnapshot s;
-  const RigState& rig = *world.rig();
+  const RigState& rig = *rig_state(world);
   s.slave_q.assign(rig.slave->q().size(), 0.0);
   s.time_s = rig.result.time_s;
   fill_teleop_snapshot(s, world);
@@ -17,7 +18,7 @@ TeleopSnapshot make_teleop_snapshot(const World& world) {
 
 // haptic path
 void fill_teleop_snapshot(TeleopSnapshot& s, const World& world) noexcept {
-  const RigState& rig = *world.rig();
+  const RigState& rig = *rig_state(world);
   const TeleopStepResult& r = rig.result;
   const bool stepped = r.time_s > 0.0;
   const auto q = rig.slave->q();
@@ -28,10 +29,10 @@ void fill_teleop_snapshot(TeleopSnapshot& s, const World& world) noexcept {
   s.pad_force_n = r.gripper.pad_force_n;
   s.grasp_force_n = r.gripper.grasp_force_n();
   s.held = r.held;
-  s.sheet_depth_m = world.sheet(world.description().teleop->sheet_body)->max_depth_m();
+  s.sheet_depth_m = world.sheet(rig_description(world.description())->sheet_body)->max_depth_m();
   s.master_joint_rad = r.master_arm_rad;
   s.master_finger_rad = r.master_finger_rad;
-  s.X_master_hand = world.model().master()->hand_pose(r.master_arm_rad);
+  s.X_master_hand = rig_controller(world.description())->master().hand_pose(r.master_arm_rad);
 }
 
 }  // namespace hapsim

@@ -2,6 +2,7 @@
 
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/deform/virtual_sheet.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/runtime/tool_rendered_force.h"
 
 #include <algorithm>
@@ -175,7 +176,7 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
       s.tool_force_n[t] = tool_rendered_force_n(d.tools[t], r.tools[t], *cycle.output, tip_scale);
     }
   }
-  if (s.teleop && world_.rig() != nullptr) {
+  if (s.teleop && rig_state(world_) != nullptr) {
     TeleopSnapshot& t = *s.teleop;
     t.cycle = s.cycle;
     t.time_s = s.time_s;

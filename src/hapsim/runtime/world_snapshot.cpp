@@ -2,6 +2,7 @@
 
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/deform/virtual_sheet.h"
+#include "hapsim/rig/rig_controller.h"
 
 namespace hapsim {
 
@@ -50,7 +51,7 @@ WorldSnapshot make_world_snapshot(const World& world) {
           deflection->max_deflection_m();
     }
   }
-  if (world.rig() != nullptr) {
+  if (rig_state(world) != nullptr) {
     s.teleop = make_teleop_snapshot(world);
   }
   return s;

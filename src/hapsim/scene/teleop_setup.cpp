@@ -4,6 +4,8 @@
 #include "hapsim/kinematics/master_arm.h"
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/urdf_chain.h"
+#include "hapsim/rig/rig_controller.h"
+#include "hapsim/rig/rig_world.h"
 #include "hapsim/script/slave_start.h"
 #include "hapsim/script/teleop_pick_and_place_plan.h"
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "hapsim/kinematics/master_arm.h"
+#include "hapsim/rig/rig_description.h"
 #include "hapsim/script/trajectory.h"
 #include "hapsim/world/world_description.h"
 

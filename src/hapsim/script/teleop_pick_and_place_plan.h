@@ -6,6 +6,7 @@
 
 #include "hapsim/core/types.h"
 #include "hapsim/kinematics/master_arm.h"
+#include "hapsim/rig/rig_description.h"
 #include "hapsim/script/pick_and_place_trajectory.h"
 #include "hapsim/world/world_description.h"
 

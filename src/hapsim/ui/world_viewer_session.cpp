@@ -1,5 +1,6 @@
 #include "hapsim/ui/world_viewer_session.h"
 
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/ui/world_readout.h"
 
 #include "hapsim/core/error.h"
@@ -107,15 +108,15 @@ class WorldViewerSession final : public ViewerSession {
     // The position a mouse or 3D mouse starts at, and what turns it into the device's input.
     std::optional<MasterHandMapping> hand_mapping;
     view_ = std::make_unique<WorldScene>(*world_);
-    if (world_->rig() != nullptr) {
+    if (rig_state(*world_) != nullptr) {
       // The probe starts where the master's hand is at the script's first sample, so the slave
       // starts still (the run setup solved its start joints for that pose). The cursor points at
       // the slave's tool: the probe is its target in the world.
       const DeviceInput& first = setup.script_start;
       const std::array<double, 3> first_arm{first.joint_rad[0], first.joint_rad[1],
                                             first.joint_rad[2]};
-      hand_mapping.emplace(*world_->model().master(), first_arm);
-      hand_mapping->set_probe_in_slave_frame(world_->description().teleop->mapping);
+      hand_mapping.emplace(rig_controller(world_->description())->master(), first_arm);
+      hand_mapping->set_probe_in_slave_frame(rig_description(world_->description())->mapping);
       probe_start_world_ = hand_mapping->probe_for(first_arm);
     } else {
       probe_start_world_ = probe_start_for(scene_.world, view_->rest_bounds_world());
@@ -172,8 +173,8 @@ class WorldViewerSession final : public ViewerSession {
     }
     title_ = scene_.file.filename().string() + " — " +
              (setup.slave_name.empty() ? "" : setup.slave_name + ", ") + device_name_;
-    readout_.rated_force_n = world_->rig() != nullptr
-                                 ? world_->description().teleop->gripper.max_force_n
+    readout_.rated_force_n = rig_state(*world_) != nullptr
+                                 ? rig_description(world_->description())->gripper.max_force_n
                                  : device_rated_force_n(profile);
     readout_.bar_full_scale_n =
         force_display_scale_n(world_->description(), readout_.rated_force_n);
@@ -404,7 +405,7 @@ class WorldViewerSession final : public ViewerSession {
     view_->set_options(o);
   }
   void draw_controls() override {
-    if (world_->rig() != nullptr) {
+    if (rig_state(*world_) != nullptr) {
       draw_rig_controls();
       return;
     }
@@ -484,7 +485,7 @@ class WorldViewerSession final : public ViewerSession {
     char text[160];
     r.lines.clear();
     const Vec3 ball_p_world =
-        world.body_poses_world[world_->description().teleop->ball_body].translation();
+        world.body_poses_world[rig_description(world_->description())->ball_body].translation();
     r.lines.emplace_back("ball (mm)", format_mm(ball_p_world) + (s.held ? "  held" : "  free"));
     std::snprintf(text, sizeof text, "%.1f mm, grasp %.2f N", s.gripper_width_m * 1e3,
                   s.grasp_force_n);
@@ -527,7 +528,7 @@ class WorldViewerSession final : public ViewerSession {
           "The probe is the master's hand (its base frame): drag to move it, wheel for depth, G "
           "closes or opens the grasp.");
     }
-    const TeleopRigDescription& d = *world_->description().teleop;
+    const TeleopRigDescription& d = *rig_description(world_->description());
     ImGui::Text("mapping scale %.2f, gripper %.0f mm / %.0f N", d.mapping.scale,
                 d.follower.gripper_max_width_m * 1e3, d.gripper.max_force_n);
   }

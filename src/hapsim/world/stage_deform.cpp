@@ -43,12 +43,6 @@ void deform(const WorldModel& model, WorldState& state, double dt_s) noexcept {
     if (seg.sheet) {
       deform_sheet(model, state, segs[i], seg);
       state.sheet_depth_m[sheet_index++] = seg.sheet->max_depth_m();
-      if (state.rig &&
-          i ==
-              model.flat_segment(BodyIndex{model.description().teleop->sheet_body}, LocalSegment{0})
-                  .index()) {
-        state.rig->result.sheet_depth_m = seg.sheet->max_depth_m();
-      }
       continue;
     }
     if (!seg.deflection) {

@@ -3,8 +3,8 @@
 // (symplectic) Euler — v += (F/m + g)·dt, then x += v·dt; ω += I⁻¹(τ − ω×Iω)·dt, then the
 // orientation turns by ω·dt — with the contacts' springs and dampers (linearised where the stages
 // computed them) taken implicitly in the velocity update, so a light body on stiff contacts
-// stays stable at 1 kHz where explicit Euler gains energy. A teleoperation rig's ball is one of
-// these bodies; this stage also fills the rig's report of what carries it (the sheet, the floor).
+// stays stable at 1 kHz where explicit Euler gains energy (a ball a robot's gripper picks is one
+// of these bodies).
 #include "hapsim/world/world_model.h"
 #include "hapsim/world/world_stages.h"
 #include "hapsim/world/world_state.h"
@@ -212,33 +212,6 @@ void integrate(const WorldModel& model, WorldState& state, double dt_s) noexcept
   for (const std::size_t b : model.dynamic_bodies()) {
     move_body(model.bodies()[b], state.bodies[b], dt_s);
   }
-  if (!state.rig) {
-    return;
-  }
-  // The rig's report of where the ball is and what carries it (the sheet, the floor).
-  RigState& rig = *state.rig;
-  const TeleopRigDescription& d = *model.description().teleop;
-  TeleopStepResult& r = rig.result;
-  BallContactReport& b = r.ball_contacts;
-  b = BallContactReport{};
-  for (std::size_t k = 0; k < state.body_contact_count; ++k) {
-    const BodyContact& c = state.body_contacts[k];
-    if (c.body != BodyIndex{d.ball_body}) {
-      continue;
-    }
-    if (c.other_body == BodyIndex{d.sheet_body}) {
-      b.on_sheet = c.force_world_n.squaredNorm() > 0.0;
-      b.sheet_force_world_n += c.force_world_n;
-      const Iso3& X_sheet_world = state.bodies[d.sheet_body].X_body_world;
-      b.sheet_contact_sheet = X_sheet_world * c.point_world;
-      b.sheet_push_n = std::max(0.0, (X_sheet_world.linear() * c.force_world_n).z());
-    } else if (c.other_body == BodyIndex{d.floor_body}) {
-      b.on_floor = c.force_world_n.squaredNorm() > 0.0;
-      b.floor_force_world_n += c.force_world_n;
-    }
-  }
-  r.ball_p_world = state.bodies[d.ball_body].X_world_body.translation();
-  r.held = r.gripper.held;
 }
 
 }  // namespace hapsim::stage

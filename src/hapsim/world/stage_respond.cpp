@@ -37,44 +37,6 @@ void add_pending(SegmentState& seg, const DeflectionContact& contact) noexcept {
   }
 }
 
-// The rig's grasp, read off the pads' contacts with the ball (body-contact stage): each pad's
-// squeeze, what the pads push on the ball, and whether the grasp holds — both pads pressing from
-// opposite sides with friction able to carry the ball's weight, μ·(N₁ + N₂) ≥ safety · m·g. The
-// ball stays a free body held by friction; this is the report (and the master's fingers' force).
-void respond_rig(const WorldModel& model, WorldState& state) noexcept {
-  RigState& rig = *state.rig;
-  const TeleopRigDescription& d = *model.description().teleop;
-  GripperReport& g = rig.result.gripper;
-  g.pad_force_n = {0.0, 0.0};
-  g.force_on_ball_world_n.setZero();
-  g.grasped_now = false;
-  g.released_now = false;
-  std::array<Vec3, 2> normals{Vec3::Zero(), Vec3::Zero()};
-  for (std::size_t k = 0; k < state.body_contact_count; ++k) {
-    const BodyContact& c = state.body_contacts[k];
-    for (std::size_t i = 0; i < 2; ++i) {
-      if (c.body == BodyIndex{d.ball_body} && c.other_body == BodyIndex{d.pad_body[i]}) {
-        g.pad_force_n[i] = std::max(0.0, c.force_world_n.dot(c.normal_world));
-        normals[i] = c.normal_world;
-        g.force_on_ball_world_n += c.force_world_n;
-      }
-    }
-  }
-  const double weight = d.ball.mass_kg * model.description().gravity_m_per_s2.norm();
-  const bool both =
-      g.pad_force_n[0] > 0.0 && g.pad_force_n[1] > 0.0 && normals[0].dot(normals[1]) < -0.5;
-  const double friction = d.gripper.pad_contact.friction;
-  if (!rig.held && both &&
-      friction * (g.pad_force_n[0] + g.pad_force_n[1]) >= d.gripper.safety_factor * weight) {
-    rig.held = true;
-    g.grasped_now = true;
-  } else if (rig.held && !both) {
-    rig.held = false;
-    g.released_now = true;
-  }
-  g.held = rig.held;
-}
-
 }  // namespace
 
 // haptic path
@@ -133,9 +95,6 @@ void count_proxy_loss(WorldState& state, ToolRuntime& tool) noexcept {
 
 // haptic path
 void respond(const WorldModel& model, WorldState& state, double /*dt_s*/) noexcept {
-  if (state.rig) {
-    respond_rig(model, state);
-  }
   const WorldDescription& d = model.description();
   const std::vector<SegmentModel>& segs = model.segments();
   for (std::size_t t = 0; t < state.tools.size(); ++t) {

@@ -12,55 +12,9 @@
 
 namespace hapsim::stage {
 
-namespace {
-
-// The rig's forces back to the master: the reaction at the slave's tool (the pads', and the
-// palm's and stem's when the ball presses them: the gripper's parts past the wrist), scaled into
-// the master's frame and turned into joint torques through the master's Jᵀ; the grasp force on
-// both fingers. The links' contacts are not felt: they are the arm's, not the hand's.
-void rig_command(const WorldModel& model, const WorldState& state, RigState& rig) noexcept {
-  TeleopStepResult& r = rig.result;
-  r.command = DeviceCommand{};
-  if (!rig.input_usable) {
-    return;
-  }
-  const TeleopRigDescription& d = *model.description().teleop;
-  // What the ball pushes on the pads (held by friction: its weight and whatever the sheet or
-  // the floor push on it, carried through the grasp).
-  Vec3 at_tool = -r.gripper.force_on_ball_world_n;
-  for (const TeleopRigDescription::SlaveBody& s : d.slave_bodies) {
-    if (s.frame == kToolFrame) {
-      at_tool += state.bodies[s.body].force_world_n;
-    }
-  }
-  const Vec3 at_master = d.mapping.X_slave_master.linear().transpose() * at_tool * d.force_scale;
-  const MasterTorques t =
-      model.master()->torques(r.master_arm_rad, at_master, r.gripper.grasp_force_n());
-  for (std::size_t i = 0; i < 3; ++i) {
-    r.command.joint_torque_nm[i] = t.arm_n_m[i];
-  }
-  r.command.joint_torque_nm[3] = t.fingers_n_m[0];
-  r.command.joint_torque_nm[4] = t.fingers_n_m[1];
-  r.command.joint_count = 5;
-  const double grasp = r.gripper.grasp_force_n();
-  r.command.finger_force_n[0] = std::isfinite(grasp) ? grasp : 0.0;
-  r.command.finger_force_n[1] = r.command.finger_force_n[0];
-  r.command.finger_count = 2;
-  for (double& torque : r.command.joint_torque_nm) {
-    torque = std::isfinite(torque) ? torque : 0.0;
-  }
-}
-
-}  // namespace
-
 // haptic path
 void safety(const WorldModel& model, WorldState& state) noexcept {
   state.command = DeviceCommand{};
-  if (state.rig) {
-    // A rig's master gets the rig's torques and grasp (its scenes have no probe tools).
-    rig_command(model, state, *state.rig);
-    state.command = state.rig->result.command;
-  }
   const WorldDescription& d = model.description();
   for (std::size_t t = 0; t < state.tool_states.size(); ++t) {
     ToolState& out = state.tool_states[t];
@@ -84,6 +38,11 @@ void safety(const WorldModel& model, WorldState& state) noexcept {
     } else {
       state.command.force_world_n += out.force_world_n;
     }
+  }
+  if (state.controller) {
+    // A controller that drives the device another way (a master arm's joint torques) writes
+    // its own command.
+    state.controller->command(model, state, state.command);
   }
 }
 

@@ -96,9 +96,9 @@ class World {
     return state_.material_contact.at(material);
   }
   [[nodiscard]] std::size_t body_count() const { return description().bodies.size(); }
-  /// The teleoperation rig's state (slave, gripper, ball, sheet, last step), or null when the
-  /// world has none. Only the thread that steps may read it while the world runs.
-  [[nodiscard]] const RigState* rig() const { return state_.rig.get(); }
+  /// The state of the description's controller (a robot's rig: rig/rig_controller.h), or null
+  /// when the world has none. Only the thread that steps may read it while the world runs.
+  [[nodiscard]] const ControllerState* controller() const { return state_.controller.get(); }
   /// The glove hand's pose and finger angles from the last usable input (a world with a hand;
   /// the tools sit at its fingertips). Only the thread that steps may read it while it runs.
   [[nodiscard]] const GloveReading& hand_reading() const { return state_.hand; }

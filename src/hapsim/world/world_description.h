@@ -9,17 +9,11 @@
 #include "hapsim/deform/sheet_profile.h"
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/deform/virtual_sheet.h"
-#include "hapsim/dynamics/ball_environment.h"
-#include "hapsim/dynamics/parallel_gripper.h"
-#include "hapsim/dynamics/rigid_ball.h"
 #include "hapsim/force/contact_material.h"
 #include "hapsim/geometry/csg.h"
 #include "hapsim/geometry/triangle_mesh.h"
 #include "hapsim/kinematics/hand_model.h"
-#include "hapsim/kinematics/master_arm.h"
-#include "hapsim/kinematics/serial_chain.h"
-#include "hapsim/kinematics/slave_follower.h"
-#include "hapsim/kinematics/slave_shapes.h"
+#include "hapsim/world/world_controller.h"
 
 #include <array>
 #include <cstdint>
@@ -53,7 +47,8 @@ enum class BodyKind : std::uint8_t {
   kStatic,      ///< never moves, never deforms
   kDynamic,     ///< rigid with mass: moves under gravity and its contacts (integrate stage)
   kDeformable,  ///< deforms under contact and recovers (architecture.md#deformation)
-  /// Rigid, moved by the rig each step (a gripper pad): pushes dynamic bodies, is never pushed.
+  /// Rigid, moved by a controller each step (a robot's gripper pad): pushes dynamic bodies, is
+  /// never pushed.
   kKinematic,
 };
 
@@ -160,45 +155,6 @@ struct ToolDescription {
   int device = 0;
 };
 
-/// A teleoperation rig (paper 000): a 5-DOF master arm (the device: joint_rad[0..2] arm,
-/// finger_rad[0..1] grasp) drives a slave robot with a parallel gripper through IK; the gripper
-/// picks a rigid ball, which rests on a virtual sheet (or the floor) and imprints it. Forces come
-/// back to the master as joint torques (the pads' reaction at the slave's tool, scaled, through
-/// Jᵀ) and finger torques (the grasp force).
-struct TeleopRigDescription {
-  MasterArmGeometry master;
-  /// The slave arm (procedural Motoman or the GP7 URDF) and its start joints (dof() values;
-  /// empty: all zero, clamped into the limits).
-  std::shared_ptr<const SerialChain> slave;
-  std::vector<double> slave_start_rad;
-  TeleopMapping mapping;
-  SlaveFollowerOptions follower;
-  ParallelGripperParams gripper;
-  RigidBallParams ball;
-  Vec3 ball_start_world = Vec3(0.55, -0.25, 0.03);
-  VirtualSheetOptions sheet;
-  BallEnvironmentOptions environment;
-  /// How the contact force at the slave's tool is scaled back onto the master's hand.
-  double force_scale = 1.0;
-  /// The rig's bodies in WorldDescription::bodies (rig_world() adds them): the ball (dynamic),
-  /// the sheet, the two gripper pads (kinematic; 0: the +y side), the floor (or kNoBody).
-  static constexpr std::size_t kNoBody = static_cast<std::size_t>(-1);
-  std::size_t ball_body = kNoBody;
-  std::size_t sheet_body = kNoBody;
-  std::array<std::size_t, 2> pad_body{kNoBody, kNoBody};
-  std::size_t floor_body = kNoBody;
-  /// A body of the slave itself (kinematic: a link, the gripper's palm or stem), placed each step
-  /// where its chain frame is (slave_shapes.h): X_world_body = X_world_frame · X_frame_body.
-  struct SlaveBody {
-    std::size_t body = kNoBody;
-    /// −1: the base; i: joint i's frame after its motion; kToolFrame: the tool (flange).
-    int frame = -1;
-    Iso3 X_frame_body = Iso3::Identity();
-  };
-  /// The links in chain order, then the palm and stem (rig_world() adds them).
-  std::vector<SlaveBody> slave_bodies;
-};
-
 struct WorldDescription {
   std::string name;
   std::vector<MaterialDescription> materials;
@@ -214,8 +170,9 @@ struct WorldDescription {
   double passivity_damping_factor = 1.0;
   /// Gravity on dynamic bodies, world frame.
   Vec3 gravity_m_per_s2 = Vec3(0.0, 0.0, -9.81);
-  /// A teleoperation rig driven by the device (the master arm), when the scene has one.
-  std::optional<TeleopRigDescription> teleop;
+  /// A controller that drives some of the bodies from the device (world_controller.h: a
+  /// robot's rig), or null. Shared: immutable, like the rest of the description.
+  std::shared_ptr<const WorldController> controller;
   /// Several users in one world: the named device hosts (`hapsim device --name NAME`), in the
   /// order of ToolDescription::device. Empty: one device, unnamed.
   std::vector<std::string> device_hosts;
@@ -223,13 +180,6 @@ struct WorldDescription {
 
 /// Most devices one world takes (one per user: a trainee, an instructor, two hands).
 inline constexpr int kMaxWorldDevices = 4;
-
-/// A world made of a teleoperation rig (the teleoperation scenes): the rig, and as ordinary bodies
-/// its floor (static), sheet (deformable, Gaussian), ball (dynamic sphere), gripper pads
-/// (kinematic boxes) and the slave's links, palm and stem (kinematic: slave_shapes.h, at the
-/// slave's start joints), each with a penalty material made from the rig's contact springs, so
-/// the ball meets them through the same contact code as every other body.
-[[nodiscard]] WorldDescription rig_world(TeleopRigDescription rig, std::string name = "teleop");
 
 /// A content hash of a world description (meshes, materials, tools), as recordings carry it.
 [[nodiscard]] std::string content_hash(const WorldDescription& description);

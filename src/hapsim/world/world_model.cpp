@@ -52,50 +52,6 @@ std::unique_ptr<ProximityQuery> make_query(ContactMethod method, const SegmentDe
   return std::make_unique<MeshBvh>(mesh);
 }
 
-void check_rig(const TeleopRigDescription& d) {
-  if (!d.slave) {
-    throw Error("teleop", "no slave arm");
-  }
-  if (!d.slave_start_rad.empty() &&
-      d.slave_start_rad.size() != static_cast<std::size_t>(d.slave->dof())) {
-    throw Error("teleop", "slave start has " + std::to_string(d.slave_start_rad.size()) +
-                              " joint values; the slave has " + std::to_string(d.slave->dof()));
-  }
-  if (!d.ball_start_world.allFinite() || !std::isfinite(d.force_scale) || d.force_scale < 0.0) {
-    throw Error("teleop", "ball start must be finite and the force scale >= 0");
-  }
-  const ParallelGripperParams& g = d.gripper;
-  if (!(g.pad_half_m.minCoeff() > 0.0) || !g.pad_half_m.allFinite() ||
-      !std::isfinite(g.pad_depth_m) || !(g.pad_contact.stiffness_n_per_m > 0.0) ||
-      !(g.max_force_n > 0.0) || !std::isfinite(g.max_force_n) || !(g.safety_factor >= 1.0)) {
-    throw Error("teleop",
-                "gripper pads need finite sizes > 0, a stiffness and force limit > 0 "
-                "and a safety factor >= 1");
-  }
-}
-
-// The rig's bodies are where rig_world() put them, of the kinds the rig's stages expect.
-void check_rig_bodies(const WorldDescription& w) {
-  const TeleopRigDescription& d = *w.teleop;
-  const auto is = [&](std::size_t b, BodyKind kind) {
-    return b < w.bodies.size() && w.bodies[b].kind == kind;
-  };
-  if (!is(d.ball_body, BodyKind::kDynamic) || !w.bodies[d.ball_body].segments.front().sphere ||
-      !is(d.sheet_body, BodyKind::kDeformable) ||
-      w.bodies[d.sheet_body].deformation != BodyDeformation::kGaussianSheet ||
-      !is(d.pad_body[0], BodyKind::kKinematic) || !is(d.pad_body[1], BodyKind::kKinematic) ||
-      (d.floor_body != TeleopRigDescription::kNoBody && !is(d.floor_body, BodyKind::kStatic)) ||
-      std::any_of(d.slave_bodies.begin(), d.slave_bodies.end(),
-                  [&](const TeleopRigDescription::SlaveBody& s) {
-                    return !is(s.body, BodyKind::kKinematic) ||
-                           !(s.frame == kToolFrame || (s.frame >= -1 && s.frame < d.slave->dof()));
-                  })) {
-    throw Error("teleop",
-                "the rig's ball, sheet, pads, floor and slave links must be bodies of the world "
-                "(build the world with rig_world())");
-  }
-}
-
 // A dynamic body needs a usable mass and inertia; its segments answer by penalty (a god-object's
 // proxy assumes a surface that stays put within the cycle).
 void check_dynamic(const WorldDescription& d, const BodyDescription& body) {
@@ -363,10 +319,8 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
                 "has " + std::to_string(description_.tools.size()) + " tools; at most " +
                     std::to_string(kMaxTools) + " are supported");
   }
-  if (description_.teleop) {
-    check_rig(*description_.teleop);
-    check_rig_bodies(description_);
-    master_ = std::make_unique<MasterArm>(description_.teleop->master);
+  if (description_.controller) {
+    description_.controller->check(description_);
   }
   build_ms_ = watch.elapsed_ms();
 }
@@ -435,16 +389,6 @@ void WorldModel::check_sheet_contacts() const {
                   std::to_string(press.sheet_stiffness_n_per_m) +
                   " N/m): the press would not settle; soften the material or stiffen the "
                   "sheet (sensitivity_n_per_mm)");
-}
-
-double WorldModel::slave_width_for(double master_opening_m) const noexcept {
-  if (!master_) {
-    return 0.0;
-  }
-  const MasterArmGeometry& g = master_->geometry();
-  const double widest = 2.0 * g.finger_m * std::sin(g.finger_open_limit_rad);
-  const double u = std::clamp((master_opening_m - g.finger_gap_m) / widest, 0.0, 1.0);
-  return u * description_.teleop->follower.gripper_max_width_m;
 }
 
 std::size_t WorldModel::query_memory_bytes() const {

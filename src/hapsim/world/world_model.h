@@ -105,8 +105,6 @@ class WorldModel {
   [[nodiscard]] const WorldOptions& options() const { return options_; }
   /// The hand the glove drives, or null when the tools sit at device offsets.
   [[nodiscard]] const HandModel* hand() const { return hand_.get(); }
-  /// The teleoperation rig's master arm (the device), or null when the scene has no rig.
-  [[nodiscard]] const MasterArm* master() const { return master_.get(); }
   [[nodiscard]] const std::vector<SegmentModel>& segments() const { return segments_; }
   [[nodiscard]] const std::vector<BodyModel>& bodies() const { return bodies_; }
   /// Indices of the dynamic bodies, in body order.
@@ -128,9 +126,6 @@ class WorldModel {
   [[nodiscard]] std::size_t proxy_segment_count() const { return proxy_segments_; }
   [[nodiscard]] std::size_t penalty_segment_count() const { return penalty_segments_; }
   [[nodiscard]] double max_tool_radius_m() const { return max_tool_radius_m_; }
-  /// The rig's slave gripper opening for a master grip opening: the master's range mapped
-  /// linearly onto the slave's. 0 without a rig.
-  [[nodiscard]] double slave_width_for(double master_opening_m) const noexcept;
   /// Whether every press on a sheet settles with these contact materials (indexed like the
   /// description's): each spring that presses a sheet — a tool's (clamped to the device's
   /// rating), a dynamic body's (both materials in series) — is softer than the sheet gives way
@@ -153,7 +148,6 @@ class WorldModel {
   std::vector<std::string> notes_;
   WorldOptions options_;
   std::unique_ptr<HandModel> hand_;
-  std::unique_ptr<MasterArm> master_;
   std::vector<SegmentModel> segments_;
   std::vector<BodyModel> bodies_;
   std::vector<std::size_t> dynamic_bodies_;

@@ -2,10 +2,11 @@
 // read-only model and the state fields earlier stages filled, and fills its own (world_state.h
 // says which stage fills what). All are haptic path: no allocation, no lock, no I/O.
 //
-//   place_tools      device input → each tool's position and velocity (probe: device pose × offset;
-//                    glove: the hand's fingertips; a teleoperation rig's master arm: the slave
-//                    follows the master's hand through IK and carries the gripper's pad bodies,
-//                    closed to the master's grip); an unusable input holds the tools
+//   place_tools      device input → the world's controller (world_controller.h) moves the bodies
+//                    it drives (a robot's links and gripper pads); then each tool's position and
+//                    velocity (probe: device pose × offset; glove: the hand's fingertips; a
+//                    controller may put them where its mechanism holds them); an unusable input
+//                    holds the tools
 //   detect_contacts  penalty segments: each tool against each segment's rest surface (a sheet: its
 //                    live field), which side it presses from (never pulled through a thin
 //                    segment), less the dent others left under it
@@ -15,8 +16,7 @@
 //                    pushes on sheets
 //   respond          proxy segments: the god-object moves its proxy and the spring gives the force;
 //                    penalty segments: F = k·x with damping and friction, the reaction on a dynamic
-//                    body, the push on a sheet; contacts reported, deformation fed; a rig's grasp
-//                    read off its pads' contacts with the ball
+//                    body, the push on a sheet; contacts reported, deformation fed
 //   fem_contacts     FEM bodies: the local contact model the FEM thread handed over, at the tool's
 //                    fresh position (series stiffness, damping floor, cap, push-only)
 //   integrate        dynamic bodies move under gravity and this step's forces (semi-implicit Euler,
@@ -24,8 +24,10 @@
 //   deform           deformable segments deflect under this step's contacts (eq. 1), the rest
 //                    recover; sheets take this step's pushes and the imprint of resting spheres
 //   safety           what leaves the world is finite: per-tool forces, then the device command
-//                    (finger channels and tip force; for the rig the master's joint and finger
-//                    torques through Jᵀ); zero for an unusable input
+//                    (finger channels and tip force; a controller writes its own: a master arm's
+//                    joint and finger torques through Jᵀ); zero for an unusable input
+//
+// After the stages the controller observes the step's result, read-only, for its own reports.
 #pragma once
 
 #include "hapsim/core/device_io.h"

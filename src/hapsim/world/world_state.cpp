@@ -15,33 +15,6 @@ namespace hapsim {
 
 namespace {
 
-std::vector<double> start_joints(const TeleopRigDescription& d) {
-  return d.slave_start_rad.empty() ? std::vector<double>(static_cast<std::size_t>(d.slave->dof()))
-                                   : d.slave_start_rad;
-}
-
-}  // namespace
-
-RigState::RigState(const TeleopRigDescription& rig)
-    : description(&rig),
-      slave_start_rad(start_joints(rig)),
-      slave(std::make_unique<SlaveFollower>(*rig.slave, slave_start_rad, rig.follower)),
-      frames(static_cast<std::size_t>(rig.slave->dof())),
-      slave_body_previous(rig.slave_bodies.size()) {}
-
-// haptic path
-void RigState::reset() noexcept {
-  slave->reset(slave_start_rad);
-  input_usable = false;
-  has_pad_previous = false;
-  held = false;
-  result = TeleopStepResult{};
-}
-
-RigState::~RigState() = default;
-
-namespace {
-
 // J = [I, −[r]×]: the velocity of the point r from a body's centre of mass.
 Eigen::Matrix<double, 3, 6> point_jacobian(const Vec3& r) {
   Mat3 r_cross;
@@ -132,46 +105,6 @@ void place_bodies(const WorldModel& model, std::vector<BodyState>& bodies) {
       body.v_world = d.bodies[b].rigid.v_world;
       body.w_world = d.bodies[b].rigid.w_world;
     }
-  }
-}
-
-// The slave's bodies that can hit something (links beyond the waist, palm, stem, pads) and the
-// bodies they cannot push back (static, deformable), for the place stage's slave collisions.
-void find_slave_collision_pairs(const WorldModel& model, RigState& rig) {
-  const TeleopRigDescription& d = *model.description().teleop;
-  const auto add_collider = [&](std::size_t b) {
-    const BodyModel& bm = model.bodies()[b];
-    const std::size_t first = bm.first_segment.index();
-    for (std::size_t flat = first; flat < first + bm.segment_count; ++flat) {
-      const SphereTree* tree = model.segments()[flat].body_tree.get();
-      if (tree == nullptr) {
-        continue;  // no body trees: the world has no dynamic body (cannot be a rig's)
-      }
-      rig.colliders.push_back({b, flat});
-    }
-  };
-  // The base and the link the first joint turns (the waist) stand on the robot's mount: only the
-  // links beyond, and the gripper, can hit something.
-  for (const TeleopRigDescription::SlaveBody& s : d.slave_bodies) {
-    if (s.frame >= 1 || s.frame == kToolFrame) {
-      add_collider(s.body);
-    }
-  }
-  for (const std::size_t pad : d.pad_body) {
-    add_collider(pad);
-  }
-  for (std::size_t flat = 0; flat < model.segments().size(); ++flat) {
-    const SegmentModel& seg = model.segments()[flat];
-    const BodyKind kind = model.bodies()[seg.body].kind;
-    if (kind != BodyKind::kStatic && kind != BodyKind::kDeformable) {
-      continue;
-    }
-    Box3 bounds_world;
-    const Box3& b = seg.rest_bounds_body;
-    for (int corner = 0; corner < 8; ++corner) {
-      bounds_world.extend(seg.X_world_body * b.corner(static_cast<Box3::CornerType>(corner)));
-    }
-    rig.obstacles.push_back({seg.body, flat, bounds_world});
   }
 }
 
@@ -282,16 +215,15 @@ WorldState::WorldState(const WorldModel& model) {
     fem_contacts.assign(tool_count * kMaxFemBodies, FemToolContact{});
     fem = std::make_unique<FemCoupling>(model);
   }
-  if (d.teleop) {
-    rig = std::make_unique<RigState>(*d.teleop);
-    find_slave_collision_pairs(model, *rig);
+  if (d.controller) {
+    controller = d.controller->make_state(model);
   }
   result.tools = tool_states;
   result.contacts = {contacts.data(), 0};
   result.body_contacts = {body_contacts.data(), 0};
   result.bodies = bodies;
   result.sheet_depth_m = sheet_depth_m;
-  result.teleop = rig ? &rig->result : nullptr;
+  result.controller = controller.get();
   model_ = &model;
 }
 
@@ -341,8 +273,8 @@ void WorldState::reset() {
   for (ToolState& state : tool_states) {
     state = ToolState{};
   }
-  if (rig) {
-    rig->reset();
+  if (controller) {
+    controller->reset();
   }
   contact_count = 0;
   result = StepResult{};
@@ -351,7 +283,7 @@ void WorldState::reset() {
   result.body_contacts = {body_contacts.data(), 0};
   result.bodies = bodies;
   result.sheet_depth_m = sheet_depth_m;
-  result.teleop = rig ? &rig->result : nullptr;
+  result.controller = controller.get();
 }
 
 }  // namespace hapsim

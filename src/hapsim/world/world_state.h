@@ -8,14 +8,10 @@
 #include "hapsim/core/types.h"
 #include "hapsim/deform/vertex_deflection.h"
 #include "hapsim/deform/virtual_sheet.h"
-#include "hapsim/dynamics/ball_environment.h"
-#include "hapsim/dynamics/parallel_gripper.h"
-#include "hapsim/dynamics/rigid_ball.h"
 #include "hapsim/force/contact_friction.h"
 #include "hapsim/force/contact_material.h"
 #include "hapsim/force/god_object.h"
 #include "hapsim/force/local_contact_model.h"
-#include "hapsim/kinematics/slave_follower.h"
 #include "hapsim/world/indices.h"
 #include "hapsim/world/world_description.h"
 #include "hapsim/world/world_model.h"
@@ -130,31 +126,6 @@ struct ToolState {
   bool present = true;
 };
 
-/// What a teleoperation rig did this step (world_description.h: TeleopRigDescription).
-struct TeleopStepResult {
-  double time_s = 0.0;
-  /// What the master's motors get (arm joint torques, finger torques as joints 3 and 4).
-  DeviceCommand command;
-  /// The master's arm joints (base, shoulder, elbow) and fingers, radians, and its hand pose in
-  /// its base frame: from the last usable input (held through an unusable one).
-  std::array<double, 3> master_arm_rad{};
-  std::array<double, 2> master_finger_rad{};
-  Iso3 master_hand = Iso3::Identity();
-  Iso3 slave_tool = Iso3::Identity();
-  SlaveStep slave;
-  GripperReport gripper;
-  BallContactReport ball_contacts;
-  Vec3 ball_p_world = Vec3::Zero();
-  bool held = false;
-  double sheet_depth_m = 0.0;
-  /// Place stage: pairs (slave body, static or deformable body) in contact this step — a link,
-  /// the palm, the stem or a pad more than RigState::kCollisionDepthM inside the floor, the sheet
-  /// or another body that cannot be pushed back: where the real robot would hit the table.
-  std::int32_t slave_collisions = 0;
-  /// Which bodies they were, a bit per body index (< 64): the slave's and the others.
-  std::uint64_t slave_collision_bodies = 0;
-};
-
 struct StepResult {
   double time_s = 0.0;
   std::span<const ToolState> tools;
@@ -175,8 +146,9 @@ struct StepResult {
   std::span<const double> sheet_depth_m;
   /// Body contacts found but not reported because the per-step buffer was full.
   std::int32_t dropped_body_contacts = 0;
-  /// The teleoperation rig's step, or null when the world has no rig.
-  const TeleopStepResult* teleop = nullptr;
+  /// The world's controller (WorldDescription::controller), which has observed this result, or
+  /// null when the world has none: its own reports are read through it (rig/rig_controller.h).
+  const ControllerState* controller = nullptr;
 };
 
 /// Which side of a penalty segment a tool is pressing from. A penalty contact's depth is measured
@@ -295,62 +267,6 @@ struct ToolRuntime {
   bool has_previous = false;
 };
 
-/// Per-step state of a teleoperation rig: the slave following the master and the gripper pads it
-/// carries (place stage), the grasp read off the pads' contacts with the ball (respond stage).
-/// The ball, the sheet, the pads and the floor are ordinary bodies of the world
-/// (TeleopRigDescription::ball_body …): their state is in WorldState::bodies and ::segments.
-struct RigState {
-  /// Throws hapsim::Error on unusable slave settings.
-  explicit RigState(const TeleopRigDescription& rig);
-  ~RigState();
-  RigState(const RigState&) = delete;
-  RigState& operator=(const RigState&) = delete;
-  /// Back to the start: slave at its start joints with the gripper open. haptic path (no
-  /// allocation: a reset asked for from the viewer runs on the haptic thread)
-  void reset() noexcept;
-
-  const TeleopRigDescription* description = nullptr;  ///< the model's; outlives this state
-  std::vector<double> slave_start_rad;                ///< the slave's start joints, dof() values
-
-  std::unique_ptr<SlaveFollower> slave;
-  /// Place stage: the master's input was usable (healthy, finite joints).
-  bool input_usable = false;
-  /// Place stage: the pads' centres last step (their velocity), world frame.
-  std::array<Vec3, 2> pad_previous_world{Vec3::Zero(), Vec3::Zero()};
-  Mat3 tool_previous_R = Mat3::Identity();
-  bool has_pad_previous = false;
-  /// Place stage: the slave's joint frames this step (dof(), sized at construction).
-  std::vector<Iso3> frames;
-  /// Place stage: each slave body's pose last step (TeleopRigDescription::slave_bodies order),
-  /// for its velocity.
-  std::vector<Iso3> slave_body_previous;
-
-  /// A slave collision is counted when a slave body's surface is deeper than this inside another
-  /// body (a graze is not a hit).
-  static constexpr double kCollisionDepthM = 1e-3;
-  /// What the place stage checks for slave collisions (built with the world state): the slave's
-  /// bodies (not its base and waist — the links on the base frame and joint 0's frame — which
-  /// stand on the robot's mount; their sphere trees are the body-contact stage's), and the bodies
-  /// they cannot push back (static and deformable) with their segments' world bounds (those
-  /// bodies never move).
-  struct Collider {
-    std::size_t body = 0;
-    std::size_t flat = 0;  ///< its segment
-  };
-  struct Obstacle {
-    std::size_t body = 0;
-    std::size_t flat = 0;
-    Box3 bounds_world;
-  };
-  std::vector<Collider> colliders;
-  std::vector<Obstacle> obstacles;
-
-  /// Respond stage: the grasp holds (both pads press the ball from opposite sides hard enough
-  /// that friction carries its weight). A report: the ball is held by friction, not attached.
-  bool held = false;
-  TeleopStepResult result;
-};
-
 struct WorldState {
   /// Sizes every buffer for `model` and builds the deformation state of deformable segments.
   /// Throws hapsim::Error naming the segment when its deformation cannot be built.
@@ -397,7 +313,8 @@ struct WorldState {
   std::size_t body_contact_count = 0;
   /// Deform stage: per sheet (in flat segment order), its deepest dent below rest.
   std::vector<double> sheet_depth_m;
-  std::unique_ptr<RigState> rig;  ///< when the world has a teleoperation rig
+  /// The description's controller's state (world_controller.h), or null.
+  std::unique_ptr<ControllerState> controller;
   /// Per (tool t, FEM body b): [t · kMaxFemBodies + b] (world/fem_coupling.h); empty without FEM
   /// bodies.
   std::vector<FemToolContact> fem_contacts;

@@ -121,9 +121,9 @@ const StepResult& step(const WorldModel& model, WorldState& state, const DeviceI
   r.sheet_depth_m = state.sheet_depth_m;
   r.dropped_body_contacts = state.dropped_body_contacts;
   r.penalty_pop_throughs = state.pop_throughs;
-  if (state.rig) {
-    state.rig->result.time_s = state.time_s;
-    r.teleop = &state.rig->result;
+  r.controller = state.controller.get();
+  if (state.controller) {
+    state.controller->observe(model, r);  // its reports: read-only, after the stages
   }
   return r;
 }

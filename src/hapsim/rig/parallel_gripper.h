@@ -7,7 +7,7 @@
 #pragma once
 
 #include "hapsim/core/types.h"
-#include "hapsim/dynamics/contact_spring.h"
+#include "hapsim/rig/contact_spring.h"
 
 #include <array>
 

@@ -1,4 +1,4 @@
-#include "hapsim/kinematics/slave_shapes.h"
+#include "hapsim/rig/slave_shapes.h"
 
 #include "hapsim/geometry/vertex_welding.h"
 

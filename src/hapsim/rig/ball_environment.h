@@ -4,7 +4,7 @@
 #pragma once
 
 #include "hapsim/core/types.h"
-#include "hapsim/dynamics/contact_spring.h"
+#include "hapsim/rig/contact_spring.h"
 
 namespace hapsim {
 

@@ -7,9 +7,9 @@
 #pragma once
 
 #include "hapsim/core/types.h"
-#include "hapsim/dynamics/parallel_gripper.h"
 #include "hapsim/geometry/triangle_mesh.h"
 #include "hapsim/kinematics/serial_chain.h"
+#include "hapsim/rig/parallel_gripper.h"
 
 #include <string>
 #include <vector>

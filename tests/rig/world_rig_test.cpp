@@ -2,6 +2,8 @@
 // sheet; reset() puts all three back where the description starts them, without allocating (a
 // viewer's reset runs on the haptic thread), and the run after it is the fresh run's to the bit; an
 // unusable master input holds the slave and sends no torque.
+#include "hapsim/rig/rig_controller.h"
+#include "hapsim/rig/rig_world.h"
 #include "hapsim/world/world.h"
 
 #include "hapsim/kinematics/procedural_motoman.h"
@@ -38,25 +40,26 @@ DeviceInput master(double base_rad) {
 
 TEST(WorldRig, BallFallsOnTheSheetAndResetPutsEverythingBack) {
   World world(rig());
-  ASSERT_NE(world.rig(), nullptr);
-  const Vec3 start = world.body_pose(world.description().teleop->ball_body).translation();
+  ASSERT_NE(rig_state(world), nullptr);
+  const Vec3 start = world.body_pose(rig_description(world.description())->ball_body).translation();
   const auto q0 =
-      std::vector<double>(world.rig()->slave->q().begin(), world.rig()->slave->q().end());
+      std::vector<double>(rig_state(world)->slave->q().begin(), rig_state(world)->slave->q().end());
   for (int k = 0; k < 1500; ++k) {
     const StepResult& r = world.step(master(0.2), 1e-3);
-    ASSERT_NE(r.teleop, nullptr);
-    ASSERT_TRUE(r.teleop->ball_p_world.allFinite());
+    ASSERT_NE(rig_result(r), nullptr);
+    ASSERT_TRUE(rig_result(r)->ball_p_world.allFinite());
   }
   // Fallen and resting on the dented sheet (sheet at z = 0.05, ball radius 0.03).
-  EXPECT_LT(world.body_pose(world.description().teleop->ball_body).translation().z(), 0.08 + 1e-3);
-  EXPECT_GT(world.sheet(world.description().teleop->sheet_body)->max_depth_m(), 0.0);
+  EXPECT_LT(world.body_pose(rig_description(world.description())->ball_body).translation().z(),
+            0.08 + 1e-3);
+  EXPECT_GT(world.sheet(rig_description(world.description())->sheet_body)->max_depth_m(), 0.0);
   EXPECT_NEAR(world.last_result().time_s, 1.5, 1e-9);
   world.reset();
-  EXPECT_EQ(world.body_pose(world.description().teleop->ball_body).translation(), start);
-  EXPECT_EQ(world.sheet(world.description().teleop->sheet_body)->max_depth_m(), 0.0);
-  const auto q = world.rig()->slave->q();
+  EXPECT_EQ(world.body_pose(rig_description(world.description())->ball_body).translation(), start);
+  EXPECT_EQ(world.sheet(rig_description(world.description())->sheet_body)->max_depth_m(), 0.0);
+  const auto q = rig_state(world)->slave->q();
   EXPECT_TRUE(std::equal(q.begin(), q.end(), q0.begin()));
-  EXPECT_EQ(world.last_result().teleop, &world.rig()->result);
+  EXPECT_EQ(rig_result(world.last_result()), &rig_state(world)->result);
 }
 
 TEST(WorldRig, ResetAllocatesNothingAndTheRunAfterItIsAFreshRun) {
@@ -72,9 +75,10 @@ TEST(WorldRig, ResetAllocatesNothingAndTheRunAfterItIsAFreshRun) {
     (void)world.step(master(0.3 - 2e-4 * k), 1e-3);
     (void)fresh.step(master(0.3 - 2e-4 * k), 1e-3);
   }
-  const std::size_t ball = world.description().teleop->ball_body;
+  const std::size_t ball = rig_description(world.description())->ball_body;
   EXPECT_EQ(world.body_pose(ball).matrix(), fresh.body_pose(ball).matrix());
-  EXPECT_EQ(world.rig()->slave->tip_pose().matrix(), fresh.rig()->slave->tip_pose().matrix());
+  EXPECT_EQ(rig_state(world)->slave->tip_pose().matrix(),
+            rig_state(fresh)->slave->tip_pose().matrix());
   EXPECT_EQ(world.last_result().command.joint_torque_nm,
             fresh.last_result().command.joint_torque_nm);
 }
@@ -84,12 +88,12 @@ TEST(WorldRig, UnusableMasterInputHoldsTheSlaveAndSendsNoTorque) {
   for (int k = 0; k < 50; ++k) {
     (void)world.step(master(0.2), 1e-3);
   }
-  const Iso3 tool = world.rig()->slave->tip_pose();
+  const Iso3 tool = rig_state(world)->slave->tip_pose();
   DeviceInput bad = master(std::numeric_limits<double>::quiet_NaN());
   const StepResult& r = world.step(bad, 1e-3);
   EXPECT_EQ(r.command.joint_count, 0);
   EXPECT_EQ(r.command.finger_count, 0);
-  EXPECT_TRUE(world.rig()->slave->tip_pose().isApprox(tool, 1e-12));
+  EXPECT_TRUE(rig_state(world)->slave->tip_pose().isApprox(tool, 1e-12));
   bad = master(0.2);
   bad.healthy = false;
   EXPECT_EQ(world.step(bad, 1e-3).command.joint_count, 0);

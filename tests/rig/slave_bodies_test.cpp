@@ -3,6 +3,8 @@
 // SerialChain::frames, and for boxes against the joint origins they join), they push the ball
 // (away from the link, equal and opposite), and one inside the floor is counted as a slave
 // collision.
+#include "hapsim/rig/rig_controller.h"
+#include "hapsim/rig/rig_world.h"
 #include "hapsim/world/world.h"
 
 #include "hapsim/kinematics/procedural_motoman.h"
@@ -64,8 +66,8 @@ std::size_t body_named(const World& world, const std::string& name) {
 
 TEST(SlaveBodies, ProceduralBoxLinksJoinTheJointOriginsAsTheArmMoves) {
   World world(rig_world(procedural_rig()));
-  const SerialChain& chain = world.rig()->slave->chain();
-  const auto& slave = world.description().teleop->slave_bodies;
+  const SerialChain& chain = rig_state(world)->slave->chain();
+  const auto& slave = rig_description(world.description())->slave_bodies;
   std::vector<Vec3> before(slave.size());
   for (int k = 0; k <= 400; ++k) {
     for (std::size_t l = 0; l < slave.size(); ++l) {
@@ -89,7 +91,7 @@ TEST(SlaveBodies, ProceduralBoxLinksJoinTheJointOriginsAsTheArmMoves) {
     }
     // Independent: the joint origins from the chain's own forward kinematics.
     std::array<Iso3, kMaxChainJoints> frames;
-    const Iso3 tool = chain.frames(world.rig()->slave->q(), frames);
+    const Iso3 tool = chain.frames(rig_state(world)->slave->q(), frames);
     std::vector<Vec3> origins{Vec3::Zero()};
     for (int j = 0; j < chain.dof(); ++j) {
       origins.push_back(frames[static_cast<std::size_t>(j)].translation());
@@ -108,7 +110,7 @@ TEST(SlaveBodies, ProceduralBoxLinksJoinTheJointOriginsAsTheArmMoves) {
           << "link box " << l << " at step " << k;
     }
     // The palm and the stem hang on the tool's axis, between the flange and the pads' tops.
-    const ParallelGripperParams& g = world.description().teleop->gripper;
+    const ParallelGripperParams& g = rig_description(world.description())->gripper;
     for (const std::size_t b : {slave[midpoints.size()].body, slave[midpoints.size() + 1].body}) {
       const Vec3 c_tool = tool.inverse() * centroid_world(world, b);
       EXPECT_LT(c_tool.head<2>().norm(), 1e-9);
@@ -127,7 +129,7 @@ TEST(SlaveBodies, Gp7LinkBodiesAreItsCollisionMeshesAtTheirChainFrames) {
   const SceneDescription scene =
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop_gp7.json", o);
   const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/true);
-  const SerialChain& chain = *setup.description.teleop->slave;
+  const SerialChain& chain = *rig_description(setup.description)->slave;
   ASSERT_FALSE(chain.link_geometry().empty());
   World world(setup.description);
   const Trajectory& t = setup.trajectory;
@@ -135,7 +137,7 @@ TEST(SlaveBodies, Gp7LinkBodiesAreItsCollisionMeshesAtTheirChainFrames) {
     static_cast<void>(world.step(t.sample_at(t.start_time_s() + k * 1e-3), 1e-3));
   }
   std::array<Iso3, kMaxChainJoints> frames;
-  static_cast<void>(chain.frames(world.rig()->slave->q(), frames));
+  static_cast<void>(chain.frames(rig_state(world)->slave->q(), frames));
   std::size_t links = 0;
   for (const ChainLinkGeometry& g : chain.link_geometry()) {
     if (g.mesh.empty()) {
@@ -150,7 +152,7 @@ TEST(SlaveBodies, Gp7LinkBodiesAreItsCollisionMeshesAtTheirChainFrames) {
               g.mesh.vertices.size())
         << g.link;
   }
-  EXPECT_EQ(world.description().teleop->slave_bodies.size(), links + 2);
+  EXPECT_EQ(rig_description(world.description())->slave_bodies.size(), links + 2);
 }
 
 TEST(SlaveBodies, ALinkSweptIntoTheRestingBallPushesItAway) {
@@ -167,11 +169,11 @@ TEST(SlaveBodies, ALinkSweptIntoTheRestingBallPushesItAway) {
     for (int k = 1; k <= 400; ++k) {
       static_cast<void>(dry.step(swing(k), 1e-3));
     }
-    meet = centroid_world(dry, dry.description().teleop->slave_bodies[3].body);
+    meet = centroid_world(dry, rig_description(dry.description())->slave_bodies[3].body);
   }
   d.ball_start_world = meet;
   World world(rig_world(d));
-  const std::size_t ball = world.description().teleop->ball_body;
+  const std::size_t ball = rig_description(world.description())->ball_body;
   BodyIndex link = kNoBody;  // the first body to touch the ball: one of the slave's links
   Vec3 link_velocity = Vec3::Zero();
   for (int k = 1; k <= 600; ++k) {
@@ -222,16 +224,17 @@ TEST(SlaveBodies, ALinkInsideTheFloorIsASlaveCollision) {
     d.ball_start_world = Vec3(0.5, -0.25, floor_z + 0.03);
     World world(rig_world(d));
     const StepResult& r = world.step(master(0.0), 1e-3);
-    const std::size_t floor = world.description().teleop->floor_body;
+    const std::size_t floor = rig_description(world.description())->floor_body;
     if (floor_z == 0.0) {
-      EXPECT_EQ(r.teleop->slave_collisions, 0);
-      EXPECT_EQ(r.teleop->slave_collision_bodies, 0U);
+      EXPECT_EQ(rig_result(r)->slave_collisions, 0);
+      EXPECT_EQ(rig_result(r)->slave_collision_bodies, 0U);
     } else {
-      EXPECT_GT(r.teleop->slave_collisions, 0);
-      EXPECT_TRUE((r.teleop->slave_collision_bodies >> floor) & 1U);
-      for (const TeleopRigDescription::SlaveBody& s : world.description().teleop->slave_bodies) {
+      EXPECT_GT(rig_result(r)->slave_collisions, 0);
+      EXPECT_TRUE((rig_result(r)->slave_collision_bodies >> floor) & 1U);
+      for (const TeleopRigDescription::SlaveBody& s :
+           rig_description(world.description())->slave_bodies) {
         if (s.frame < 1 && s.frame != kToolFrame) {
-          EXPECT_FALSE((r.teleop->slave_collision_bodies >> s.body) & 1U);
+          EXPECT_FALSE((rig_result(r)->slave_collision_bodies >> s.body) & 1U);
         }
       }
     }
@@ -253,7 +256,7 @@ TEST(SlaveBodies, TheBallPressingThePalmIsFeltAtTheMaster) {
       for (int k = 0; k < 2; ++k) {
         static_cast<void>(dry.step(input, 1e-3));
       }
-      tool = dry.rig()->result.slave_tool;
+      tool = rig_state(dry)->result.slave_tool;
     }
     const ParallelGripperParams& g = d.gripper;
     // 2 mm into the palm, whose underside is the pads' top.
@@ -289,13 +292,13 @@ TEST(SlaveBodies, ShippedPickAndPlaceHoldsTheBallWithThePadsAlone) {
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
   const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, true);
   World world(setup.description);
-  const TeleopRigDescription& rig = *world.description().teleop;
+  const TeleopRigDescription& rig = *rig_description(world.description());
   const Trajectory& t = setup.trajectory;
   const auto steps = static_cast<int>((t.end_time_s() - t.start_time_s()) / 1e-3);
   int pad_steps = 0;
   for (int k = 1; k <= steps; ++k) {
     const StepResult& r = world.step(t.sample_at(t.start_time_s() + k * 1e-3), 1e-3);
-    ASSERT_EQ(r.teleop->slave_collisions, 0) << "at " << r.time_s << " s";
+    ASSERT_EQ(rig_result(r)->slave_collisions, 0) << "at " << r.time_s << " s";
     for (const BodyContact& c : r.body_contacts) {
       const std::size_t other = c.other_body.index();
       const bool pad = other == rig.pad_body[0] || other == rig.pad_body[1];

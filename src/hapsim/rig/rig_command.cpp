@@ -1,0 +1,76 @@
+// The rig's command (rig_controller.h): the pads' reaction at the slave's tool back to the
+// master's joints through its Jᵀ, the grasp to its fingers.
+#include "hapsim/rig/rig_controller.h"
+#include "hapsim/world/world_model.h"
+#include "hapsim/world/world_state.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace hapsim {
+
+namespace {
+
+// The pads' squeeze on the ball, read off their contacts with it (body-contact stage): each pad's
+// normal force and what the pads push on the ball together. What the master's fingers feel.
+// haptic path
+void pad_forces(const TeleopRigDescription& d, const WorldState& state, GripperReport& g) noexcept {
+  g.pad_force_n = {0.0, 0.0};
+  g.force_on_ball_world_n.setZero();
+  for (std::size_t k = 0; k < state.body_contact_count; ++k) {
+    const BodyContact& c = state.body_contacts[k];
+    for (std::size_t i = 0; i < 2; ++i) {
+      if (c.body == BodyIndex{d.ball_body} && c.other_body == BodyIndex{d.pad_body[i]}) {
+        g.pad_force_n[i] = std::max(0.0, c.force_world_n.dot(c.normal_world));
+        g.force_on_ball_world_n += c.force_world_n;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+// The rig's forces back to the master: the reaction at the slave's tool (the pads', and the
+// palm's and stem's when the ball presses them: the gripper's parts past the wrist), scaled into
+// the master's frame and turned into joint torques through the master's Jᵀ; the grasp force on
+// both fingers. The links' contacts are not felt: they are the arm's, not the hand's.
+// haptic path
+void RigState::command(const WorldModel& /*model*/, const WorldState& state,
+                       DeviceCommand& command) noexcept {
+  RigState& rig = *this;
+  TeleopStepResult& r = rig.result;
+  pad_forces(*description, state, r.gripper);
+  r.command = DeviceCommand{};
+  command = r.command;  // the master has no probe tools: the rig's command is all it gets
+  if (!rig.input_usable) {
+    return;
+  }
+  const TeleopRigDescription& d = *description;
+  // What the ball pushes on the pads (held by friction: its weight and whatever the sheet or
+  // the floor push on it, carried through the grasp).
+  Vec3 at_tool = -r.gripper.force_on_ball_world_n;
+  for (const TeleopRigDescription::SlaveBody& s : d.slave_bodies) {
+    if (s.frame == kToolFrame) {
+      at_tool += state.bodies[s.body].force_world_n;
+    }
+  }
+  const Vec3 at_master = d.mapping.X_slave_master.linear().transpose() * at_tool * d.force_scale;
+  const MasterTorques t =
+      controller->master().torques(r.master_arm_rad, at_master, r.gripper.grasp_force_n());
+  for (std::size_t i = 0; i < 3; ++i) {
+    r.command.joint_torque_nm[i] = t.arm_n_m[i];
+  }
+  r.command.joint_torque_nm[3] = t.fingers_n_m[0];
+  r.command.joint_torque_nm[4] = t.fingers_n_m[1];
+  r.command.joint_count = 5;
+  const double grasp = r.gripper.grasp_force_n();
+  r.command.finger_force_n[0] = std::isfinite(grasp) ? grasp : 0.0;
+  r.command.finger_force_n[1] = r.command.finger_force_n[0];
+  r.command.finger_count = 2;
+  for (double& torque : r.command.joint_torque_nm) {
+    torque = std::isfinite(torque) ? torque : 0.0;
+  }
+  command = r.command;
+}
+
+}  // namespace hapsim
