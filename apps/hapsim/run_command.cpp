@@ -428,12 +428,22 @@ void run(const RunArgs& args) {
   const bool teleop = rig_state(*world) != nullptr;
   if (teleop) {
     const RigState& rig = *rig_state(*world);
-    std::printf(
-        "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
-        "sheet %dx%d\n",
-        scene.file.string().c_str(), setup.slave_name.c_str(), rig.slave->chain().dof(),
-        scene.teleop.ball_mass_kg * 1e3, scene.teleop.ball_radius_m * 1e3,
-        scene.teleop.sheet_nodes_per_side, scene.teleop.sheet_nodes_per_side);
+    if (rig.description->ball_body == TeleopRigDescription::kNoBody) {
+      const std::size_t tool = rig.description->carried_tool;
+      std::printf(
+          "scene        %s: teleoperation, slave %s (%d joints) carrying tool '%s', %zu "
+          "bodies of the scene\n",
+          scene.file.string().c_str(), setup.slave_name.c_str(), rig.slave->chain().dof(),
+          tool < scene.world.tools.size() ? scene.world.tools[tool].name.c_str() : "none",
+          scene.world.bodies.size());
+    } else {
+      std::printf(
+          "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
+          "sheet %dx%d\n",
+          scene.file.string().c_str(), setup.slave_name.c_str(), rig.slave->chain().dof(),
+          scene.teleop.ball_mass_kg * 1e3, scene.teleop.ball_radius_m * 1e3,
+          scene.teleop.sheet_nodes_per_side, scene.teleop.sheet_nodes_per_side);
+    }
   } else {
     std::size_t vertices = 0;
     std::size_t segments = 0;

@@ -627,6 +627,47 @@ TEST_F(SceneFileTest, TeleopScenesNameTheirMistakes) {
   EXPECT_TRUE(s.world.bodies.empty());
 }
 
+// A "rig" beside the bodies and tools: it names what it drives and reads, and each name must be
+// one of the scene's of the right kind.
+TEST_F(SceneFileTest, RigScenesNameTheirMistakes) {
+  Json rig = base();
+  rig["rig"] = Json::parse(R"({ "slave": { "model": "procedural" }, "carries_tool": "tip" })");
+  const Mutation cases[] = {
+      {"unknown key", [](Json& j) { j["rig"]["ball_m"] = 1; }, "/rig/ball_m",
+       "unknown key 'ball_m'"},
+      {"no such tool", [](Json& j) { j["rig"]["carries_tool"] = "probe"; }, "/rig/carries_tool",
+       "no tool named 'probe'"},
+      {"no such body", [](Json& j) { j["rig"]["ball"] = "marble"; }, "/rig/ball",
+       "no body named 'marble'"},
+      {"a ball that is not dynamic", [](Json& j) { j["rig"]["ball"] = "block"; }, "/rig/ball",
+       "must be dynamic"},
+      {"a floor that is not static", [](Json& j) { j["rig"]["floor"] = "ball"; }, "/rig/floor",
+       "must be static"},
+      {"zero scale",
+       [](Json& j) {
+         j["rig"]["mapping"] = {{"scale", 0}};
+       },
+       "/rig/mapping/scale", "expected a number > 0"},
+      {"the teleop dialect's ball",
+       [](Json& j) {
+         j["rig"]["ball"] = {{"mass_kg", 0.1}};
+       },
+       "/rig/ball", "a body name"},
+  };
+  for (const Mutation& c : cases) {
+    SCOPED_TRACE(c.name);
+    Json scene = rig;
+    c.change(scene);
+    expect_error(scene, c.where, c.fragment);
+  }
+  const SceneDescription s = load_scene(write("rig.json", rig.dump()));
+  EXPECT_TRUE(s.has_rig);
+  EXPECT_FALSE(s.is_teleop);
+  EXPECT_EQ(s.teleop.carried_tool, "tip");
+  EXPECT_TRUE(s.teleop.ball_body.empty());
+  EXPECT_EQ(s.world.bodies.size(), 2U);  // the scene's own; the run adds the rig's
+}
+
 TEST_F(SceneFileTest, GloveScenesNameTheirMistakes) {
   Json glove = base();
   glove["tools"] = {{{"name", "index"}, {"finger", 1}}, {{"name", "middle"}, {"finger", 2}}};

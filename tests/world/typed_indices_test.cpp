@@ -41,7 +41,8 @@ static_assert(std::is_trivially_copyable_v<ToolIndex> && std::is_trivially_copya
 static_assert(sizeof(WorldContact) == 88);
 static_assert(sizeof(BodyContact) == 96);
 static_assert(sizeof(PenaltyCandidate) == 96);
-static_assert(sizeof(CycleRecord) == 8048);
+static_assert(sizeof(CycleRecord) ==
+              8176);  // 8048 before the rig reported its tool force and slave torques
 
 // The sentinels keep their −1.
 static_assert(kNoSegment.value == -1 && !kNoSegment.valid());

@@ -17,6 +17,9 @@ namespace {
 void pad_forces(const TeleopRigDescription& d, const WorldState& state, GripperReport& g) noexcept {
   g.pad_force_n = {0.0, 0.0};
   g.force_on_ball_world_n.setZero();
+  if (d.ball_body == TeleopRigDescription::kNoBody) {
+    return;
+  }
   for (std::size_t k = 0; k < state.body_contact_count; ++k) {
     const BodyContact& c = state.body_contacts[k];
     for (std::size_t i = 0; i < 2; ++i) {
@@ -30,10 +33,26 @@ void pad_forces(const TeleopRigDescription& d, const WorldState& state, GripperR
 
 }  // namespace
 
+// What the slave's joints hold against the carried tool's force F at its centre: the wrench
+// [F; (p_tool − p_flange) × F] at the flange through the slave's Jᵀ. haptic path
+void slave_joint_torques(const RigState& rig, const Vec3& p_tool_world, const Vec3& force_world_n,
+                         TeleopStepResult& r) noexcept {
+  r.slave_joint_torque_nm.fill(0.0);
+  const ChainJacobian J = rig.slave->chain().jacobian(rig.slave->q());
+  Eigen::Matrix<double, 6, 1> wrench;
+  wrench.head<3>() = force_world_n;
+  wrench.tail<3>() = (p_tool_world - r.slave_tool.translation()).cross(force_world_n);
+  const ChainVector tau = J.transpose() * wrench;
+  for (Eigen::Index i = 0; i < tau.size(); ++i) {
+    r.slave_joint_torque_nm[static_cast<std::size_t>(i)] = tau(i);
+  }
+}
+
 // The rig's forces back to the master: the reaction at the slave's tool (the pads', and the
-// palm's and stem's when the ball presses them: the gripper's parts past the wrist), scaled into
-// the master's frame and turned into joint torques through the master's Jᵀ; the grasp force on
-// both fingers. The links' contacts are not felt: they are the arm's, not the hand's.
+// palm's and stem's when the ball presses them: the gripper's parts past the wrist; the carried
+// tool's contact force), scaled into the master's frame and turned into joint torques through the
+// master's Jᵀ; the grasp force on both fingers. The links' contacts are not felt: they are the
+// arm's, not the hand's.
 // haptic path
 void RigState::command(const WorldModel& /*model*/, const WorldState& state,
                        DeviceCommand& command) noexcept {
@@ -54,6 +73,12 @@ void RigState::command(const WorldModel& /*model*/, const WorldState& state,
       at_tool += state.bodies[s.body].force_world_n;
     }
   }
+  if (d.carried_tool != TeleopRigDescription::kNoTool) {
+    const ToolState& tool = state.tool_states[d.carried_tool];
+    at_tool += tool.force_world_n;
+    slave_joint_torques(rig, tool.p_world, tool.force_world_n, r);
+  }
+  r.tool_force_world_n = at_tool;
   const Vec3 at_master = d.mapping.X_slave_master.linear().transpose() * at_tool * d.force_scale;
   const MasterTorques t =
       controller->master().torques(r.master_arm_rad, at_master, r.gripper.grasp_force_n());

@@ -37,16 +37,21 @@ void check_rig(const TeleopRigDescription& d) {
   }
 }
 
-// The rig's bodies are where rig_world() put them, of the kinds the rig's stages expect.
+// The rig's bodies are where rig_world() or add_rig() put them, of the kinds the rig expects; its
+// carried tool is device 0's probe.
 void check_rig_bodies(const WorldDescription& w, const TeleopRigDescription& d) {
+  constexpr std::size_t kNone = TeleopRigDescription::kNoBody;
   const auto is = [&](std::size_t b, BodyKind kind) {
     return b < w.bodies.size() && w.bodies[b].kind == kind;
   };
-  if (!is(d.ball_body, BodyKind::kDynamic) || !w.bodies[d.ball_body].segments.front().sphere ||
-      !is(d.sheet_body, BodyKind::kDeformable) ||
-      w.bodies[d.sheet_body].deformation != BodyDeformation::kGaussianSheet ||
-      !is(d.pad_body[0], BodyKind::kKinematic) || !is(d.pad_body[1], BodyKind::kKinematic) ||
-      (d.floor_body != TeleopRigDescription::kNoBody && !is(d.floor_body, BodyKind::kStatic)) ||
+  const bool ball_ok = d.ball_body == kNone || (is(d.ball_body, BodyKind::kDynamic) &&
+                                                w.bodies[d.ball_body].segments.front().sphere);
+  const bool sheet_ok = d.sheet_body == kNone ||
+                        (is(d.sheet_body, BodyKind::kDeformable) &&
+                         w.bodies[d.sheet_body].deformation == BodyDeformation::kGaussianSheet);
+  if (!ball_ok || !sheet_ok || !is(d.pad_body[0], BodyKind::kKinematic) ||
+      !is(d.pad_body[1], BodyKind::kKinematic) ||
+      (d.floor_body != kNone && !is(d.floor_body, BodyKind::kStatic)) ||
       std::any_of(d.slave_bodies.begin(), d.slave_bodies.end(),
                   [&](const TeleopRigDescription::SlaveBody& s) {
                     return !is(s.body, BodyKind::kKinematic) ||
@@ -54,7 +59,14 @@ void check_rig_bodies(const WorldDescription& w, const TeleopRigDescription& d) 
                   })) {
     throw Error("teleop",
                 "the rig's ball, sheet, pads, floor and slave links must be bodies of the world "
-                "(build the world with rig_world())");
+                "(build the world with rig_world() or add_rig())");
+  }
+  if (d.carried_tool != TeleopRigDescription::kNoTool &&
+      (d.carried_tool >= w.tools.size() || w.tools[d.carried_tool].device != 0 ||
+       w.tools[d.carried_tool].finger >= 0 || w.has_hand)) {
+    throw Error("teleop",
+                "the tool the slave carries must be one of the world's tools, on "
+                "device 0, with no finger, in a world without a glove hand");
   }
 }
 
@@ -63,8 +75,12 @@ std::vector<double> start_joints(const TeleopRigDescription& d) {
                                    : d.slave_start_rad;
 }
 
-// The rig's sheet among the world's sheets, in flat segment order (StepResult::sheet_depth_m).
+// The rig's sheet among the world's sheets, in flat segment order (StepResult::sheet_depth_m);
+// 0 without one.
 std::size_t sheet_index_of(const WorldModel& model, std::size_t sheet_body) {
+  if (sheet_body == TeleopRigDescription::kNoBody) {
+    return 0;
+  }
   const std::size_t flat = model.flat_segment(BodyIndex{sheet_body}, LocalSegment{0}).index();
   const std::vector<SegmentModel>& segs = model.segments();
   return static_cast<std::size_t>(std::count_if(segs.begin(),

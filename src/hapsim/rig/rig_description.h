@@ -22,9 +22,10 @@ namespace hapsim {
 
 /// A teleoperation rig (paper 000): a 5-DOF master arm (the device: joint_rad[0..2] arm,
 /// finger_rad[0..1] grasp) drives a slave robot with a parallel gripper through IK; the gripper
-/// picks a rigid ball, which rests on a virtual sheet (or the floor) and imprints it. Forces come
-/// back to the master as joint torques (the pads' reaction at the slave's tool, scaled, through
-/// Jᵀ) and finger torques (the grasp force).
+/// picks a rigid ball, which rests on a virtual sheet (or the floor) and imprints it, or carries a
+/// probe tool that palpates tissue. Forces come back to the master as joint torques (the pads' and
+/// the probe's reaction at the slave's tool, scaled, through Jᵀ) and finger torques (the grasp
+/// force). The ball, the sheet and the floor are optional (kNoBody): a rig may only palpate.
 struct TeleopRigDescription {
   MasterArmGeometry master;
   /// The slave arm (procedural Motoman or the GP7 URDF) and its start joints (dof() values;
@@ -40,8 +41,9 @@ struct TeleopRigDescription {
   BallEnvironmentOptions environment;
   /// How the contact force at the slave's tool is scaled back onto the master's hand.
   double force_scale = 1.0;
-  /// The rig's bodies in WorldDescription::bodies (rig_world() adds them): the ball (dynamic),
-  /// the sheet, the two gripper pads (kinematic; 0: the +y side), the floor (or kNoBody).
+  /// The rig's bodies in WorldDescription::bodies (rig_world() and add_rig() add the pads): the
+  /// ball (dynamic), the sheet, the floor (each or kNoBody), the two gripper pads (kinematic; 0:
+  /// the +y side).
   static constexpr std::size_t kNoBody = static_cast<std::size_t>(-1);
   std::size_t ball_body = kNoBody;
   std::size_t sheet_body = kNoBody;
@@ -57,6 +59,12 @@ struct TeleopRigDescription {
   };
   /// The links in chain order, then the palm and stem (rig_world() adds them).
   std::vector<SlaveBody> slave_bodies;
+  /// A tool of the world the slave carries instead of the hand (a probe at its gripper: the
+  /// tele-palpation scene), or kNoTool. It is placed at the slave's tool (flange) frame, its own
+  /// offset (ToolDescription::offset_device) in that frame; its contact force is felt at the
+  /// master's hand like the pads'. Device 0's, with no finger.
+  static constexpr std::size_t kNoTool = static_cast<std::size_t>(-1);
+  std::size_t carried_tool = kNoTool;
 };
 
 }  // namespace hapsim

@@ -22,9 +22,11 @@ void place_pads(const TeleopRigDescription& d, RigState& rig, WorldState& state,
   const ParallelGripperParams& g = d.gripper;
   const Iso3& X_world_tool = rig.result.slave_tool;
   const Iso3 X_tool_world = X_world_tool.inverse();
-  const Vec3 c = X_tool_world * state.bodies[d.ball_body].X_world_body.translation();
   const Vec3& half = g.pad_half_m;
   double width = std::max(rig.slave->gripper_width_m(), 0.0);
+  const Vec3 c = d.ball_body != TeleopRigDescription::kNoBody
+                     ? Vec3(X_tool_world * state.bodies[d.ball_body].X_world_body.translation())
+                     : Vec3::Constant(kInf);
   if (std::abs(c.x()) <= half.x() && std::abs(c.z() - g.pad_depth_m) <= half.z()) {
     const double pen_max = g.max_force_n / g.pad_contact.stiffness_n_per_m;
     width = std::max(width, 2.0 * (d.ball.radius_m - pen_max + std::abs(c.y())));
@@ -98,7 +100,7 @@ void place_slave_bodies(const TeleopRigDescription& d, RigState& rig, WorldState
 
 // haptic path
 void RigState::place(const WorldModel& model, WorldState& state, const DeviceInput& input,
-                     DeviceInput& /*tool_input*/, double dt_s) noexcept {
+                     DeviceInput& tool_input, double dt_s) noexcept {
   RigState& rig = *this;
   const TeleopRigDescription& d = *description;
   TeleopStepResult& r = rig.result;
@@ -125,6 +127,13 @@ void RigState::place(const WorldModel& model, WorldState& state, const DeviceInp
   place_slave_bodies(d, rig, state, dt_s);
   place_pads(d, rig, state, dt_s);
   count_slave_collisions(model, rig, state);
+  if (d.carried_tool != TeleopRigDescription::kNoTool) {
+    // The carried tool follows the slave's flange, not the master's hand: its input is the
+    // flange's pose (the tool's own offset is in that frame), usable when the master's is.
+    tool_input.p_world = r.slave_tool.translation();
+    tool_input.q_world = Quat(r.slave_tool.linear());
+    tool_input.healthy = rig.input_usable;
+  }
 }
 
 }  // namespace hapsim

@@ -71,11 +71,15 @@ void observe_ball(const TeleopRigDescription& d, const StepResult& step,
 void RigState::observe(const WorldModel& model, const StepResult& step) noexcept {
   const TeleopRigDescription& d = *description;
   result.time_s = step.time_s;
-  observe_grasp(d, model, step, held, result.gripper);
-  observe_ball(d, step, result);
+  if (d.ball_body != TeleopRigDescription::kNoBody) {
+    observe_grasp(d, model, step, held, result.gripper);
+    observe_ball(d, step, result);
+  }
   result.held = result.gripper.held;
   result.sheet_depth_m =
-      sheet_index < step.sheet_depth_m.size() ? step.sheet_depth_m[sheet_index] : 0.0;
+      d.sheet_body != TeleopRigDescription::kNoBody && sheet_index < step.sheet_depth_m.size()
+          ? step.sheet_depth_m[sheet_index]
+          : 0.0;
 }
 
 }  // namespace hapsim

@@ -4,6 +4,7 @@
 
 #include "hapsim/core/device_io.h"
 #include "hapsim/core/types.h"
+#include "hapsim/kinematics/serial_chain.h"
 #include "hapsim/kinematics/slave_follower.h"
 #include "hapsim/rig/ball_environment.h"
 #include "hapsim/rig/parallel_gripper.h"
@@ -36,6 +37,12 @@ struct TeleopStepResult {
   std::int32_t slave_collisions = 0;
   /// Which bodies they were, a bit per body index (< 64): the slave's and the others.
   std::uint64_t slave_collision_bodies = 0;
+  /// The force on the slave's tool this step, world frame: the pads' and the gripper's reaction
+  /// and the carried tool's contact force (what the master's hand feels, before the scale).
+  Vec3 tool_force_world_n = Vec3::Zero();
+  /// What the slave's joints hold against it: τ = J_slaveᵀ·[F; (p_tool − p_flange) × F] with the
+  /// carried tool's force F at its centre, N·m (slave dof() entries; the rest 0).
+  std::array<double, static_cast<std::size_t>(kMaxChainJoints)> slave_joint_torque_nm{};
 };
 
 }  // namespace hapsim

@@ -16,4 +16,11 @@ namespace hapsim {
 /// Throws hapsim::Error (RigController's) on a rig it cannot drive.
 [[nodiscard]] WorldDescription rig_world(TeleopRigDescription rig, std::string name = "teleop");
 
+/// A rig added to an existing world (a scene's `"rig"`, docs/scene-format.md): its gripper pads
+/// and the slave's links, palm and stem appended as kinematic bodies (materials "slave_pad" and
+/// "slave_link" appended), the rig as the world's controller. The rig's ball, sheet, floor and
+/// carried tool are indices into `world` (or none). Throws hapsim::Error on a rig it cannot drive
+/// or a material name taken.
+[[nodiscard]] WorldDescription add_rig(WorldDescription world, TeleopRigDescription rig);
+
 }  // namespace hapsim

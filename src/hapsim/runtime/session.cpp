@@ -134,7 +134,13 @@ class SessionAccountant {
     }
     if (rig_state(world) != nullptr) {
       summary_.teleop.emplace();
-      ball_start_z_ = world.body_pose(rig_description(desc)->ball_body).translation().z();
+      const TeleopRigDescription& rig = *rig_description(desc);
+      summary_.teleop->has_ball = rig.ball_body != TeleopRigDescription::kNoBody;
+      summary_.teleop->has_sheet = rig.sheet_body != TeleopRigDescription::kNoBody;
+      carried_tool_ = rig.carried_tool;
+      if (summary_.teleop->has_ball) {
+        ball_start_z_ = world.body_pose(rig.ball_body).translation().z();
+      }
     }
     // A served world runs until stopped: reserve a run of up to an hour, grow beyond.
     cost_us_.reserve(std::min<std::size_t>(steps, 3'600'000));
@@ -172,7 +178,11 @@ class SessionAccountant {
       const ToolState& tool = r.tools[t];
       ToolSummary& ts = summary_.tools[t];
       const bool own = desc.tools[t].device == 0;
-      const double f = tool_rendered_force_n(desc.tools[t], tool, out, tip_scale);
+      // A tool a robot carries reaches the hand through the master's joints, not as a tip force:
+      // its own contact force is what it renders (before the master's scale).
+      const double f = t == carried_tool_
+                           ? tool.force_world_n.norm()
+                           : tool_rendered_force_n(desc.tools[t], tool, out, tip_scale);
       ts.peak_force_n = std::max(ts.peak_force_n, f);
       if (tool.contact_count > 0) {
         ++ts.contact_steps;
@@ -273,6 +283,24 @@ class SessionAccountant {
     if (r.gripper.released_now && t.grasped && t.release_time_s < 0.0) {
       t.release_time_s = r.time_s;
     }
+    t.peak_tool_force_n = std::max(t.peak_tool_force_n, r.tool_force_world_n.norm());
+    for (std::size_t j = 0; j < 3; ++j) {
+      t.peak_master_torque_nm =
+          std::max(t.peak_master_torque_nm, std::abs(r.command.joint_torque_nm[j]));
+    }
+    if (!t.has_ball) {
+      t.max_slave_tracking_error_m =
+          std::max(t.max_slave_tracking_error_m, r.slave.position_error_m);
+      if (r.slave_collisions > 0) {
+        ++t.slave_collision_steps;
+        t.slave_collisions += static_cast<std::size_t>(r.slave_collisions);
+        if (t.first_slave_collision_s < 0.0) {
+          t.first_slave_collision_s = r.time_s;
+        }
+        slave_collision_bodies_ |= r.slave_collision_bodies;
+      }
+      return;
+    }
     t.ball_lift_m = std::max(t.ball_lift_m, r.ball_p_world.z() - ball_start_z_);
     t.peak_grasp_force_n = std::max(t.peak_grasp_force_n, r.gripper.grasp_force_n());
     t.max_sheet_deflection_m = std::max(t.max_sheet_deflection_m, r.sheet_depth_m);
@@ -330,8 +358,10 @@ class SessionAccountant {
     }
     if (summary_.teleop) {
       TeleopSummary& t = *summary_.teleop;
-      t.ball_final_world = world_.body_pose(rig_description(desc)->ball_body).translation();
-      if (options_.teleop_target_world) {
+      if (t.has_ball) {
+        t.ball_final_world = world_.body_pose(rig_description(desc)->ball_body).translation();
+      }
+      if (t.has_ball && options_.teleop_target_world) {
         t.target_error_m = (t.ball_final_world - *options_.teleop_target_world).norm();
       }
       for (std::size_t b = 0; b < std::min<std::size_t>(desc.bodies.size(), 64); ++b) {
@@ -365,7 +395,8 @@ class SessionAccountant {
   // Per-segment touch flags of one step, so a tool-step counts once per segment.
   std::vector<std::uint8_t> touched_;
   double ball_start_z_ = 0.0;
-  std::vector<std::size_t> dynamic_bodies_;  // body index of each BodySummary
+  std::size_t carried_tool_ = TeleopRigDescription::kNoTool;  // the tool a rig carries
+  std::vector<std::size_t> dynamic_bodies_;                   // body index of each BodySummary
   std::array<std::uint64_t, kMaxCycleDynamicBodies> last_touching_{};
 };
 
@@ -692,7 +723,16 @@ std::string format_session_summary(const SessionSummary& s) {
                   t.name.c_str(), t.peak_force_n, t.mean_force_n, t.contact_steps);
     out << line;
   }
-  if (s.teleop) {
+  if (s.teleop && !s.teleop->has_ball) {
+    const TeleopSummary& t = *s.teleop;
+    std::snprintf(
+        line, sizeof line,
+        "slave tool   peak force %.3f N (what the master's hand feels, before the scale); "
+        "master peak joint torque %.3f N m\nslave        largest tip error while "
+        "tracking %.3f mm\n",
+        t.peak_tool_force_n, t.peak_master_torque_nm, t.max_slave_tracking_error_m * 1e3);
+    out << line;
+  } else if (s.teleop) {
     const TeleopSummary& t = *s.teleop;
     if (t.grasped) {
       std::snprintf(

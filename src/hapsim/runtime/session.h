@@ -125,6 +125,10 @@ struct RealtimeSummary {
 
 /// What a teleoperation rig did over the run (the pick-and-place of paper 000).
 struct TeleopSummary {
+  /// The rig picks a ball (the pick-and-place scenes); without one (tele-palpation) the grasp and
+  /// ball figures stay at their defaults.
+  bool has_ball = false;
+  bool has_sheet = false;
   bool grasped = false;
   double grasp_time_s = -1.0;    ///< first grasp (-1: never)
   double release_time_s = -1.0;  ///< first release after it (-1: never)
@@ -140,6 +144,10 @@ struct TeleopSummary {
   double first_slave_collision_s = -1.0;
   std::vector<std::string> slave_collision_bodies;
   Vec3 ball_final_world = Vec3::Zero();
+  /// The largest force at the slave's tool (TeleopStepResult::tool_force_world_n) and the largest
+  /// joint torque the master's arm motors were asked for, over the run.
+  double peak_tool_force_n = 0.0;
+  double peak_master_torque_nm = 0.0;
   /// With SessionOptions::teleop_target_world: the ball's final distance from it.
   std::optional<double> target_error_m;
   /// Grasped, released, the ball finite and (with a target) within 5 mm of it.

@@ -181,6 +181,8 @@ nlohmann::json run_summary_json(const RunSetup& setup, const SessionSummary& sum
     j["peak_grasp_force_n"] = t.peak_grasp_force_n;
     j["max_sheet_deflection_m"] = t.max_sheet_deflection_m;
     j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
+    j["peak_tool_force_n"] = t.peak_tool_force_n;
+    j["peak_master_torque_nm"] = t.peak_master_torque_nm;
     j["slave_collisions"] = {
         {"steps", t.slave_collision_steps},
         {"pairs", t.slave_collisions},

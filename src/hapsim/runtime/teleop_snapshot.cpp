@@ -29,7 +29,9 @@ void fill_teleop_snapshot(TeleopSnapshot& s, const World& world) noexcept {
   s.pad_force_n = r.gripper.pad_force_n;
   s.grasp_force_n = r.gripper.grasp_force_n();
   s.held = r.held;
-  s.sheet_depth_m = world.sheet(rig_description(world.description())->sheet_body)->max_depth_m();
+  const std::size_t sheet = rig.description->sheet_body;
+  s.sheet_depth_m =
+      sheet != TeleopRigDescription::kNoBody ? world.sheet(sheet)->max_depth_m() : 0.0;
   s.master_joint_rad = r.master_arm_rad;
   s.master_finger_rad = r.master_finger_rad;
   s.X_master_hand = rig_controller(world.description())->master().hand_pose(r.master_arm_rad);

@@ -63,6 +63,14 @@ struct TeleopSceneDescription {
   double sheet_size_m = 0.2;
   Vec3 sheet_position_m = Vec3(0.5, 0.25, 0.05);
   double floor_z_m = 0.0;
+  /// A "rig" section (SceneDescription::has_rig): the scene's bodies it reads (empty: none) and
+  /// the tool the slave carries (empty: none), by name; how the force at the slave's tool is
+  /// scaled onto the master's hand.
+  std::string ball_body;
+  std::string sheet_body;
+  std::string floor_body;
+  std::string carried_tool;
+  double force_scale = 1.0;
 };
 
 struct RunDescription {
@@ -84,8 +92,11 @@ struct SceneView {
 struct SceneDescription {
   std::filesystem::path file;  // where it was read from (empty when built in code)
   std::string description;
-  /// Set for a teleoperation scene; then `world` is empty.
+  /// Set for a teleoperation scene (the "teleop" dialect); then `world` is empty.
   bool is_teleop = false;
+  /// Set for a scene with a "rig" beside its bodies and tools: `teleop` holds the rig, `world` the
+  /// rest (the run adds the rig's bodies, scene/teleop_setup.h).
+  bool has_rig = false;
   TeleopSceneDescription teleop;
   WorldDescription world;
   DeviceDescription device;

@@ -73,7 +73,7 @@ SceneDescription Parser::parse(const Json& root) {
   } else {
     allow_keys(root, "",
                {"$schema", "format", "description", "data", "world", "materials", "bodies", "tools",
-                "device", "run", "views", "assessment"});
+                "rig", "device", "run", "views", "assessment"});
   }
   const Json& format = required(root, "", "format");
   if (!format.is_string() || format.get<std::string>() != "hapsim-scene/1") {
@@ -197,6 +197,9 @@ SceneDescription Parser::parse(const Json& root) {
     }
   }
 
+  if (root.contains("rig")) {
+    read_rig(*this, root["rig"], "/rig", scene);
+  }
   read_device(*this, required(root, "", "device"), "/device", scene);
 
   parse_run(root, scene);

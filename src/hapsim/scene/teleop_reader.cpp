@@ -1,13 +1,16 @@
 #include "hapsim/scene/teleop_reader.h"
 
+#include <algorithm>
+
 namespace hapsim {
 
 using Json = JsonReader::Json;
 
-void read_teleop(const SceneReader& r, const Json& j, const std::string& ptr,
-                 TeleopSceneDescription& t) {
-  r.object(j, ptr, "teleoperation settings");
-  r.allow_keys(j, ptr, {"slave", "mapping", "gripper", "ball", "sheet", "floor_z_m"});
+namespace {
+
+// The parts a "teleop" and a "rig" section share: the slave, the mapping, the gripper.
+void read_arm(const SceneReader& r, const Json& j, const std::string& ptr,
+              TeleopSceneDescription& t) {
   if (j.contains("slave")) {
     const std::string sp = JsonReader::at(ptr, "slave");
     const Json& s = r.object(j["slave"], sp, "the slave arm");
@@ -48,6 +51,64 @@ void read_teleop(const SceneReader& r, const Json& j, const std::string& ptr,
     t.gripper_speed_m_per_s =
         r.number_in(g, gp, "speed_m_per_s", t.gripper_speed_m_per_s, 0.0, 10.0, "m/s", true);
   }
+}
+
+// A body named in a rig section: one of the scene's, of the kind the rig needs.
+std::string rig_body_name(const SceneReader& r, const Json& j, const std::string& ptr,
+                          const char* key, const WorldDescription& world, BodyKind kind,
+                          const char* what) {
+  if (!j.contains(key)) {
+    return {};
+  }
+  const std::string p = JsonReader::at(ptr, key);
+  const std::string name = r.nonempty_string(j[key], p, "a body name");
+  const auto it = std::find_if(world.bodies.begin(), world.bodies.end(),
+                               [&](const BodyDescription& b) { return b.name == name; });
+  if (it == world.bodies.end()) {
+    r.fail(p, "no body named '" + name + "' in /bodies");
+  }
+  if (it->kind != kind) {
+    r.fail(p, "body '" + name + "' must be " + what);
+  }
+  return name;
+}
+
+}  // namespace
+
+void read_rig(const SceneReader& r, const Json& j, const std::string& ptr,
+              SceneDescription& scene) {
+  TeleopSceneDescription& t = scene.teleop;
+  r.object(j, ptr, "the rig");
+  r.allow_keys(
+      j, ptr,
+      {"slave", "mapping", "gripper", "force_scale", "carries_tool", "ball", "sheet", "floor"});
+  read_arm(r, j, ptr, t);
+  t.force_scale = r.number_in(j, ptr, "force_scale", t.force_scale, 0.0, 100.0, "");
+  const WorldDescription& w = scene.world;
+  t.ball_body = rig_body_name(r, j, ptr, "ball", w, BodyKind::kDynamic, "dynamic (a sphere)");
+  t.sheet_body = rig_body_name(r, j, ptr, "sheet", w, BodyKind::kDeformable, "a sheet");
+  t.floor_body = rig_body_name(r, j, ptr, "floor", w, BodyKind::kStatic, "static");
+  if (j.contains("carries_tool")) {
+    const std::string p = JsonReader::at(ptr, "carries_tool");
+    t.carried_tool = r.nonempty_string(j["carries_tool"], p, "a tool name");
+    const auto it = std::find_if(w.tools.begin(), w.tools.end(), [&](const ToolDescription& tool) {
+      return tool.name == t.carried_tool;
+    });
+    if (it == w.tools.end()) {
+      r.fail(p, "no tool named '" + t.carried_tool + "' in /tools");
+    }
+    if (it->finger >= 0 || it->device != 0) {
+      r.fail(p, "tool '" + t.carried_tool + "' must be the first device's, with no finger");
+    }
+  }
+  scene.has_rig = true;
+}
+
+void read_teleop(const SceneReader& r, const Json& j, const std::string& ptr,
+                 TeleopSceneDescription& t) {
+  r.object(j, ptr, "teleoperation settings");
+  r.allow_keys(j, ptr, {"slave", "mapping", "gripper", "ball", "sheet", "floor_z_m"});
+  read_arm(r, j, ptr, t);
   if (j.contains("ball")) {
     const std::string bp = JsonReader::at(ptr, "ball");
     const Json& b = r.object(j["ball"], bp, "ball settings");

@@ -15,6 +15,12 @@ namespace hapsim {
 void read_teleop(const SceneReader& reader, const JsonReader::Json& j, const std::string& ptr,
                  TeleopSceneDescription& t);
 
+/// Reads a scene's "rig" object `j` at `ptr` (docs/scene-format.md, "Rigs"): the slave, the
+/// mapping, the gripper, the force scale and the names of the scene's bodies and tool it drives or
+/// reads (its ball, sheet, floor, the tool it carries), checked against `scene.world`, which must
+/// be read first. Sets scene.has_rig.
+void read_rig(const SceneReader& reader, const JsonReader::Json& j, const std::string& ptr,
+              SceneDescription& scene);
 /// Reads a teleoperation scene's "device" object `j` at `ptr` into `d` (profile "simulated").
 void read_teleop_device(const SceneReader& reader, const JsonReader::Json& j,
                         const std::string& ptr, DeviceDescription& d);

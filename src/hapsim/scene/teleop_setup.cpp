@@ -6,8 +6,11 @@
 #include "hapsim/kinematics/urdf_chain.h"
 #include "hapsim/rig/rig_controller.h"
 #include "hapsim/rig/rig_world.h"
+#include "hapsim/script/scene_palpation_plan.h"
 #include "hapsim/script/slave_start.h"
 #include "hapsim/script/teleop_pick_and_place_plan.h"
+#include "hapsim/script/teleop_probe_plan.h"
+#include "hapsim/world/world.h"
 
 #include <memory>
 #include <utility>
@@ -16,7 +19,8 @@ namespace hapsim {
 
 namespace {
 
-TeleopRigDescription rig_description(const SceneDescription& scene, bool load_link_meshes) {
+// The rig a scene describes: its slave (procedural or URDF), mapping, gripper, ball and sheet.
+TeleopRigDescription rig_from_scene(const SceneDescription& scene, bool load_link_meshes) {
   const TeleopSceneDescription& t = scene.teleop;
   TeleopRigDescription d;
   if (t.slave_urdf.empty()) {
@@ -39,7 +43,61 @@ TeleopRigDescription rig_description(const SceneDescription& scene, bool load_li
   d.sheet.side_m = t.sheet_size_m;
   d.environment.X_world_sheet = Iso3(Eigen::Translation3d(t.sheet_position_m));
   d.environment.floor_z_m = t.floor_z_m;
+  d.force_scale = t.force_scale;
   return d;
+}
+
+std::size_t body_index(const WorldDescription& w, const std::string& name) {
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    if (w.bodies[b].name == name) {
+      return b;
+    }
+  }
+  return TeleopRigDescription::kNoBody;
+}
+
+// The master's scripted tele-palpation: the scene's palpation planned for the carried tool's
+// centre on the scene's bodies (rigid: aiming needs their rest surfaces only), then carried by
+// the slave (script/teleop_probe_plan.h).
+Trajectory rig_palpation(const SceneDescription& scene, const TeleopRigDescription& d,
+                         const MasterArm& master) {
+  if (d.carried_tool == TeleopRigDescription::kNoTool) {
+    throw Error(scene.file.string() + ":/rig",
+                "a palpation script needs the tool the slave carries ('carries_tool')");
+  }
+  WorldDescription aim = scene.world;
+  for (BodyDescription& b : aim.bodies) {
+    if (b.kind == BodyKind::kDeformable) {
+      b.kind = BodyKind::kStatic;
+      b.fem.reset();
+    }
+  }
+  // The plan is for the first tool's centre: the carried tool, where it is.
+  const ToolDescription carried = aim.tools[d.carried_tool];
+  aim.tools = {carried};
+  aim.tools.front().offset_device = Vec3::Zero();
+  const World aim_world(std::move(aim));
+  const PalpationPlan probe = make_scene_palpation(aim_world, scene.device.palpation);
+  return make_teleop_probe_plan(probe.trajectory, d, master, carried.offset_device);
+}
+
+// The slave starts where the master's first pose asks it to be (one cold IK, before the run).
+void solve_start(const SceneDescription& scene, TeleopRigDescription& d, const MasterArm& master,
+                 const Trajectory& trajectory) {
+  if (!solve_slave_start(d, master, trajectory)) {
+    throw Error(scene.file.string(),
+                "the master's first pose puts the slave's target out of its reach");
+  }
+}
+
+Trajectory master_trajectory_file(const std::filesystem::path& file) {
+  Trajectory t = load_trajectory_csv(file);
+  if (t.joint_count < 3 || t.finger_count < 2) {
+    throw Error(file.string(),
+                "a master trajectory needs joint columns j0..j2 (base, shoulder, elbow) and "
+                "finger columns f0, f1");
+  }
+  return t;
 }
 
 }  // namespace
@@ -48,16 +106,11 @@ TeleopSetup make_teleop_setup(const SceneDescription& scene,
                               const std::optional<std::filesystem::path>& trajectory,
                               bool load_link_meshes) {
   TeleopSetup s;
-  TeleopRigDescription d = rig_description(scene, load_link_meshes);
+  TeleopRigDescription d = rig_from_scene(scene, load_link_meshes);
   const MasterArm master(d.master);
   if (trajectory || !scene.device.has_pick_and_place) {
     const std::filesystem::path file = trajectory ? *trajectory : scene.device.trajectory_file;
-    s.trajectory = load_trajectory_csv(file);
-    if (s.trajectory.joint_count < 3 || s.trajectory.finger_count < 2) {
-      throw Error(file.string(),
-                  "a master trajectory needs joint columns j0..j2 (base, shoulder, elbow) and "
-                  "finger columns f0, f1");
-    }
+    s.trajectory = master_trajectory_file(file);
     s.device_name = "simulated master (trajectory " + file.string() + ")";
   } else {
     s.trajectory = make_teleop_pick_and_place(scene.device.pick_and_place, d, master).trajectory;
@@ -66,15 +119,48 @@ TeleopSetup make_teleop_setup(const SceneDescription& scene,
     s.device_name = "simulated master (scripted pick-and-place)";
   }
 
-  // The slave starts where the master's first pose asks it to be (one cold IK, before the run).
-  if (!solve_slave_start(d, master, s.trajectory)) {
-    throw Error(scene.file.string(),
-                "the master's first pose puts the slave's target out of its reach");
-  }
+  solve_start(scene, d, master, s.trajectory);
   s.slave_name =
       scene.teleop.slave_urdf.empty() ? "procedural Motoman" : scene.teleop.slave_urdf.string();
   // Built with the start joints: the slave's bodies start where its follower does.
   s.description = rig_world(std::move(d));
+  return s;
+}
+
+TeleopSetup make_rig_setup(const SceneDescription& scene,
+                           const std::optional<std::filesystem::path>& trajectory,
+                           bool load_link_meshes) {
+  TeleopSetup s;
+  TeleopRigDescription d = rig_from_scene(scene, load_link_meshes);
+  const TeleopSceneDescription& t = scene.teleop;
+  d.ball_body =
+      t.ball_body.empty() ? TeleopRigDescription::kNoBody : body_index(scene.world, t.ball_body);
+  d.sheet_body =
+      t.sheet_body.empty() ? TeleopRigDescription::kNoBody : body_index(scene.world, t.sheet_body);
+  d.floor_body =
+      t.floor_body.empty() ? TeleopRigDescription::kNoBody : body_index(scene.world, t.floor_body);
+  for (std::size_t i = 0; i < scene.world.tools.size(); ++i) {
+    if (!t.carried_tool.empty() && scene.world.tools[i].name == t.carried_tool) {
+      d.carried_tool = i;
+    }
+  }
+  const MasterArm master(d.master);
+  if (trajectory || !scene.device.trajectory_file.empty()) {
+    const std::filesystem::path file = trajectory ? *trajectory : scene.device.trajectory_file;
+    s.trajectory = master_trajectory_file(file);
+    s.device_name = "simulated master (trajectory " + file.string() + ")";
+  } else if (scene.device.has_palpation) {
+    s.trajectory = rig_palpation(scene, d, master);
+    s.device_name = "simulated master (scripted tele-palpation)";
+  } else {
+    throw Error(scene.file.string() + ":/device",
+                "a rig scene's device is the master: give it a 'trajectory' of master joints "
+                "or a 'palpation' script for the tool the slave carries");
+  }
+  solve_start(scene, d, master, s.trajectory);
+  s.slave_name = t.slave_urdf.empty() ? "procedural Motoman" : t.slave_urdf.string();
+  // Built with the start joints: the slave's bodies start where its follower does.
+  s.description = add_rig(scene.world, std::move(d));
   return s;
 }
 

@@ -40,4 +40,14 @@ struct TeleopSetup {
                                             const std::optional<std::filesystem::path>& trajectory,
                                             bool load_link_meshes);
 
+/// Builds the setup of a scene with a "rig" (`scene.has_rig`): the scene's own bodies and tools
+/// with the rig's pads and slave links added and the rig as the world's controller (add_rig). The
+/// master plays `trajectory`, else the scene's trajectory file, else its palpation script carried
+/// by the slave (the tool the rig carries presses each target; script/teleop_probe_plan.h).
+/// Throws hapsim::Error naming the file, as make_teleop_setup does, and when the device gives the
+/// master neither a trajectory nor a palpation script.
+[[nodiscard]] TeleopSetup make_rig_setup(const SceneDescription& scene,
+                                         const std::optional<std::filesystem::path>& trajectory,
+                                         bool load_link_meshes);
+
 }  // namespace hapsim

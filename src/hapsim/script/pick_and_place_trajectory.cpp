@@ -1,7 +1,7 @@
 #include "hapsim/script/pick_and_place_trajectory.h"
 
 #include "hapsim/core/error.h"
-#include "hapsim/kinematics/inverse_kinematics.h"
+#include "hapsim/script/master_flange_ik.h"
 #include "hapsim/script/palpation_trajectory.h"
 
 #include <algorithm>
@@ -38,9 +38,6 @@ PickAndPlacePlan make_pick_and_place_plan(const PickAndPlaceScript& s, const Mas
       throw Error(where, "durations must be > 0 s");
     }
   }
-  if (!(slave_max_width_m > 0.0) || !(mapping.scale > 0.0)) {
-    throw Error(where, "the gripper width and the mapping scale must be > 0");
-  }
   const Vec3 up = Vec3::UnitZ();
   const Vec3 above_pick = s.pick_world + up * (s.grasp_depth_m + s.clearance_m);
   const Vec3 at_pick = s.pick_world + up * s.grasp_depth_m;
@@ -60,38 +57,9 @@ PickAndPlacePlan make_pick_and_place_plan(const PickAndPlaceScript& s, const Mas
   };
 
   // Slave flange → master hand (inverse of the mapping) → master joints (position IK, tracked).
-  const Iso3 X_master_slave = mapping.X_slave_master.inverse();
-  const MasterArmGeometry& g = master.geometry();
-  const double widest = 2.0 * g.finger_m * std::sin(g.finger_open_limit_rad);
-  IkOptions ik;
-  ik.orientation = false;
-  ik.restarts = 8;
-  std::array<double, 3> q{0.0, 0.8, 1.4};
+  MasterFlangeIk ik(master, mapping, slave_max_width_m, where);
   auto sample = [&](double t, const Vec3& flange, double width) {
-    const Vec3 hand = X_master_slave * flange / mapping.scale;
-    Iso3 target = Iso3::Identity();
-    target.translation() = hand;
-    std::array<double, 3> solved{};
-    const IkResult r = solve_ik(master.arm(), target, q, solved, ik);
-    if (!r.reached) {
-      throw Error(where, "the slave flange target (" + std::to_string(flange.x()) + ", " +
-                             std::to_string(flange.y()) + ", " + std::to_string(flange.z()) +
-                             ") m maps to a master hand position out of the master's reach");
-    }
-    q = solved;
-    const double finger =
-        master.finger_angle_for_opening(g.finger_gap_m + width / slave_max_width_m * widest);
-    DeviceInput in;
-    in.time_s = t;
-    in.p_world = hand;
-    in.joint_count = 3;
-    in.joint_rad[0] = q[0];
-    in.joint_rad[1] = q[1];
-    in.joint_rad[2] = q[2];
-    in.finger_count = 2;
-    in.finger_rad[0] = finger;
-    in.finger_rad[1] = finger;
-    return in;
+    return ik.input_for(t, flange, width);
   };
 
   PickAndPlacePlan out;

@@ -484,9 +484,11 @@ class WorldViewerSession final : public ViewerSession {
 
     char text[160];
     r.lines.clear();
-    const Vec3 ball_p_world =
-        world.body_poses_world[rig_description(world_->description())->ball_body].translation();
-    r.lines.emplace_back("ball (mm)", format_mm(ball_p_world) + (s.held ? "  held" : "  free"));
+    const std::size_t ball = rig_description(world_->description())->ball_body;
+    if (ball != TeleopRigDescription::kNoBody) {
+      const Vec3 ball_p_world = world.body_poses_world[ball].translation();
+      r.lines.emplace_back("ball (mm)", format_mm(ball_p_world) + (s.held ? "  held" : "  free"));
+    }
     std::snprintf(text, sizeof text, "%.1f mm, grasp %.2f N", s.gripper_width_m * 1e3,
                   s.grasp_force_n);
     r.lines.emplace_back("gripper", text);

@@ -1,0 +1,124 @@
+// scenes/telepalpation.json as `hapsim run` assembles it: the master drives the Motoman, whose
+// carried pad presses the FEM knee. Checked against finite differences of the arms' own forward
+// kinematics (not the Jacobians the rig uses): the master's joint torques are Jᵀ·F of the pad's
+// contact force at the master's hand, and the slave's joint torques are what holds the pad's force
+// at its centre; the pad sits where the slave's flange carries it.
+#include "hapsim/core/error.h"
+#include "hapsim/kinematics/master_arm.h"
+#include "hapsim/rig/rig_controller.h"
+#include "hapsim/runtime/session.h"
+#include "hapsim/scene/run_setup.h"
+#include "hapsim/scene/scene_file.h"
+#include "hapsim/world/world.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace hapsim {
+namespace {
+
+const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/telepalpation.json";
+
+// ∂p/∂q_j of a point by central differences: a column per joint.
+template <typename PointOf>
+std::vector<Vec3> point_jacobian(std::vector<double> q, PointOf point_of) {
+  constexpr double kH = 1e-6;
+  std::vector<Vec3> columns;
+  for (std::size_t j = 0; j < q.size(); ++j) {
+    const double q0 = q[j];
+    q[j] = q0 + kH;
+    const Vec3 plus = point_of(q);
+    q[j] = q0 - kH;
+    const Vec3 minus = point_of(q);
+    q[j] = q0;
+    columns.emplace_back((plus - minus) / (2.0 * kH));
+  }
+  return columns;
+}
+
+TEST(Telepalpation, MasterTorqueIsJacobianTransposeOfThePadsContactForce) {
+  RunSetup setup = make_run_setup(load_scene(kScene), DeviceChoice::scene_script());
+  const World& world = *setup.world;
+  const RigState* rig = rig_state(world);
+  ASSERT_NE(rig, nullptr);
+  const TeleopRigDescription& d = *rig->description;
+  ASSERT_NE(d.carried_tool, TeleopRigDescription::kNoTool);
+  ASSERT_EQ(d.ball_body, TeleopRigDescription::kNoBody);  // it palpates; there is no ball
+  const MasterArm& master = rig->controller->master();
+  const Vec3 offset_tool = world.description().tools[d.carried_tool].offset_device;
+
+  std::size_t checked = 0;
+  double peak_force_n = 0.0;
+  double worst_master_nm = 0.0;
+  double worst_slave_nm = 0.0;
+  double worst_place_m = 0.0;
+  SessionOptions options;
+  options.duration_s =
+      2.6;  // the first press (move 1.0 s, approach 0.6 s, press 0.8 s) and into its hold
+  options.dt_s = setup.scene.run.dt_s;
+  options.after_cycle = [&](std::size_t) {
+    const StepResult& step = world.last_result();
+    const TeleopStepResult& r = *rig_result(step);
+    const ToolState& pad = step.tools[d.carried_tool];
+    // The pad is where the slave's flange carries it.
+    worst_place_m = std::max(worst_place_m, (pad.p_world - r.slave_tool * offset_tool).norm());
+    const Vec3 f_world = pad.force_world_n;
+    if (f_world.norm() < 0.5) {
+      return;
+    }
+    peak_force_n = std::max(peak_force_n, f_world.norm());
+    // Master: the force in its base frame, scaled, through the Jacobian of its hand position.
+    const Vec3 f_master = d.mapping.X_slave_master.linear().transpose() * f_world * d.force_scale;
+    const std::vector<Vec3> J_master =
+        point_jacobian(std::vector<double>(r.master_arm_rad.begin(), r.master_arm_rad.end()),
+                       [&](const std::vector<double>& q) {
+                         return Vec3(master.hand_pose({q[0], q[1], q[2]}).translation());
+                       });
+    for (std::size_t j = 0; j < 3; ++j) {
+      const double expected = J_master[j].dot(f_master);
+      if (std::abs(expected) < master.geometry().max_torque_n_m[j]) {  // not clamped
+        worst_master_nm =
+            std::max(worst_master_nm, std::abs(r.command.joint_torque_nm[j] - expected));
+      }
+    }
+    // Slave: the torque that holds the force at the pad's centre, τ = (∂p_pad/∂q)ᵀ·F.
+    const SerialChain& chain = rig->slave->chain();
+    const std::vector<Vec3> J_slave = point_jacobian(
+        std::vector<double>(rig->slave->q().begin(), rig->slave->q().end()),
+        [&](const std::vector<double>& q) { return Vec3(chain.forward(q) * offset_tool); });
+    for (std::size_t j = 0; j < J_slave.size(); ++j) {
+      worst_slave_nm =
+          std::max(worst_slave_nm, std::abs(r.slave_joint_torque_nm[j] - J_slave[j].dot(f_world)));
+    }
+    ++checked;
+  };
+  (void)run_session(*setup.world, *setup.device, options);
+  EXPECT_GT(checked, 200U) << "the pad should press the knee for a good part of the first press";
+  EXPECT_GT(peak_force_n, 2.0);
+  EXPECT_LT(worst_place_m, 1e-12);
+  EXPECT_LT(worst_master_nm, 1e-6);
+  EXPECT_LT(worst_slave_nm, 1e-6);
+}
+
+// A rig's tool must be one the slave can carry: the first device's, with no finger.
+TEST(Telepalpation, ACarriedToolOfAnotherDeviceIsRefused) {
+  SceneDescription scene = load_scene(kScene);
+  RunSetup setup = make_run_setup(scene, DeviceChoice::scene_script());
+  WorldDescription world = setup.world->description();
+  world.tools[0].device = 1;
+  world.device_hosts = {"trainee", "instructor"};
+  try {
+    const World bad(world);
+    FAIL() << "a carried tool on another device was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the tool the slave carries"), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace hapsim
