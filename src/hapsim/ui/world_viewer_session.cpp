@@ -474,26 +474,36 @@ class WorldViewerSession final : public ViewerSession {
     hand.contacts = 0;
     r.contact_count = static_cast<std::size_t>(tool.contacts);
 
+    const TeleopRigDescription& rig = *rig_description(world_->description());
     r.bars.clear();
-    r.bars.emplace_back("grasp", s.grasp_force_n);
-    r.bars.emplace_back("pad 1", s.pad_force_n[0]);
-    r.bars.emplace_back("pad 2", s.pad_force_n[1]);
-    // The sheet's deepest dent (≥ 0: a node resting a hair above its rest height is no dent).
-    const double dent_m = s.sheet_depth_m > 0.0 ? s.sheet_depth_m : 0.0;
-    r.max_deflection_m = dent_m;
-
     char text[160];
     r.lines.clear();
-    const std::size_t ball = rig_description(world_->description())->ball_body;
-    if (ball != TeleopRigDescription::kNoBody) {
-      const Vec3 ball_p_world = world.body_poses_world[ball].translation();
-      r.lines.emplace_back("ball (mm)", format_mm(ball_p_world) + (s.held ? "  held" : "  free"));
+    if (rig.carried_tool < world.tools.size()) {
+      // A carried tool (tele-palpation): its contact force is what the master's hand feels.
+      const ToolState& carried = world.tools[rig.carried_tool];
+      tool.force_n = carried.force_world_n.allFinite() ? carried.force_world_n.norm() : 0.0;
+      tool.contacts = carried.contact_count;
+      r.contact_count = static_cast<std::size_t>(std::max(0, carried.contact_count));
+      r.bars.emplace_back(world_->description().tools[rig.carried_tool].name, tool.force_n);
+      r.max_deflection_m = 0.0;
     }
-    std::snprintf(text, sizeof text, "%.1f mm, grasp %.2f N", s.gripper_width_m * 1e3,
-                  s.grasp_force_n);
-    r.lines.emplace_back("gripper", text);
-    std::snprintf(text, sizeof text, "%.2f", dent_m * 1e3);
-    r.lines.emplace_back("sheet deepest dent (mm)", text);
+    if (rig.ball_body != TeleopRigDescription::kNoBody) {
+      r.bars.emplace_back("grasp", s.grasp_force_n);
+      r.bars.emplace_back("pad 1", s.pad_force_n[0]);
+      r.bars.emplace_back("pad 2", s.pad_force_n[1]);
+      const Vec3 ball_p_world = world.body_poses_world[rig.ball_body].translation();
+      r.lines.emplace_back("ball (mm)", format_mm(ball_p_world) + (s.held ? "  held" : "  free"));
+      std::snprintf(text, sizeof text, "%.1f mm, grasp %.2f N", s.gripper_width_m * 1e3,
+                    s.grasp_force_n);
+      r.lines.emplace_back("gripper", text);
+    }
+    if (rig.sheet_body != TeleopRigDescription::kNoBody) {
+      // The sheet's deepest dent (≥ 0: a node resting a hair above its rest height is no dent).
+      const double dent_m = s.sheet_depth_m > 0.0 ? s.sheet_depth_m : 0.0;
+      r.max_deflection_m = dent_m;
+      std::snprintf(text, sizeof text, "%.2f", dent_m * 1e3);
+      r.lines.emplace_back("sheet deepest dent (mm)", text);
+    }
     std::string joints;
     for (const double q : s.slave_q) {
       std::snprintf(text, sizeof text, "%s%.1f", joints.empty() ? "" : " ",
