@@ -1,6 +1,6 @@
 // `hapsim run scenes/telepalpation.json` as a user runs it: a rig scene with a knee body runs
 // from the scene file, says what the slave's tool felt, draws the pad on the knee, and its
-// recording replays bit for bit.
+// recording replays bit for bit and is scored against its landmarks.
 #include "hapsim_process.h"
 
 #include <nlohmann/json.hpp>
@@ -49,6 +49,16 @@ TEST(TelepalpationRun, RunsRecordsAndReplaysBitForBit) {
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_TRUE(j.at("replay_identical").get<bool>()) << again.output;
   EXPECT_GT(j.at("steps").get<int>(), 9000);
+
+  // Scored as a palpation through the slave: the carried pad's contacts find the landmarks.
+  const auto assessed = temp_path("telepalpation_assessment.json");
+  const RunResult scored = run_hapsim("assess " + rec.string() + " --scene " + kScene +
+                                      " --json " + assessed.string());
+  ASSERT_EQ(scored.exit_code, 0) << scored.output;
+  std::ifstream a(assessed);
+  const nlohmann::json result = nlohmann::json::parse(a);
+  EXPECT_EQ(result.at("kind").get<std::string>(), "palpation") << result.dump(2);
+  EXPECT_NE(scored.output.find("3 of 3 found"), std::string::npos) << scored.output;
 }
 
 }  // namespace

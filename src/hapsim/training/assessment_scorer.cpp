@@ -1,6 +1,7 @@
 #include "hapsim/training/assessment_scorer.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/rig/rig_controller.h"
 
 #include <algorithm>
 #include <cmath>
@@ -28,6 +29,8 @@ AssessmentScorer::AssessmentScorer(const AssessmentDefinition& definition, const
     throw Error("assessment", "the cycle length must be > 0 s");
   }
   const WorldDescription& d = world.description();
+  const TeleopRigDescription* rig = rig_description(d);
+  rig_picks_ball_ = rig != nullptr && rig->ball_body != TeleopRigDescription::kNoBody;
   flat_count_ = world.flat_segment_count();
   body_first_flat_.resize(d.bodies.size(), 0);
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
@@ -265,7 +268,7 @@ void AssessmentScorer::add(const CycleRecord& record) {
   }
 
   // A teleoperation rig's pick and place.
-  if (record.has_teleop) {
+  if (record.has_teleop && rig_picks_ball_) {
     has_teleop_ = true;
     const TeleopStepResult& t = record.teleop;
     if (t.held && !held_ && !grasp_at_s_) {

@@ -81,6 +81,9 @@ class AssessmentScorer {
   std::optional<Vec3> last_path_point_;
   // Pick and place.
   bool has_teleop_ = false;
+  /// The world's rig picks a ball: its cycles are scored as a pick and place (a rig that carries
+  /// a probe instead, tele-palpation, is scored as a palpation by its tool's contacts).
+  bool rig_picks_ball_ = false;
   std::optional<double> grasp_at_s_;
   bool held_ = false;
   bool released_ = false;
