@@ -276,36 +276,12 @@ class SessionAccountant {
 
   void account_teleop(const TeleopStepResult& r) {
     TeleopSummary& t = *summary_.teleop;
-    if (r.gripper.grasped_now && !t.grasped) {
-      t.grasped = true;
-      t.grasp_time_s = r.time_s;
-    }
-    if (r.gripper.released_now && t.grasped && t.release_time_s < 0.0) {
-      t.release_time_s = r.time_s;
-    }
     t.peak_tool_force_n = std::max(t.peak_tool_force_n, r.tool_force_world_n.norm());
     for (std::size_t j = 0; j < 3; ++j) {
       t.peak_master_torque_nm =
           std::max(t.peak_master_torque_nm, std::abs(r.command.joint_torque_nm[j]));
     }
-    if (!t.has_ball) {
-      t.max_slave_tracking_error_m =
-          std::max(t.max_slave_tracking_error_m, r.slave.position_error_m);
-      if (r.slave_collisions > 0) {
-        ++t.slave_collision_steps;
-        t.slave_collisions += static_cast<std::size_t>(r.slave_collisions);
-        if (t.first_slave_collision_s < 0.0) {
-          t.first_slave_collision_s = r.time_s;
-        }
-        slave_collision_bodies_ |= r.slave_collision_bodies;
-      }
-      return;
-    }
-    t.ball_lift_m = std::max(t.ball_lift_m, r.ball_p_world.z() - ball_start_z_);
-    t.peak_grasp_force_n = std::max(t.peak_grasp_force_n, r.gripper.grasp_force_n());
-    t.max_sheet_deflection_m = std::max(t.max_sheet_deflection_m, r.sheet_depth_m);
     t.max_slave_tracking_error_m = std::max(t.max_slave_tracking_error_m, r.slave.position_error_m);
-    t.nonfinite_ball_steps += r.ball_p_world.allFinite() ? 0 : 1;
     if (r.slave_collisions > 0) {
       ++t.slave_collision_steps;
       t.slave_collisions += static_cast<std::size_t>(r.slave_collisions);
@@ -314,6 +290,20 @@ class SessionAccountant {
       }
       slave_collision_bodies_ |= r.slave_collision_bodies;
     }
+    if (!t.has_ball) {
+      return;  // a rig that palpates: no grasp, ball or sheet to follow
+    }
+    if (r.gripper.grasped_now && !t.grasped) {
+      t.grasped = true;
+      t.grasp_time_s = r.time_s;
+    }
+    if (r.gripper.released_now && t.grasped && t.release_time_s < 0.0) {
+      t.release_time_s = r.time_s;
+    }
+    t.ball_lift_m = std::max(t.ball_lift_m, r.ball_p_world.z() - ball_start_z_);
+    t.peak_grasp_force_n = std::max(t.peak_grasp_force_n, r.gripper.grasp_force_n());
+    t.max_sheet_deflection_m = std::max(t.max_sheet_deflection_m, r.sheet_depth_m);
+    t.nonfinite_ball_steps += r.ball_p_world.allFinite() ? 0 : 1;
   }
 
   void note_deflection(std::size_t flat_segment, double deflection_m) {

@@ -61,7 +61,7 @@ std::string rig_body_name(const SceneReader& r, const Json& j, const std::string
     return {};
   }
   const std::string p = JsonReader::at(ptr, key);
-  const std::string name = r.nonempty_string(j[key], p, "a body name");
+  std::string name = r.nonempty_string(j[key], p, "a body name");
   const auto it = std::find_if(world.bodies.begin(), world.bodies.end(),
                                [&](const BodyDescription& b) { return b.name == name; });
   if (it == world.bodies.end()) {

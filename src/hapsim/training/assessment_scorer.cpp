@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace hapsim {
 namespace {
@@ -24,7 +25,7 @@ std::size_t AssessmentResult::landmarks_found() const {
 
 AssessmentScorer::AssessmentScorer(const AssessmentDefinition& definition, const World& world,
                                    double dt_s, std::optional<Vec3> teleop_target_world)
-    : definition_(definition), dt_s_(dt_s), teleop_target_world_(teleop_target_world) {
+    : definition_(definition), dt_s_(dt_s), teleop_target_world_(std::move(teleop_target_world)) {
   if (!(dt_s > 0.0) || !std::isfinite(dt_s)) {
     throw Error("assessment", "the cycle length must be > 0 s");
   }
