@@ -9,12 +9,15 @@
 #include "hapsim/runtime/session.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
+#include "hapsim/script/master_flange_ik.h"
 #include "hapsim/world/world.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -102,6 +105,33 @@ TEST(Telepalpation, MasterTorqueIsJacobianTransposeOfThePadsContactForce) {
   EXPECT_LT(worst_place_m, 1e-12);
   EXPECT_LT(worst_master_nm, 1e-6);
   EXPECT_LT(worst_slave_nm, 1e-6);
+}
+
+// The robot cannot push the patient: a gripper driven down into the knee is a slave collision
+// with the knee's tissue (its links' trees are built though the world has no dynamic body).
+TEST(Telepalpation, AGripperDrivenIntoTheKneeIsASlaveCollision) {
+  RunSetup setup = make_run_setup(load_scene(kScene), DeviceChoice::scene_script());
+  World& world = *setup.world;
+  const RigState& rig = *rig_state(world);
+  const TeleopRigDescription& d = *rig.description;
+  MasterFlangeIk ik(rig.controller->master(), d.mapping, d.follower.gripper_max_width_m, "test");
+  // The flange 10 cm above the knee's middle: the closed pads (7 cm below it, 2 cm tall) in it.
+  DeviceInput in = ik.input_for(0.0, Vec3(0.5, 0.0, 0.13), 0.0);
+  in.healthy = true;
+  std::int32_t collisions = 0;
+  std::uint64_t bodies = 0;
+  for (int k = 0; k < 4000; ++k) {
+    in.time_s = k * 1e-3;
+    const TeleopStepResult& r = *rig_result(world.step(in, 1e-3));
+    collisions = std::max(collisions, r.slave_collisions);
+    bodies |= r.slave_collision_bodies;
+  }
+  EXPECT_GT(collisions, 0);
+  std::size_t knee = 0;
+  for (std::size_t b = 0; b < world.description().bodies.size(); ++b) {
+    knee = world.description().bodies[b].name == "knee" ? b : knee;
+  }
+  EXPECT_TRUE((bodies >> knee) & 1U) << "bodies hit: " << bodies;
 }
 
 // A rig's tool must be one the slave can carry: the first device's, with no finger.

@@ -121,7 +121,7 @@ void find_slave_collision_pairs(const WorldModel& model, RigState& rig) {
     for (std::size_t flat = first; flat < first + bm.segment_count; ++flat) {
       const SphereTree* tree = model.segments()[flat].body_tree.get();
       if (tree == nullptr) {
-        continue;  // no body trees: the world has no dynamic body (cannot be a rig's)
+        continue;  // a sheet: no tree (a rig's bodies are kinematic, which always have one)
       }
       rig.colliders.push_back({b, flat});
     }

@@ -749,8 +749,13 @@ std::string format_session_summary(const SessionSummary& s) {
                   "tracking %.3f mm\n",
                   t.max_sheet_deflection_m * 1e3, t.max_slave_tracking_error_m * 1e3);
     out << line;
+  }
+  if (s.teleop) {
+    const TeleopSummary& t = *s.teleop;
     if (t.slave_collision_steps == 0) {
-      out << "slave collisions none (no link, palm or pad inside the floor or the sheet)\n";
+      out << (t.has_ball
+                  ? "slave collisions none (no link, palm or pad inside the floor or the sheet)\n"
+                  : "slave collisions none (no link, palm or pad inside a body it cannot push)\n");
     } else {
       std::snprintf(line, sizeof line,
                     "slave collisions in %zu steps, first at %.3f s:", t.slave_collision_steps,

@@ -306,6 +306,14 @@ WorldModel::WorldModel(WorldDescription description, WorldOptions options)
       }
     }
   }
+  // A kinematic body (moved by a controller: a robot's links and pads) has its tree in any world:
+  // the controller finds where it enters what it cannot push back with it (a robot's link in the
+  // table or the patient, rig/slave_collisions.cpp), dynamic bodies or not.
+  for (SegmentModel& seg : segments_) {
+    if (!seg.body_tree && !seg.sheet && bodies_[seg.body].kind == BodyKind::kKinematic) {
+      seg.body_tree = std::make_unique<SphereTree>(seg.description->mesh);
+    }
+  }
   if (proxy_segments_ > static_cast<std::size_t>(GodObject::kMaxSurfaces)) {
     throw Error("world '" + description_.name + "'",
                 "has " + std::to_string(proxy_segments_) + " proxy segments; at most " +
