@@ -1,9 +1,10 @@
 // The teleoperation rig as a controller on ordinary bodies (world/world_controller.h,
 // architecture.md#controllers). The master arm is the device: in the place stage the slave
 // follows the master's hand through IK and carries its links, palm, stem and gripper pads (all
-// kinematic bodies of the world) to its joint frames, the pads closed to the master's grip; in the
-// safety stage the pads' and the gripper's reaction at the slave's tool goes back to the master as
-// joint torques (scaled, through the master's Jᵀ) and the grasp as finger torques. After the step
+// kinematic bodies of the world) to its joint frames, the pads closed to the master's grip, and the
+// tool it carries (if any) at its flange; in the safety stage the pads', the gripper's and the
+// carried tool's reaction at the slave's tool goes back to the master as joint torques (scaled,
+// through the master's Jᵀ) and the grasp as finger torques. After the step
 // it observes the result: whether the grasp holds, where the ball is and what carries it, how
 // deep the sheet is dented. The ball, the sheet and the floor are ordinary bodies it only reads.
 #pragma once
@@ -34,7 +35,8 @@ class RigController final : public WorldController {
   explicit RigController(TeleopRigDescription description);
 
   [[nodiscard]] std::string_view kind() const noexcept override { return "rig"; }
-  /// The rig's bodies are where rig_world() put them, of the kinds it drives and reads.
+  /// The rig's bodies are where rig_world() or add_rig() put them, of the kinds it drives and
+  /// reads; its carried tool is device 0's, with no finger.
   void check(const WorldDescription& world) const override;
   void fingerprint(ContentFingerprint& h) const override;
   [[nodiscard]] std::unique_ptr<ControllerState> make_state(const WorldModel& model) const override;

@@ -76,8 +76,9 @@ struct SegmentModel {
   /// The rest surface's query in the body frame (the body's contact method): what a step uses.
   std::unique_ptr<ProximityQuery> rest_query;
   /// Sphere tree of the rest surface for body-against-body contact (paper 000 §3.1: both bodies'
-  /// trees descended where parent spheres overlap, then refined exactly); built only when the
-  /// world has dynamic bodies, and not for sheets (their field answers directly). A CSG solid's
+  /// trees descended where parent spheres overlap, then refined exactly); built when the world
+  /// has dynamic bodies (a kinematic body's always: a controller checks where it enters others),
+  /// and not for sheets (their field answers directly). A CSG solid's
   /// or exact sphere's tree is over its polygonised mesh: it finds candidate vertices, the exact
   /// solid refines.
   std::unique_ptr<SphereTree> body_tree;
