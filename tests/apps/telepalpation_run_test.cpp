@@ -52,8 +52,8 @@ TEST(TelepalpationRun, RunsRecordsAndReplaysBitForBit) {
 
   // Scored as a palpation through the slave: the carried pad's contacts find the landmarks.
   const auto assessed = temp_path("telepalpation_assessment.json");
-  const RunResult scored = run_hapsim("assess " + rec.string() + " --scene " + kScene +
-                                      " --json " + assessed.string());
+  const RunResult scored =
+      run_hapsim("assess " + rec.string() + " --scene " + kScene + " --json " + assessed.string());
   ASSERT_EQ(scored.exit_code, 0) << scored.output;
   std::ifstream a(assessed);
   const nlohmann::json result = nlohmann::json::parse(a);
