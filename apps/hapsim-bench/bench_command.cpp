@@ -426,7 +426,7 @@ void run_soak(const SoakArgs& args) {
     options.scene = scene;
     options.duration_s = args.minutes * 60.0;
     // A rig's pick-and-place moves the ball: each repetition starts from the scene's start.
-    options.reset_between = load_scene(scene).is_teleop;
+    options.reset_between = load_scene(scene).has_rig;
     ProgressPrinter printer;
     options.progress = [&printer](std::string_view label, double fraction) {
       printer(label, fraction);

@@ -441,8 +441,8 @@ void run(const RunArgs& args) {
           "scene        %s: teleoperation, slave %s (%d joints), ball %.0f g r %.0f mm, "
           "sheet %dx%d\n",
           scene.file.string().c_str(), setup.slave_name.c_str(), rig.slave->chain().dof(),
-          scene.teleop.ball_mass_kg * 1e3, scene.teleop.ball_radius_m * 1e3,
-          scene.teleop.sheet_nodes_per_side, scene.teleop.sheet_nodes_per_side);
+          rig.description->ball.mass_kg * 1e3, rig.description->ball.radius_m * 1e3,
+          rig.description->sheet.nodes_per_side, rig.description->sheet.nodes_per_side);
     }
   } else {
     std::size_t vertices = 0;

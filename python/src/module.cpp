@@ -201,7 +201,7 @@ PYBIND11_MODULE(_hapsim, m) {
       .def_property_readonly("file", [](const Scene& s) { return s.description->file.string(); })
       .def_property_readonly("description",
                              [](const Scene& s) { return s.description->description; })
-      .def_property_readonly("is_teleop", [](const Scene& s) { return s.description->is_teleop; })
+      .def_property_readonly("has_rig", [](const Scene& s) { return s.description->has_rig; })
       .def_property_readonly("warnings", [](const Scene& s) {
         py::list out;
         for (const std::string& w : s.description->warnings) {

@@ -88,7 +88,7 @@ TEST(TeleopRun, RecordingReplaysBitForBit) {
 
 TEST(TeleopRun, UnsupportedOptionsAreOneLine) {
   for (const std::string opt :
-       {"--method knee", "--realtime --snapshot-every 10 --snapshot /tmp/x.png", "--duration -1"}) {
+       {"--realtime --snapshot-every 10 --snapshot /tmp/x.png", "--duration -1"}) {
     SCOPED_TRACE(opt);
     const RunResult r = run_hapsim("run " + kScenes + "/teleop.json -q " + opt);
     EXPECT_EQ(r.exit_code, 2) << r.output;

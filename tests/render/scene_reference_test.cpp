@@ -135,7 +135,7 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
   }
   const SceneDescription scene =
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
-  TeleopSetup setup = make_teleop_setup(scene, std::nullopt, false);
+  TeleopSetup setup = make_rig_setup(scene, std::nullopt, false);
   World world(setup.description);
   // 6 s into the scripted pick-and-place the gripper carries the ball towards the sheet.
   const double dt = scene.run.dt_s;
@@ -169,7 +169,7 @@ TEST(SceneReference, TeleopInEachDisplayModeMatchesTheReferences) {
 
 // A teleoperation scene stepped `steps` cycles on its scripted pick-and-place (−1: all of it).
 std::unique_ptr<World> stepped_teleop(const SceneDescription& scene, int steps) {
-  TeleopSetup setup = make_teleop_setup(scene, std::nullopt, true);
+  TeleopSetup setup = make_rig_setup(scene, std::nullopt, true);
   auto world = std::make_unique<World>(setup.description);
   const double dt = scene.run.dt_s;
   const Trajectory& t = setup.trajectory;

@@ -39,10 +39,9 @@ constexpr int kH = 240;
 class WorldSceneRigTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    SceneDescription scene;
-    scene.is_teleop = true;
-    scene.device.has_pick_and_place = true;
-    setup_ = std::make_unique<TeleopSetup>(make_teleop_setup(scene, std::nullopt, false));
+    const SceneDescription scene =
+        load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
+    setup_ = std::make_unique<TeleopSetup>(make_rig_setup(scene, std::nullopt, false));
     world_ = std::make_unique<World>(setup_->description);
     const Trajectory& t = setup_->trajectory;
     const double dt = 1e-3;
@@ -378,7 +377,7 @@ TEST(WorldSceneRig, Gp7CollisionMeshesArePosedAtTheirChainFrames) {
   o.data_dir = data;
   const SceneDescription scene =
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop_gp7.json", o);
-  const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/true);
+  const TeleopSetup setup = make_rig_setup(scene, std::nullopt, /*load_link_meshes=*/true);
   const SerialChain& chain = *rig_description(setup.description)->slave;
   ASSERT_FALSE(chain.link_geometry().empty());
   World world(setup.description);

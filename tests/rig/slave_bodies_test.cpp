@@ -128,7 +128,7 @@ TEST(SlaveBodies, Gp7LinkBodiesAreItsCollisionMeshesAtTheirChainFrames) {
   o.data_dir = data;
   const SceneDescription scene =
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop_gp7.json", o);
-  const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/true);
+  const TeleopSetup setup = make_rig_setup(scene, std::nullopt, /*load_link_meshes=*/true);
   const SerialChain& chain = *rig_description(setup.description)->slave;
   ASSERT_FALSE(chain.link_geometry().empty());
   World world(setup.description);
@@ -290,7 +290,7 @@ TEST(SlaveBodies, ShippedPickAndPlaceHoldsTheBallWithThePadsAlone) {
   // it, and the slave hits nothing.
   const SceneDescription scene =
       load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
-  const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, true);
+  const TeleopSetup setup = make_rig_setup(scene, std::nullopt, true);
   World world(setup.description);
   const TeleopRigDescription& rig = *rig_description(world.description());
   const Trajectory& t = setup.trajectory;

@@ -8,6 +8,7 @@
 
 #include "hapsim/core/device_profile.h"
 #include "hapsim/device/simulated_device.h"
+#include "hapsim/scene/scene_file.h"
 #include "hapsim/scene/teleop_setup.h"
 #include "support/allocation_counting_client.h"
 
@@ -15,6 +16,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <thread>
 
 namespace hapsim {
@@ -22,10 +24,9 @@ namespace {
 
 // The default teleop scene (procedural Motoman) with its scripted pick-and-place.
 TeleopSetup pick_and_place_setup() {
-  SceneDescription scene;
-  scene.is_teleop = true;
-  scene.device.has_pick_and_place = true;
-  return make_teleop_setup(scene, std::nullopt, /*load_link_meshes=*/false);
+  const SceneDescription scene =
+      load_scene(std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
+  return make_rig_setup(scene, std::nullopt, /*load_link_meshes=*/false);
 }
 
 TEST(WorldHapticClientRig, SnapshotMatchesTheWorldExactlyAfterTheLoop) {

@@ -6,6 +6,8 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/geometry/triangle_mesh.h"
+#include "hapsim/scene/teleop_setup.h"
+#include "hapsim/world/world.h"
 
 #include "support/temp_dir_test.h"
 #include "support/test_data.h"
@@ -609,8 +611,10 @@ TEST_F(SceneFileTest, TeleopScenesNameTheirMistakes) {
        "exactly one of 'trajectory'"},
       {"script without a place", [](Json& j) { j["device"]["pick_and_place"].erase("place_m"); },
        "/device/pick_and_place", "missing required key 'place_m'"},
-      {"palpation in a teleop scene", [](Json& j) { j["device"]["palpation"] = 1; },
-       "/device/palpation", "unknown key 'palpation'"},
+      {"two scripts", [](Json& j) { j["device"]["palpation"] = 1; }, "/device",
+       "exactly one of 'trajectory'"},
+      {"a glove for the master", [](Json& j) { j["device"]["type"] = "glove"; }, "/device/type",
+       "a rig's device is its master arm"},
   };
   for (const Mutation& c : cases) {
     SCOPED_TRACE(c.name);
@@ -618,13 +622,50 @@ TEST_F(SceneFileTest, TeleopScenesNameTheirMistakes) {
     c.change(scene);
     expect_error(scene, c.where, c.fragment);
   }
+  // Read as a rig scene: the ball, the sheet and the floor are bodies the rig names; one note.
   const SceneDescription s = load_scene(write("teleop.json", teleop.dump()));
-  EXPECT_TRUE(s.is_teleop);
+  EXPECT_TRUE(s.has_rig);
   EXPECT_TRUE(s.teleop.slave_urdf.empty());
   EXPECT_TRUE(s.device.has_pick_and_place);
   EXPECT_TRUE(s.device.pick_and_place.place_m.isApprox(Vec3(0.5, 0.25, 0.08)));
   EXPECT_EQ(s.teleop.scale, 1.6);  // the default
-  EXPECT_TRUE(s.world.bodies.empty());
+  ASSERT_EQ(s.world.bodies.size(), 3U);
+  EXPECT_EQ(s.teleop.ball_body, "ball");
+  EXPECT_EQ(s.teleop.sheet_body, "sheet");
+  EXPECT_EQ(s.teleop.floor_body, "floor");
+  ASSERT_EQ(s.warnings.size(), 1U);
+  EXPECT_NE(s.warnings.front().find("older rig dialect, converted on read"), std::string::npos)
+      << s.warnings.front();
+}
+
+// An older "teleop" file is the same world as the scene written in the one language: the first
+// paper's scenes/teleop.json as it was before the "rig" key, converted on read, builds a world
+// with the same content hash as today's scenes/teleop.json.
+TEST_F(SceneFileTest, AnOlderTeleopFileIsTheSameWorldAsItsRigScene) {
+  const Json old = Json::parse(R"({
+    "format": "hapsim-scene/1",
+    "teleop": {
+      "slave": { "model": "procedural" },
+      "mapping": { "scale": 1.6, "offset_m": [0.0, 0.0, 0.0] },
+      "gripper": { "max_force_n": 20.0, "max_width_m": 0.10, "speed_m_per_s": 0.25 },
+      "ball": { "mass_kg": 0.1, "radius_m": 0.03, "start_m": [0.5, -0.25, 0.03] },
+      "sheet": { "nodes_per_side": 16, "size_m": 0.2, "position_m": [0.5, 0.25, 0.05] },
+      "floor_z_m": 0.0
+    },
+    "device": {
+      "type": "simulated",
+      "pick_and_place": { "place_m": [0.5, 0.25, 0.08], "clearance_m": 0.12, "carry_s": 2.0 }
+    },
+    "run": { "duration_s": 0.0, "dt_s": 0.001 }
+  })");
+  const SceneDescription converted = load_scene(write("teleop.json", old.dump()));
+  const SceneDescription written =
+      load_scene(fs::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");
+  EXPECT_TRUE(written.warnings.empty());
+  const World a(make_rig_setup(converted, std::nullopt, false).description);
+  const World b(make_rig_setup(written, std::nullopt, false).description);
+  EXPECT_EQ(a.content_hash(), b.content_hash());
+  EXPECT_EQ(a.description().bodies.size(), b.description().bodies.size());
 }
 
 // A "rig" beside the bodies and tools: it names what it drives and reads, and each name must be
@@ -632,6 +673,7 @@ TEST_F(SceneFileTest, TeleopScenesNameTheirMistakes) {
 TEST_F(SceneFileTest, RigScenesNameTheirMistakes) {
   Json rig = base();
   rig["rig"] = Json::parse(R"({ "slave": { "model": "procedural" }, "carries_tool": "tip" })");
+  rig["device"].erase("profile");  // a rig's device is its master arm
   const Mutation cases[] = {
       {"unknown key", [](Json& j) { j["rig"]["ball_m"] = 1; }, "/rig/ball_m",
        "unknown key 'ball_m'"},
@@ -648,6 +690,18 @@ TEST_F(SceneFileTest, RigScenesNameTheirMistakes) {
          j["rig"]["mapping"] = {{"scale", 0}};
        },
        "/rig/mapping/scale", "expected a number > 0"},
+      {"a ball that is not a sphere",
+       [](Json& j) {
+         j["bodies"].push_back(Json::parse(R"({ "name": "cube", "type": "dynamic", "mass_kg": 0.1,
+             "geometry": { "box": { "half_extents_m": [0.02, 0.02, 0.02] } },
+             "materials": "soft" })"));
+         j["rig"]["ball"] = "cube";
+       },
+       "/rig/ball", "must be a sphere"},
+      {"a sheet that is not a sheet", [](Json& j) { j["rig"]["sheet"] = "ball"; }, "/rig/sheet",
+       "must be a sheet"},
+      {"a device profile", [](Json& j) { j["device"]["profile"] = "touch"; }, "/device/profile",
+       "a rig's device is its simulated master arm"},
       {"the teleop dialect's ball",
        [](Json& j) {
          j["rig"]["ball"] = {{"mass_kg", 0.1}};
@@ -662,7 +716,6 @@ TEST_F(SceneFileTest, RigScenesNameTheirMistakes) {
   }
   const SceneDescription s = load_scene(write("rig.json", rig.dump()));
   EXPECT_TRUE(s.has_rig);
-  EXPECT_FALSE(s.is_teleop);
   EXPECT_EQ(s.teleop.carried_tool, "tip");
   EXPECT_TRUE(s.teleop.ball_body.empty());
   EXPECT_EQ(s.world.bodies.size(), 2U);  // the scene's own; the run adds the rig's

@@ -371,6 +371,72 @@ TEST(SceneSchema, BadScenesAreRefusedByTheSchemaAndTheLoader) {
   fs::remove(file);
 }
 
+// The first paper's scenes/teleop.json as it was before the "rig" key (the older dialect, which
+// still loads: converted on read).
+Json older_teleop_scene() {
+  return Json::parse(R"({
+    "format": "hapsim-scene/1",
+    "teleop": {
+      "slave": { "model": "procedural" },
+      "mapping": { "scale": 1.6, "offset_m": [0.0, 0.0, 0.0] },
+      "gripper": { "max_force_n": 20.0, "max_width_m": 0.10, "speed_m_per_s": 0.25 },
+      "ball": { "mass_kg": 0.1, "radius_m": 0.03, "start_m": [0.5, -0.25, 0.03] },
+      "sheet": { "nodes_per_side": 16, "size_m": 0.2, "position_m": [0.5, 0.25, 0.05] },
+      "floor_z_m": 0.0
+    },
+    "device": {
+      "type": "simulated",
+      "pick_and_place": { "place_m": [0.5, 0.25, 0.08], "clearance_m": 0.12, "carry_s": 2.0 }
+    },
+    "assessment": { "time_limit_s": 20.0 },
+    "run": { "duration_s": 0.0, "dt_s": 0.001 }
+  })");
+}
+
+TEST(SceneSchema, TheOlderTeleopDialectIsStillAValidScene) {
+  const Json old = older_teleop_scene();
+  EXPECT_EQ(schema().validate(old), "");
+  const fs::path file = fs::temp_directory_path() / "hapsim_schema_older_teleop.json";
+  std::ofstream(file) << old.dump();
+  EXPECT_TRUE(load_scene(file).has_rig);
+  fs::remove(file);
+}
+
+// The rig scene's own mistakes: a rigid material with a stiffness, a rig naming a tool that is not
+// there, a world with neither tools nor a rig.
+TEST(SceneSchema, BadRigScenesAreRefusedByTheSchemaAndTheLoader) {
+  struct Case {
+    const char* name;
+    std::function<void(Json&)> change;
+  };
+  const Case cases[] = {
+      {"rigid is not a boolean", [](Json& j) { j["materials"]["ball"]["rigid"] = "yes"; }},
+      {"neither tools nor a rig", [](Json& j) { j.erase("rig"); }},
+      {"unknown rig key", [](Json& j) { j["rig"]["robot"] = "gp7"; }},
+      {"a ball named by position",
+       [](Json& j) {
+         j["rig"]["ball"] = {0.5, 0.1, 0.0};
+       }},
+  };
+  const SchemaValidator v = schema();
+  const Json rig = read_json(kScenes / "teleop.json");
+  const fs::path file = fs::temp_directory_path() / "hapsim_schema_bad_rig.json";
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    Json scene = rig;
+    c.change(scene);
+    EXPECT_NE(v.validate(scene), "") << "the schema accepts it";
+    std::ofstream(file) << scene.dump();
+    EXPECT_THROW((void)load_scene(file), Error) << "the loader accepts it";
+  }
+  // Said by the loader alone: a rigid material has no stiffness of its own.
+  Json stiff = rig;
+  stiff["materials"]["ball"]["stiffness_n_per_m"] = 5000;
+  std::ofstream(file) << stiff.dump();
+  EXPECT_THROW((void)load_scene(file), Error);
+  fs::remove(file);
+}
+
 TEST(SceneSchema, BadTeleopScenesAreRefusedByTheSchemaAndTheLoader) {
   struct Case {
     const char* name;
@@ -397,7 +463,7 @@ TEST(SceneSchema, BadTeleopScenesAreRefusedByTheSchemaAndTheLoader) {
        }},
   };
   const SchemaValidator v = schema();
-  const Json teleop = read_json(kScenes / "teleop.json");
+  const Json teleop = older_teleop_scene();
   const fs::path file = fs::temp_directory_path() / "hapsim_schema_bad_teleop.json";
   for (const Case& c : cases) {
     SCOPED_TRACE(c.name);

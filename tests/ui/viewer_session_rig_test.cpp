@@ -18,6 +18,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 #include <thread>
 
 namespace hapsim {
@@ -25,6 +27,15 @@ namespace {
 
 const std::filesystem::path kScene =
     std::filesystem::path(HAPSIM_SOURCE_DIR) / "scenes/teleop.json";
+
+const BodyDescription& body_named(const WorldDescription& world, const std::string& name) {
+  for (const BodyDescription& b : world.bodies) {
+    if (b.name == name) {
+      return b;
+    }
+  }
+  throw std::runtime_error("no body named " + name);
+}
 
 ViewerConfig config_for(const std::string& device) {
   ViewerConfig c;
@@ -98,8 +109,9 @@ TEST(TeleopViewerSession, ScriptedMasterRunsOnTheLoopAndFillsTheReadout) {
   ASSERT_NE(tool(r, "master hand"), nullptr);
   // The script hovers above the ball first: the tool is above it, within the reach of the arm.
   const Vec3 p_tool = tool(r, "slave tool")->p_world;
-  EXPECT_GT(p_tool.z(), scene.teleop.ball_start_m.z());
-  EXPECT_LT((p_tool - scene.teleop.ball_start_m).head<2>().norm(), 0.05);
+  const Vec3 ball_start = body_named(scene.world, "ball").X_world_body.translation();
+  EXPECT_GT(p_tool.z(), ball_start.z());
+  EXPECT_LT((p_tool - ball_start).head<2>().norm(), 0.05);
   EXPECT_GT(session->loop_status().cycles, 1000u);
   EXPECT_GT(session->render_scene().mesh_count(), 0u);
 
@@ -121,7 +133,7 @@ TEST(TeleopViewerSession, ScriptedMasterRunsOnTheLoopAndFillsTheReadout) {
 
 TEST(TeleopViewerSession, MouseProbeIsTheSlaveToolsTargetAndTheSlaveFollowsIt) {
   const SceneDescription scene = load_scene(kScene);
-  const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, false);
+  const TeleopSetup setup = make_rig_setup(scene, std::nullopt, false);
   const std::unique_ptr<ViewerSession> session = make_viewer_session(config_for("mouse"), scene);
   InteractiveDevice* mouse = session->mouse_device();
   ASSERT_NE(mouse, nullptr);
@@ -168,7 +180,7 @@ TEST(TeleopViewerSession, MouseProbeIsTheSlaveToolsTargetAndTheSlaveFollowsIt) {
 
 TEST(MasterHandMapping, HandLandsOnReachableProbePositionsAndGraspFollowsTheButton) {
   const SceneDescription scene = load_scene(kScene);
-  const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, false);
+  const TeleopSetup setup = make_rig_setup(scene, std::nullopt, false);
   const MasterArm master(rig_description(setup.description)->master);
   MasterHandMapping mapping(master, first_arm_rad(setup));
   const Vec3 p0 = master.hand_pose(first_arm_rad(setup)).translation();
@@ -213,7 +225,7 @@ TEST(MasterHandMapping, HandLandsOnReachableProbePositionsAndGraspFollowsTheButt
 
 TEST(MasterHandMapping, ConvertingAllocatesNothing) {
   const SceneDescription scene = load_scene(kScene);
-  const TeleopSetup setup = make_teleop_setup(scene, std::nullopt, false);
+  const TeleopSetup setup = make_rig_setup(scene, std::nullopt, false);
   const MasterArm master(rig_description(setup.description)->master);
   MasterHandMapping mapping(master, first_arm_rad(setup));
   const Vec3 p0 = master.hand_pose(first_arm_rad(setup)).translation();

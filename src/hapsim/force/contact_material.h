@@ -18,6 +18,18 @@ struct ContactMaterial {
   double dynamic_friction = 0.0;
 };
 
+/// A body that does not give (a material's `"rigid": true`, the teleoperation rig's ball): its
+/// stiffness and damping so far above any other body's that in series with another material the
+/// pair is that material's spring (1/(1/k + 1e-12) = k to 1e-9 relative at k = 5000 N/m). A tool
+/// pressing it feels the device's stiffest (effective_material clamps the stiffness to the
+/// device's rating and takes the passivity floor for the damping).
+inline constexpr double kRigidStiffness_n_per_m = 1e12;
+inline constexpr double kRigidDamping_n_s_per_m = 1e12;
+
+[[nodiscard]] constexpr bool is_rigid(const ContactMaterial& m) noexcept {
+  return m.stiffness_n_per_m >= kRigidStiffness_n_per_m;
+}
+
 }  // namespace hapsim
 
 namespace hapsim {

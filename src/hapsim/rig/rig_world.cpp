@@ -1,6 +1,7 @@
 #include "hapsim/rig/rig_world.h"
 
 #include "hapsim/core/error.h"
+#include "hapsim/force/contact_material.h"
 #include "hapsim/geometry/procedural.h"
 #include "hapsim/rig/rig_controller.h"
 
@@ -86,22 +87,20 @@ WorldDescription rig_world(TeleopRigDescription rig, std::string name) {
   WorldDescription d;
   d.name = std::move(name);
   // The ball is rigid: in series with it, each pair is the other body's spring.
-  ContactSpring rigid;
-  rigid.stiffness_n_per_m = 1e12;
-  rigid.damping_n_s_per_m = 1e12;
-  rigid.friction = 0.0;
-  d.materials = {spring_material("ball", rigid),
-                 spring_material("sheet", rig.environment.sheet_contact),
-                 spring_material("pad", rig.gripper.pad_contact, rig.gripper.max_force_n),
-                 spring_material("floor", rig.environment.floor_contact),
-                 spring_material("link", rig.gripper.pad_contact)};
+  MaterialDescription ball_material = spring_material("ball", ContactSpring{});
+  ball_material.contact.stiffness_n_per_m = kRigidStiffness_n_per_m;
+  ball_material.contact.damping_n_s_per_m = kRigidDamping_n_s_per_m;
+  ball_material.contact.static_friction = 0.0;
+  ball_material.contact.dynamic_friction = 0.0;
+  d.materials = {std::move(ball_material), spring_material("sheet", rig.environment.sheet_contact),
+                 spring_material("floor", rig.environment.floor_contact)};
   if (rig.environment.has_floor) {
     rig.floor_body = d.bodies.size();
     const Vec3 half(2.0, 2.0, 0.05);
     d.bodies.push_back(
         rig_body("floor", BodyKind::kStatic,
                  Iso3(Eigen::Translation3d(0.0, 0.0, rig.environment.floor_z_m - half.z())),
-                 make_box(half), 3));
+                 make_box(half), 2));
   }
   rig.sheet_body = d.bodies.size();
   BodyDescription sheet = rig_body("sheet", BodyKind::kDeformable, rig.environment.X_world_sheet,
@@ -120,9 +119,7 @@ WorldDescription rig_world(TeleopRigDescription rig, std::string name) {
   ball.rigid.inertia_kg_m2 = Mat3::Identity() * 0.4 * rig.ball.mass_kg * r * r;
   d.bodies.push_back(std::move(ball));
   d.gravity_m_per_s2 = rig.ball.gravity_m_per_s2;
-  add_slave_bodies(d, rig, 2, 4);
-  d.controller = std::make_shared<RigController>(std::move(rig));
-  return d;
+  return add_rig(std::move(d), std::move(rig));
 }
 
 WorldDescription add_rig(WorldDescription world, TeleopRigDescription rig) {

@@ -1,9 +1,10 @@
-// A world made of a teleoperation rig (the teleoperation scenes): the rig as the world's controller
-// (rig_controller.h), and as ordinary bodies its floor (static), sheet (deformable, Gaussian),
-// ball (dynamic sphere), gripper pads (kinematic boxes) and the slave's links, palm and stem
-// (kinematic: slave_shapes.h, at the slave's start joints), each with a penalty material made from
-// the rig's contact springs, so the ball meets them through the same contact code as every other
-// body.
+// A rig in a world (architecture.md#controllers): add_rig() appends the rig's gripper pads
+// (kinematic boxes) and the slave's links, palm and stem (kinematic: slave_shapes.h, at the
+// slave's start joints) to any world and makes the rig its controller (rig_controller.h). A scene
+// with a "rig" is built so (scene/teleop_setup.h). rig_world() builds the first paper's
+// pick-and-place world in code, for tests and benchmarks: its floor (static), sheet (deformable,
+// Gaussian) and ball (dynamic, rigid) as ordinary bodies with penalty materials from the rig's
+// contact springs, the rig added. scenes/teleop.json is the same world as a scene.
 #pragma once
 
 #include "hapsim/rig/rig_description.h"
@@ -13,7 +14,9 @@
 
 namespace hapsim {
 
-/// Throws hapsim::Error (RigController's) on a rig it cannot drive.
+/// The pick-and-place world of `rig` (its ball, sheet and floor options) with the rig added; the
+/// rig's ball, sheet and floor indices are set here. Throws hapsim::Error (RigController's) on a
+/// rig it cannot drive.
 [[nodiscard]] WorldDescription rig_world(TeleopRigDescription rig, std::string name = "teleop");
 
 /// A rig added to an existing world (a scene's `"rig"`, docs/scene-format.md): its gripper pads

@@ -118,15 +118,6 @@ void read_assessment(const SceneReader& reader, const JsonReader::Json& j, const
   if (j.contains("time_limit_s")) {
     a.time_limit_s = reader.number_in(j, ptr, "time_limit_s", 0.0, 0.0, 86400.0, "seconds", true);
   }
-  if (scene.is_teleop) {
-    for (const char* key : {"landmarks", "limits"}) {
-      if (j.contains(key)) {
-        reader.fail(JsonReader::at(ptr, key),
-                    "a teleoperation scene is judged by its pick-and-place (docs/assessment.md); "
-                    "landmarks and limits name a haptic world's segments");
-      }
-    }
-  }
   if (j.contains("landmarks")) {
     const std::string lp = JsonReader::at(ptr, "landmarks");
     const JsonReader::Json& list = reader.array(j["landmarks"], lp, "a list of landmarks");

@@ -187,6 +187,51 @@ void read_glove_pick_and_place(const SceneReader& r, const Json& j, const std::s
   }
 }
 
+// A rig's device: the simulated master arm, played from a trajectory of its joints or scripted
+// (a pick-and-place of the rig's ball, or a palpation carried by the slave's tool).
+void read_rig_master(const SceneReader& r, const Json& j, const std::string& ptr,
+                     DeviceDescription& d) {
+  for (const char* key :
+       {"profile", "calibration", "hand", "glove_palpation", "glove_pick_and_place"}) {
+    if (j.contains(key)) {
+      r.fail(JsonReader::at(ptr, key),
+             "a rig's device is its simulated master arm: no '" + std::string(key) + "'");
+    }
+  }
+  if (d.type != "simulated") {
+    r.fail(JsonReader::at(ptr, "type"), "a rig's device is its master arm: \"simulated\"");
+  }
+  d.profile = "simulated";
+  const int scripts = static_cast<int>(j.contains("trajectory")) +
+                      static_cast<int>(j.contains("pick_and_place")) +
+                      static_cast<int>(j.contains("palpation"));
+  if (scripts != 1) {
+    r.fail(ptr,
+           "expected exactly one of 'trajectory' (a CSV of master joints j0..j2 and fingers f0, "
+           "f1), 'pick_and_place' or 'palpation' (a script)");
+  }
+  if (j.contains("trajectory")) {
+    // Not needed when the command plays another (--device sim:FILE).
+    const std::string tp = JsonReader::at(ptr, "trajectory");
+    d.trajectory_file = r.options().device_trajectory_played
+                            ? r.existing_file(j["trajectory"], tp, "a trajectory CSV path")
+                            : r.path(j["trajectory"], tp, "a trajectory CSV path");
+    return;
+  }
+  if (j.contains("palpation")) {
+    read_palpation(r, j["palpation"], JsonReader::at(ptr, "palpation"), d);
+    return;
+  }
+  const std::string pp = JsonReader::at(ptr, "pick_and_place");
+  const Json& p = r.object(j["pick_and_place"], pp, "a pick-and-place script");
+  r.allow_keys(p, pp, {"place_m", "clearance_m", "carry_s"});
+  d.has_pick_and_place = true;
+  PickAndPlaceDescription& s = d.pick_and_place;
+  s.place_m = r.vec3(r.required(p, pp, "place_m"), JsonReader::at(pp, "place_m"), "m");
+  s.clearance_m = r.number_in(p, pp, "clearance_m", s.clearance_m, 0.0, 1.0, "m", true);
+  s.carry_s = r.number_in(p, pp, "carry_s", s.carry_s, 0.0, 60.0, "seconds", true);
+}
+
 }  // namespace
 
 void read_device(const SceneReader& r, const Json& j, const std::string& ptr,
@@ -194,12 +239,20 @@ void read_device(const SceneReader& r, const Json& j, const std::string& ptr,
   r.object(j, ptr, "the device");
   r.allow_keys(j, ptr,
                {"type", "profile", "trajectory", "calibration", "palpation", "hand",
-                "glove_palpation", "glove_pick_and_place"});
+                "glove_palpation", "glove_pick_and_place", "pick_and_place"});
   DeviceDescription& d = scene.device;
   if (j.contains("type")) {
     d.type = r.one_of(j["type"], JsonReader::at(ptr, "type"), {"simulated", "glove"});
   }
   const bool glove = d.type == "glove";
+  if (scene.has_rig) {
+    read_rig_master(r, j, ptr, d);
+    return;
+  }
+  if (j.contains("pick_and_place")) {
+    r.fail(JsonReader::at(ptr, "pick_and_place"),
+           "a pick-and-place script moves a rig's master arm: the scene needs a \"rig\"");
+  }
   if (!glove &&
       (j.contains("hand") || j.contains("glove_palpation") || j.contains("glove_pick_and_place"))) {
     r.fail(ptr, "'hand', 'glove_palpation' and 'glove_pick_and_place' need \"type\": \"glove\"");

@@ -1,8 +1,8 @@
 // The "device" of a haptic-world scene file (docs/scene-format.md, "Device", "Glove", "Palpation
 // script"): its type and profile, and what drives it — a trajectory CSV, a palpation script
-// aimed at named segments, or, for a glove, the hand's settings and a glove palpation.
-// (A teleoperation scene's master device is read by teleop_reader.h.) Every error is a
-// hapsim::Error at "<file>:<JSON pointer>" of the offending value.
+// aimed at named segments, or, for a glove, the hand's settings and a glove palpation; for a
+// scene with a "rig", its master arm (a trajectory, a pick-and-place or a palpation). Every error
+// is a hapsim::Error at "<file>:<JSON pointer>" of the offending value.
 #pragma once
 
 #include "hapsim/scene/scene_description.h"

@@ -198,11 +198,7 @@ BodyGeometry GeometryReader::read(const Json& j, const std::string& ptr,
     o.resolution_scale = capped(o.resolution_scale, caps.knee_resolution_scale,
                                 JsonReader::at(ptr, "resolution_scale"));
     if (j.contains("include_skin")) {
-      if (!j["include_skin"].is_boolean()) {
-        r_.fail(JsonReader::at(ptr, "include_skin"),
-                "expected true or false, got " + JsonReader::shown(j["include_skin"]));
-      }
-      o.include_skin = j["include_skin"].get<bool>();
+      o.include_skin = r_.boolean(j["include_skin"], JsonReader::at(ptr, "include_skin"));
     }
     report_progress(progress, "scene: generating the procedural knee", 0.0);
     for (KneePart& part : make_procedural_knee(o)) {

@@ -150,6 +150,13 @@ double JsonReader::number_in(const Json& obj, const std::string& ptr, const char
   return v;
 }
 
+bool JsonReader::boolean(const Json& j, const std::string& ptr) const {
+  if (!j.is_boolean()) {
+    fail(ptr, "expected true or false, got " + shown(j));
+  }
+  return j.get<bool>();
+}
+
 std::string JsonReader::string(const Json& j, const std::string& ptr,
                                const std::string& what) const {
   if (!j.is_string()) {

@@ -51,6 +51,8 @@ class JsonReader {
   [[nodiscard]] double number_in(const Json& obj, const std::string& ptr, const char* key,
                                  double fallback, double lo, double hi, const std::string& unit,
                                  bool lo_open = false, bool inf_allowed = false) const;
+  /// `j` if it is true or false.
+  [[nodiscard]] bool boolean(const Json& j, const std::string& ptr) const;
   [[nodiscard]] std::string string(const Json& j, const std::string& ptr,
                                    const std::string& what) const;
   [[nodiscard]] std::string nonempty_string(const Json& j, const std::string& ptr,

@@ -59,11 +59,10 @@ RunSetup make_run_setup(SceneDescription scene, const DeviceChoice& choice,
           ? std::optional<std::filesystem::path>(choice.file)
           : std::nullopt;
   std::optional<TeleopSetup> teleop;
-  if (scene.is_teleop || scene.has_rig) {
-    // The master arm: the world is the rig (and the scene's bodies); the slave starts where the
-    // master's first pose puts it (make_teleop_setup and make_rig_setup solve that once).
-    teleop = scene.has_rig ? make_rig_setup(scene, trajectory, options.load_link_meshes)
-                           : make_teleop_setup(scene, trajectory, options.load_link_meshes);
+  if (scene.has_rig) {
+    // The master arm: the world is the scene's bodies and the rig's; the slave starts where the
+    // master's first pose puts it (make_rig_setup solves that once).
+    teleop = make_rig_setup(scene, trajectory, options.load_link_meshes);
     r.profile = &device_profile("simulated");
     r.world = std::make_unique<World>(teleop->description);
     r.slave_name = teleop->slave_name;

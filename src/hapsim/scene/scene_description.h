@@ -46,7 +46,8 @@ struct DeviceDescription {
   std::optional<GloveCalibration> glove_calibration;
 };
 
-/// A teleoperation scene (000): master arm → slave arm with a parallel gripper → ball → sheet.
+/// A scene's "rig" (docs/scene-format.md#rigs, SceneDescription::has_rig): the teleoperation set-up
+/// of paper 000, a master arm driving a slave arm with a parallel gripper.
 struct TeleopSceneDescription {
   /// Empty: the procedural Motoman; else a URDF file and its tip link (empty: the deepest).
   std::filesystem::path slave_urdf;
@@ -56,16 +57,8 @@ struct TeleopSceneDescription {
   double gripper_max_force_n = 20.0;
   double gripper_max_width_m = 0.10;
   double gripper_speed_m_per_s = 0.25;
-  double ball_mass_kg = 0.1;
-  double ball_radius_m = 0.03;
-  Vec3 ball_start_m = Vec3(0.5, -0.25, 0.03);
-  int sheet_nodes_per_side = 16;
-  double sheet_size_m = 0.2;
-  Vec3 sheet_position_m = Vec3(0.5, 0.25, 0.05);
-  double floor_z_m = 0.0;
-  /// A "rig" section (SceneDescription::has_rig): the scene's bodies it reads (empty: none) and
-  /// the tool the slave carries (empty: none), by name; how the force at the slave's tool is
-  /// scaled onto the master's hand.
+  /// The scene's bodies the rig reads (empty: none) and the tool the slave carries (empty: none),
+  /// by name; how the force at the slave's tool is scaled onto the master's hand.
   std::string ball_body;
   std::string sheet_body;
   std::string floor_body;
@@ -92,10 +85,9 @@ struct SceneView {
 struct SceneDescription {
   std::filesystem::path file;  // where it was read from (empty when built in code)
   std::string description;
-  /// Set for a teleoperation scene (the "teleop" dialect); then `world` is empty.
-  bool is_teleop = false;
-  /// Set for a scene with a "rig" beside its bodies and tools: `teleop` holds the rig, `world` the
-  /// rest (the run adds the rig's bodies, scene/teleop_setup.h).
+  /// Set for a scene with a "rig" beside its bodies and tools (also an older "teleop" file, read
+  /// as one): `teleop` holds the rig, `world` the rest (the run adds the rig's bodies,
+  /// scene/teleop_setup.h).
   bool has_rig = false;
   TeleopSceneDescription teleop;
   WorldDescription world;

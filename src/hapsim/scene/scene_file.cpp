@@ -3,14 +3,16 @@
 #include "hapsim/core/device_io.h"
 #include "hapsim/core/error.h"
 #include "hapsim/core/text_file.h"
+#include "hapsim/force/contact_material.h"
 #include "hapsim/geometry/mass_properties.h"
 #include "hapsim/scene/assessment_reader.h"
 #include "hapsim/scene/device_reader.h"
 #include "hapsim/scene/fem_reader.h"
 #include "hapsim/scene/geometry_reader.h"
 #include "hapsim/scene/json_text.h"
+#include "hapsim/scene/rig_reader.h"
 #include "hapsim/scene/scene_reader.h"
-#include "hapsim/scene/teleop_reader.h"
+#include "hapsim/scene/teleop_dialect.h"
 #include "hapsim/scene/view_reader.h"
 #include "hapsim/world/fem_coupling.h"
 
@@ -35,8 +37,8 @@ using Json = nlohmann::json;
 constexpr std::size_t kMaxSceneFileBytes = std::size_t{64} << 20;
 
 // The parser of the top level, materials, bodies, tools and run; the parts have their own readers
-// (geometry_reader.h, device_reader.h, teleop_reader.h). It carries the file name for messages,
-// the folders paths resolve against (SceneReader), and the materials read so far for
+// (geometry_reader.h, device_reader.h, rig_reader.h, teleop_dialect.h). It carries the file name
+// for messages, the folders paths resolve against (SceneReader), and the materials read so far for
 // cross-references.
 class Parser : public SceneReader {
  public:
@@ -65,16 +67,15 @@ class Parser : public SceneReader {
 
 SceneDescription Parser::parse(const Json& root) {
   object(root, "", "a scene");
-  const bool teleop = root.is_object() && root.contains("teleop");
-  if (teleop) {
-    allow_keys(root, "",
-               {"$schema", "format", "description", "data", "teleop", "device", "run", "views",
-                "assessment"});
-  } else {
-    allow_keys(root, "",
-               {"$schema", "format", "description", "data", "world", "materials", "bodies", "tools",
-                "rig", "device", "run", "views", "assessment"});
+  if (root.contains("teleop")) {
+    // The older rig dialect: the same scene in the one language, with a note saying so.
+    SceneDescription scene = parse(convert_teleop_scene(*this, root));
+    scene.warnings.insert(scene.warnings.begin(), teleop_dialect_note(file_.string()));
+    return scene;
   }
+  allow_keys(root, "",
+             {"$schema", "format", "description", "data", "world", "materials", "bodies", "tools",
+              "rig", "device", "run", "views", "assessment"});
   const Json& format = required(root, "", "format");
   if (!format.is_string() || format.get<std::string>() != "hapsim-scene/1") {
     fail("/format", "expected \"hapsim-scene/1\", got " + shown(format));
@@ -91,17 +92,6 @@ SceneDescription Parser::parse(const Json& root) {
                                      "a folder under the data root"));
   }
   scene.world.name = file_.stem().string();
-  if (teleop) {
-    scene.is_teleop = true;
-    read_teleop(*this, root["teleop"], "/teleop", scene.teleop);
-    read_teleop_device(*this, required(root, "", "device"), "/device", scene.device);
-    parse_run(root, scene);
-    if (root.contains("assessment")) {
-      read_assessment(*this, root["assessment"], "/assessment", scene);
-    }
-    report_progress(options().progress, "scene: loaded", 1.0);
-    return scene;
-  }
   if (root.contains("world")) {
     const Json& w = object(root["world"], "/world", "world settings");
     allow_keys(w, "/world", {"name", "passivity_damping_factor", "gravity_m_per_s2"});
@@ -154,8 +144,12 @@ SceneDescription Parser::parse(const Json& root) {
     }
   }
 
-  const Json& tools = array(required(root, "", "tools"), "/tools", "a list of tools");
-  if (tools.empty()) {
+  // A rig's device is its master arm, which drives the slave: the rig needs no tool.
+  const Json no_tools = Json::array();
+  const Json& tools = root.contains("rig") && !root.contains("tools")
+                          ? no_tools
+                          : array(required(root, "", "tools"), "/tools", "a list of tools");
+  if (tools.empty() && !root.contains("rig")) {
     fail("/tools", "expected at least one tool (the device drives its tools)");
   }
   std::set<std::string> tool_names;
@@ -220,10 +214,10 @@ void Parser::parse_materials(const Json& j, const std::string& ptr, WorldDescrip
   for (const auto& [name, m] : j.items()) {
     const std::string p = at(ptr, name);
     object(m, p, "a material");
-    allow_keys(
-        m, p,
-        {"description", "response", "stiffness_n_per_m", "max_penetration_m", "max_force_n",
-         "damping_n_s_per_m", "static_friction", "dynamic_friction", "deformation", "opacity"});
+    allow_keys(m, p,
+               {"description", "response", "rigid", "stiffness_n_per_m", "max_penetration_m",
+                "max_force_n", "damping_n_s_per_m", "static_friction", "dynamic_friction",
+                "deformation", "opacity"});
     MaterialDescription md;
     md.name = name;
     if (m.contains("response")) {
@@ -239,6 +233,20 @@ void Parser::parse_materials(const Json& j, const std::string& ptr, WorldDescrip
     c.max_force_n = number_in(m, p, "max_force_n", c.max_force_n, 0.0, 1e4, "N", true);
     c.damping_n_s_per_m =
         number_in(m, p, "damping_n_s_per_m", c.damping_n_s_per_m, 0.0, 1e5, "N*s/m");
+    if (m.contains("rigid") && boolean(m["rigid"], at(p, "rigid"))) {
+      // A body that does not give: against another body the contact is the other's spring.
+      for (const char* key : {"stiffness_n_per_m", "damping_n_s_per_m", "deformation"}) {
+        if (m.contains(key)) {
+          fail(at(p, key), "a rigid material has no " + std::string(key) +
+                               ": against another body the contact is that body's spring");
+        }
+      }
+      if (md.response != ContactResponse::kPenalty) {
+        fail(at(p, "rigid"), "a rigid material needs \"response\": \"penalty\"");
+      }
+      c.stiffness_n_per_m = kRigidStiffness_n_per_m;
+      c.damping_n_s_per_m = kRigidDamping_n_s_per_m;
+    }
     c.static_friction = number_in(m, p, "static_friction", c.static_friction, 0.0, 10.0, "");
     c.dynamic_friction = number_in(m, p, "dynamic_friction", c.dynamic_friction, 0.0, 10.0, "");
     if (c.dynamic_friction > c.static_friction) {

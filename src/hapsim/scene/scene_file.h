@@ -2,11 +2,12 @@
 // into a SceneDescription: materials, bodies and their geometry (procedural knee, box, sphere,
 // sheet, a mesh file, a folder of mesh files (one segment each), a CSG solid, or a FEM body's
 // volume: a tet_block or tet_mesh with its "fem" settings in fem_reader.h), tools, the
-// device and the run; or, for a teleoperation scene, the rig and its master device. This file
-// reads the top level, materials, bodies, tools and run; the parts have their own readers on the
-// same SceneReader (scene_reader.h: JSON pointers in errors, paths): geometry_reader.h (a body's
-// geometry into segments; CSG solids in csg_reader.h), device_reader.h (the device, palpation and
-// glove palpation scripts) and teleop_reader.h (the teleoperation branch).
+// device and the run, and a robot "rig" beside them. This file reads the top level, materials,
+// bodies, tools and run; the parts have their own readers on the same SceneReader
+// (scene_reader.h: JSON pointers in errors, paths): geometry_reader.h (a body's geometry into
+// segments; CSG solids in csg_reader.h), device_reader.h (the device, palpation and glove
+// palpation scripts, a rig's master), rig_reader.h (the rig) and teleop_dialect.h (the older
+// "teleop" files, converted on read with a note).
 // Every error is a hapsim::Error whose where() is "<file>:<JSON pointer>" and whose message
 // says what was expected; unknown keys are errors; a load either returns a complete description
 // or throws (nothing half-loads).

@@ -2,7 +2,7 @@
 // where the scene's paths point — relative to the scene file's folder, absolute, or "data:REL"
 // under the scene's data folder (docs/scene-format.md, "Paths") — and the load's options
 // (progress). scene_file.cpp reads the top level with it; the readers of a scene's parts
-// (geometry_reader.h, device_reader.h, teleop_reader.h, csg_reader.h) take it, so a path or a
+// (geometry_reader.h, device_reader.h, rig_reader.h, csg_reader.h) take it, so a path or a
 // number fails the same way wherever it appears.
 #pragma once
 

@@ -12,6 +12,7 @@
 #include "hapsim/script/teleop_probe_plan.h"
 #include "hapsim/world/world.h"
 
+#include <algorithm>
 #include <memory>
 #include <utility>
 
@@ -19,7 +20,18 @@ namespace hapsim {
 
 namespace {
 
-// The rig a scene describes: its slave (procedural or URDF), mapping, gripper, ball and sheet.
+std::size_t body_index(const WorldDescription& w, const std::string& name) {
+  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
+    if (w.bodies[b].name == name) {
+      return b;
+    }
+  }
+  return TeleopRigDescription::kNoBody;
+}
+
+// The rig a scene describes: its slave (procedural or URDF), mapping and gripper, and the scene's
+// bodies and tool it reads; the ball's size, mass and start and the sheet's grid and pose are
+// those of their bodies (scene/rig_reader.h checked the ball is a sphere, the sheet a sheet).
 TeleopRigDescription rig_from_scene(const SceneDescription& scene, bool load_link_meshes) {
   const TeleopSceneDescription& t = scene.teleop;
   TeleopRigDescription d;
@@ -36,24 +48,42 @@ TeleopRigDescription rig_from_scene(const SceneDescription& scene, bool load_lin
   d.gripper.max_force_n = t.gripper_max_force_n;
   d.follower.gripper_max_width_m = t.gripper_max_width_m;
   d.follower.gripper_speed_m_per_s = t.gripper_speed_m_per_s;
-  d.ball.mass_kg = t.ball_mass_kg;
-  d.ball.radius_m = t.ball_radius_m;
-  d.ball_start_world = t.ball_start_m;
-  d.sheet.nodes_per_side = t.sheet_nodes_per_side;
-  d.sheet.side_m = t.sheet_size_m;
-  d.environment.X_world_sheet = Iso3(Eigen::Translation3d(t.sheet_position_m));
-  d.environment.floor_z_m = t.floor_z_m;
   d.force_scale = t.force_scale;
-  return d;
-}
-
-std::size_t body_index(const WorldDescription& w, const std::string& name) {
-  for (std::size_t b = 0; b < w.bodies.size(); ++b) {
-    if (w.bodies[b].name == name) {
-      return b;
+  const WorldDescription& w = scene.world;
+  d.ball_body = t.ball_body.empty() ? TeleopRigDescription::kNoBody : body_index(w, t.ball_body);
+  d.sheet_body = t.sheet_body.empty() ? TeleopRigDescription::kNoBody : body_index(w, t.sheet_body);
+  d.floor_body = t.floor_body.empty() ? TeleopRigDescription::kNoBody : body_index(w, t.floor_body);
+  d.ball.gravity_m_per_s2 = w.gravity_m_per_s2;
+  if (d.ball_body != TeleopRigDescription::kNoBody) {
+    const BodyDescription& ball = w.bodies[d.ball_body];
+    const ExactSphere& sphere = *ball.segments.front().sphere;
+    d.ball.mass_kg = ball.rigid.mass_kg;
+    d.ball.radius_m = sphere.radius_m;
+    d.ball_start_world = ball.X_world_body * sphere.center_body;
+  }
+  // The floor the viewer stands the master on: the top of the floor body, if any.
+  d.environment.has_floor = d.floor_body != TeleopRigDescription::kNoBody;
+  if (d.environment.has_floor) {
+    const BodyDescription& floor = w.bodies[d.floor_body];
+    double top_z = -kInf;
+    for (const SegmentDescription& segment : floor.segments) {
+      for (const Vec3& p_body : segment.mesh.vertices) {
+        top_z = std::max(top_z, (floor.X_world_body * p_body).z());
+      }
+    }
+    d.environment.floor_z_m = top_z;
+  }
+  if (d.sheet_body != TeleopRigDescription::kNoBody) {
+    const BodyDescription& sheet = w.bodies[d.sheet_body];
+    d.sheet = sheet.sheet;
+    d.environment.X_world_sheet = sheet.X_world_body;
+  }
+  for (std::size_t i = 0; i < w.tools.size(); ++i) {
+    if (!t.carried_tool.empty() && w.tools[i].name == t.carried_tool) {
+      d.carried_tool = i;
     }
   }
-  return TeleopRigDescription::kNoBody;
+  return d;
 }
 
 // The master's scripted tele-palpation: the scene's palpation planned for the carried tool's
@@ -102,60 +132,34 @@ Trajectory master_trajectory_file(const std::filesystem::path& file) {
 
 }  // namespace
 
-TeleopSetup make_teleop_setup(const SceneDescription& scene,
-                              const std::optional<std::filesystem::path>& trajectory,
-                              bool load_link_meshes) {
-  TeleopSetup s;
-  TeleopRigDescription d = rig_from_scene(scene, load_link_meshes);
-  const MasterArm master(d.master);
-  if (trajectory || !scene.device.has_pick_and_place) {
-    const std::filesystem::path file = trajectory ? *trajectory : scene.device.trajectory_file;
-    s.trajectory = master_trajectory_file(file);
-    s.device_name = "simulated master (trajectory " + file.string() + ")";
-  } else {
-    s.trajectory = make_teleop_pick_and_place(scene.device.pick_and_place, d, master).trajectory;
-    s.has_target = true;
-    s.target_world = scene.device.pick_and_place.place_m;
-    s.device_name = "simulated master (scripted pick-and-place)";
-  }
-
-  solve_start(scene, d, master, s.trajectory);
-  s.slave_name =
-      scene.teleop.slave_urdf.empty() ? "procedural Motoman" : scene.teleop.slave_urdf.string();
-  // Built with the start joints: the slave's bodies start where its follower does.
-  s.description = rig_world(std::move(d));
-  return s;
-}
-
 TeleopSetup make_rig_setup(const SceneDescription& scene,
                            const std::optional<std::filesystem::path>& trajectory,
                            bool load_link_meshes) {
   TeleopSetup s;
   TeleopRigDescription d = rig_from_scene(scene, load_link_meshes);
   const TeleopSceneDescription& t = scene.teleop;
-  d.ball_body =
-      t.ball_body.empty() ? TeleopRigDescription::kNoBody : body_index(scene.world, t.ball_body);
-  d.sheet_body =
-      t.sheet_body.empty() ? TeleopRigDescription::kNoBody : body_index(scene.world, t.sheet_body);
-  d.floor_body =
-      t.floor_body.empty() ? TeleopRigDescription::kNoBody : body_index(scene.world, t.floor_body);
-  for (std::size_t i = 0; i < scene.world.tools.size(); ++i) {
-    if (!t.carried_tool.empty() && scene.world.tools[i].name == t.carried_tool) {
-      d.carried_tool = i;
-    }
-  }
   const MasterArm master(d.master);
   if (trajectory || !scene.device.trajectory_file.empty()) {
     const std::filesystem::path file = trajectory ? *trajectory : scene.device.trajectory_file;
     s.trajectory = master_trajectory_file(file);
     s.device_name = "simulated master (trajectory " + file.string() + ")";
+  } else if (scene.device.has_pick_and_place) {
+    if (d.ball_body == TeleopRigDescription::kNoBody) {
+      throw Error(scene.file.string() + ":/device/pick_and_place",
+                  "a pick-and-place needs the rig's 'ball' (a dynamic sphere it picks)");
+    }
+    s.trajectory = make_teleop_pick_and_place(scene.device.pick_and_place, d, master).trajectory;
+    s.has_target = true;
+    s.target_world = scene.device.pick_and_place.place_m;
+    s.device_name = "simulated master (scripted pick-and-place)";
   } else if (scene.device.has_palpation) {
     s.trajectory = rig_palpation(scene, d, master);
     s.device_name = "simulated master (scripted tele-palpation)";
   } else {
     throw Error(scene.file.string() + ":/device",
-                "a rig scene's device is the master: give it a 'trajectory' of master joints "
-                "or a 'palpation' script for the tool the slave carries");
+                "a rig scene's device is the master: give it a 'trajectory' of master joints, a "
+                "'pick_and_place' of the rig's ball or a 'palpation' script for the tool the "
+                "slave carries");
   }
   solve_start(scene, d, master, s.trajectory);
   s.slave_name = t.slave_urdf.empty() ? "procedural Motoman" : t.slave_urdf.string();

@@ -1,5 +1,5 @@
 // The teleoperation scene's scripted master planned on its rig: the scene's pick-and-place
-// (PickAndPlaceDescription, read by scene/teleop_reader.h) turned into the master's trajectory by
+// (PickAndPlaceDescription, read by scene/device_reader.h) turned into the master's trajectory by
 // script/pick_and_place_trajectory.h, picking the ball where the rig starts it with the rig's own
 // gripper geometry. scene/teleop_setup.h chooses it when the scene has no trajectory file.
 #pragma once

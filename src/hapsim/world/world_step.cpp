@@ -13,6 +13,11 @@ namespace hapsim {
 ContactMaterial effective_material(const WorldModel& model, const ContactMaterial& contact,
                                    double dt_s) noexcept {
   ContactMaterial m = contact;
+  if (is_rigid(contact)) {
+    // Its 1e12 N·s/m is for the body-pair series law; a tool feels the device's stiffest spring,
+    // damped by the passivity floor.
+    m.damping_n_s_per_m = 0.0;
+  }
   m.stiffness_n_per_m = std::min(m.stiffness_n_per_m, model.options().max_stiffness_n_per_m);
   m.damping_n_s_per_m =
       std::max(m.damping_n_s_per_m,
