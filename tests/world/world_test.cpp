@@ -465,6 +465,26 @@ TEST(World, DampingNeverBelowThePassivityFloor) {
   EXPECT_EQ(world.effective_material(0, 1e-5).damping_n_s_per_m, 0.1);  // material's own wins
 }
 
+// A rigid material (the rig's ball, kRigidStiffness_n_per_m) pressed by a tool: the device's
+// stiffest spring, damped by the passivity floor, not by the 1e12 N*s/m meant for body pairs; a
+// press moving 0.1 m/s into it stays a few newtons.
+TEST(World, ARigidMaterialUnderAToolIsTheDevicesStiffestSpring) {
+  WorldDescription w = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0);
+  w.materials[0].contact.stiffness_n_per_m = kRigidStiffness_n_per_m;
+  w.materials[0].contact.damping_n_s_per_m = kRigidDamping_n_s_per_m;
+  w.materials[0].contact.max_force_n = 1e4;
+  w.passivity_damping_factor = 1.0;
+  World world(std::move(w), WorldOptions{.max_stiffness_n_per_m = 400.0});
+  const ContactMaterial m = world.effective_material(0, 1e-3);
+  EXPECT_EQ(m.stiffness_n_per_m, 400.0);
+  EXPECT_NEAR(m.damping_n_s_per_m, 0.4, 1e-15);  // the floor k·T
+  world.step(at(Vec3(0, 0, -0.0019)), 1e-3);
+  const StepResult& r = world.step(at(Vec3(0, 0, -0.002)), 1e-3);
+  EXPECT_TRUE(r.command.force_world_n.allFinite());
+  EXPECT_GT(r.command.force_world_n.z(), 0.5);
+  EXPECT_LT(r.command.force_world_n.z(), 2.0);
+}
+
 TEST(World, FingerToolsDriveFingerChannels) {
   WorldDescription w = box_world(ContactResponse::kPenalty, 0.02, BodyKind::kStatic, 0.0);
   w.tools[0].finger = 1;
