@@ -25,6 +25,7 @@
 #include "hapsim/net/scene_info.h"
 #include "hapsim/net/security_key_dir.h"
 #include "hapsim/net/served_scene.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/runtime/deadline_clock.h"
 #include "hapsim/runtime/haptic_loop.h"
 #include "hapsim/scene/run_setup.h"
@@ -255,6 +256,41 @@ HostDevice open_device(const DeviceArgs& args) {
                      ": expected sim, spacemouse, legacy-glove:PORT or plugin:PATH.so");
 }
 
+// A served rig: this host is its master arm (net/device_host_client.h). A simulated master has
+// the served world already (its script was planned on it); any other device builds it here.
+void use_served_rig(const DeviceArgs& args, const net::SceneInfoSample& info, HostDevice& host,
+                    net::DeviceHostOptions& options) {
+  if (!host.setup) {
+    SceneLoadOptions load;
+    const std::string folder = !args.data_dir.empty() ? args.data_dir : info.data_dir;
+    if (!folder.empty()) {
+      load.data_dir = folder;
+    }
+    if (!parse_scene(info.scene_json, info.scene_file, load).has_rig) {
+      return;
+    }
+    host.setup.emplace(net::build_served_scene(info, DeviceChoice::external(), args.data_dir));
+  }
+  const WorldDescription& world = host.setup->world->description();
+  const RigController* rig = rig_controller(world);
+  if (rig == nullptr) {
+    return;
+  }
+  options.rig = std::static_pointer_cast<const RigController>(world.controller);
+  const std::size_t carried = rig->description().carried_tool;
+  if (carried < world.tools.size()) {
+    options.rig_tool_flange_m = world.tools[carried].offset_device;
+    std::printf(
+        "master arm   of the served rig: tool '%s' at the slave's flange, its force felt "
+        "through the master's joints\n",
+        world.tools[carried].name.c_str());
+  } else {
+    std::printf(
+        "master arm   of the served rig: it carries no tool, so nothing is felt here (the "
+        "gripper's pads are not served as contact models)\n");
+  }
+}
+
 struct Silence {
   double since_s = 0.0;         ///< host clock, from the device's start
   double force_before_n = 0.0;  ///< rendered with the last model
@@ -352,6 +388,7 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
   if (profile.max_damping_n_s_per_m > 0.0) {
     options.passivity.max_damping_n_s_per_m = profile.max_damping_n_s_per_m;
   }
+  use_served_rig(args, *info, host, options);
   net::DeviceHostClient client(participant, options);
   client.set_scene(part.scene);
 
@@ -507,6 +544,11 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
               " cycles (%.3f mJ taken out)\n",
               s.peak_force_n, s.rate_limited_cycles, st.clamped_cycles, s.passivity_cycles,
               s.passivity_dissipated_j * 1e3);
+  if (options.rig) {
+    std::printf(
+        "master arm   peak joint torque %.3f N m (the carried tool's force through its Jt)\n",
+        s.peak_joint_torque_nm);
+  }
   std::printf("models       %" PRIu64 " rendered (%" PRIu64 " answering the script, not us);",
               s.models_accepted, s.models_not_ours);
   for (std::size_t v = 0; v < net::kSampleVerdicts; ++v) {
@@ -525,6 +567,9 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     j["cycles"] = st.cycles;
     j["realtime"] = realtime_json(rt);
     j["peak_force_n"] = s.peak_force_n;
+    if (options.rig) {
+      j["peak_joint_torque_nm"] = s.peak_joint_torque_nm;
+    }
     j["rate_limited_cycles"] = s.rate_limited_cycles;
     j["passivity"] = {{"cycles_acted", s.passivity_cycles},
                       {"dissipated_j", s.passivity_dissipated_j}};

@@ -30,7 +30,6 @@
 #include "hapsim/net/scene_info.h"
 #include "hapsim/net/topic_writer.h"
 #include "hapsim/net/view_state_codec.h"
-#include "hapsim/rig/rig_controller.h"
 #include "hapsim/runtime/session.h"
 #include "hapsim/runtime/session_json.h"
 #include "hapsim/scene/run_setup.h"
@@ -247,9 +246,6 @@ void serve(const ServeArgs& args, JsonOutput& json_out) {
   RunSetup setup =
       make_run_setup(load_scene(args.scene, load_options), DeviceChoice::scene_script());
   World& world = *setup.world;
-  if (rig_state(world) != nullptr) {
-    throw CommandError(args.scene + ": a teleoperation rig is not served over the network yet");
-  }
   // A recording replays at the scene's run.dt_s (hapsim run --replay): serve must step at it.
   if (!args.record_path.empty() && std::abs(args.rate_hz * setup.scene.run.dt_s - 1.0) > 1e-9) {
     char text[160];

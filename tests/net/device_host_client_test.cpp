@@ -4,13 +4,17 @@
 // since (against the analytic value), after the blend-in; a model answering the simulation's own
 // script (device sequence 0) is never rendered; and the cycle allocates nothing.
 #include "hapsim/net/device_host_client.h"
+#include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/net/device_state_gate.h"
 #include "hapsim/net/local_model_codec.h"
+#include "hapsim/rig/rig_controller.h"
 
 #include "net/net_test_support.h"
 #include "support/allocation_counter.h"
 
+#include <array>
 #include <chrono>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
@@ -206,6 +210,110 @@ TEST_F(GloveHostTest, AFingerToolRendersIntoItsFingerAtTheFingersRating) {
 // Two device hosts on one device id (a second `hapsim device --name trainee`): each numbers its
 // states from its own random base, so the models answering the first host's states are the
 // second's "another host's", refused and counted, never rendered; the first renders them.
+// A rig's master arm (DeviceHostOptions::rig): its one tool is the tool the slave carries, placed
+// where the slave's target puts it for the master's joints; the force rendered there reaches the
+// master as the rig's own command makes it (RigController::master_command: Jᵀ), no tip force, and
+// the state tells the simulation that force as the push its tissue takes.
+class RigMasterHostTest : public DeviceHostClientTest {
+ protected:
+  [[nodiscard]] DeviceHostOptions options() const override {
+    DeviceHostOptions o;
+    o.rig = rig;
+    o.rig_tool_flange_m = kToolInFlange;
+    return o;
+  }
+
+  static std::shared_ptr<const RigController> make_rig() {
+    TeleopRigDescription d;
+    d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
+    return std::make_shared<const RigController>(std::move(d));
+  }
+
+  DeviceInput master(const std::array<double, 3>& arm_rad) const {
+    DeviceInput in;
+    in.healthy = true;
+    in.joint_count = 3;
+    in.finger_count = 2;
+    for (std::size_t i = 0; i < 3; ++i) {
+      in.joint_rad[i] = arm_rad[i];
+    }
+    return in;
+  }
+
+  const DeviceCommand& master_cycle(const std::array<double, 3>& arm_rad) {
+    input = master(arm_rad);
+    const DeviceCommand& command = client->step(input, 0.001);
+    HapticCycle c;
+    c.input = &input;
+    c.output = &command;
+    client->after_cycle(c);
+    return command;
+  }
+
+  inline static const Vec3 kToolInFlange{0.0, 0.0, 0.1};
+  std::shared_ptr<const RigController> rig = make_rig();
+};
+
+TEST_F(RigMasterHostTest, TheCarriedToolsForceIsFeltThroughTheMastersJacobian) {
+  const std::array<double, 3> at_state{0.1, 0.7, 1.4};
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_EQ(master_cycle(at_state).joint_torque_nm[1], 0.0);  // no model yet
+  }
+  const DeviceStateSample state = newest_state();
+  ASSERT_GT(state.sequence, 0u);
+  // The model answers that state with the tool where the slave's target put it then; the master
+  // has since moved its elbow a little, and the tool with it.
+  const Vec3 x0 = rig->flange_point_target_world(master(at_state), kToolInFlange);
+  ASSERT_TRUE(x0.allFinite());
+  const std::array<double, 3> now{0.1, 0.7, 1.4005};
+  const Vec3 x = rig->flange_point_target_world(master(now), kToolInFlange);
+  ASSERT_GT((x - x0).norm(), 1e-5);
+  ASSERT_LT((x - x0).norm(), 2e-3);
+  // f0 + K·(x0 − x), K along z: the wall model's 2 N and 1000 N/m.
+  const Vec3 expected_n(0.0, 0.0, 2.0 + 1000.0 * (x0.z() - x.z()));
+  DeviceCommand command;
+  std::uint64_t sent = 0;
+  auto last_written = std::chrono::steady_clock::now();
+  // Models for 30 ms, then 30 more cycles: each adoption restarts the 20 ms blend from the force
+  // before it, and the newest (not stale before 100 ms) is rendered as it is once that is done.
+  for (int k = 0; k < 60; ++k) {
+    if (k % 10 == 0 && k < 30) {
+      models_out.write(
+          encode_local_model(wall_model(1 + sent++, state.sequence, x0), {0, 0}, kHash));
+      last_written = std::chrono::steady_clock::now();
+    }
+    command = master_cycle(now);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_GE(client->status().models_accepted, 1u);
+  const double since_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - last_written)
+          .count();
+  if (since_ms > 90.0) {
+    GTEST_SKIP() << "this thread stalled: the last model is " << since_ms << " ms old (stale)";
+  }
+  DeviceCommand want;
+  rig->master_command(now, expected_n, 0.0, want);
+  EXPECT_EQ(command.joint_count, 5);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(command.joint_torque_nm[i], want.joint_torque_nm[i], 1e-9) << i;
+  }
+  EXPECT_GT(std::abs(want.joint_torque_nm[1]) + std::abs(want.joint_torque_nm[2]), 0.1);
+  EXPECT_EQ(command.force_world_n, Vec3::Zero());  // a master has no tip
+  EXPECT_NEAR(client->status().force_n, expected_n.norm(), 1e-9);
+  EXPECT_GT(client->status().peak_joint_torque_nm, 0.1);
+  // The simulation hears the force the torques stand for: its tissue gives way to it (SPEC §8).
+  DeviceStateSample newest;
+  for (int tries = 0; tries < 200 && newest.sequence < state.sequence + 60; ++tries) {
+    states_in.take([&](const hapsim_msg_DeviceState& m, const dds_sample_info_t&) {
+      newest = decode_device_state(m);
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_TRUE(newest.rendered.force_world_n.isApprox(expected_n, 1e-9))
+      << newest.rendered.force_world_n.transpose();
+}
+
 TEST_F(DeviceHostClientTest, ASecondHostOnTheSameDeviceIdTellsTheOthersModelsFromItsOwn) {
   DeviceHostClient second(participant, options());
   second.set_scene(scene());

@@ -227,7 +227,11 @@ const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_
   const double now_s = static_cast<double>(now_ns) * 1e-9;
   apply_scene();
   ++sequence_;
-  const Vec3 p_m = input.p_world.allFinite() ? input.p_world : p_previous_m_;
+  // A rig's master: the position that moves with it is the carried tool's on the slave's target.
+  const Vec3 p_input_m =
+      options_.rig ? options_.rig->flange_point_target_world(input, options_.rig_tool_flange_m)
+                   : input.p_world;
+  const Vec3 p_m = p_input_m.allFinite() ? p_input_m : p_previous_m_;
   v_m_per_s_ = sequence_ > sequence_base_ + 1 && dt_s > 0.0 ? Vec3((p_m - p_previous_m_) / dt_s)
                                                             : Vec3::Zero();
   p_previous_m_ = p_m;
@@ -267,6 +271,18 @@ const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_
       command_.force_world_n += f;
     }
   }
+  if (options_.rig) {
+    // The master feels the carried tool's force through its joints, as the served rig's command
+    // would make it (no grasp: the pads' contacts are not served as models).
+    const Vec3 at_slave_tool_n = command_.force_world_n;
+    rig_force_world_n_ = at_slave_tool_n;
+    command_ = DeviceCommand{};
+    options_.rig->master_command({input.joint_rad[0], input.joint_rad[1], input.joint_rad[2]},
+                                 at_slave_tool_n, 0.0, command_);
+    for (const double torque_nm : command_.joint_torque_nm) {
+      raise_to(peak_joint_torque_nm_, std::abs(torque_nm));
+    }
+  }
   rate_limited_.fetch_add(limited ? 1 : 0, std::memory_order_relaxed);
   passivity_cycles_.fetch_add(acted > 0 ? 1 : 0, std::memory_order_relaxed);
   passivity_dissipated_j_.store(dissipated_j, std::memory_order_relaxed);
@@ -293,6 +309,16 @@ void DeviceHostClient::after_cycle(const HapticCycle& cycle) noexcept {
   state_.input = *cycle.input;
   state_.v_world_m_per_s = v_m_per_s_;
   state_.rendered = *cycle.output;
+  if (options_.rig) {
+    // A master renders joint torques: the push its tissue takes (SPEC §8) is the force at the
+    // slave's tool they stand for, none while the safety layer holds the master at zero.
+    const DeviceCommand& out = *cycle.output;
+    bool torque = false;
+    for (int i = 0; i < out.joint_count && i < kMaxDeviceJoints; ++i) {
+      torque = torque || out.joint_torque_nm[static_cast<std::size_t>(i)] != 0.0;
+    }
+    state_.rendered.force_world_n = torque ? rig_force_world_n_ : Vec3::Zero();
+  }
   const std::size_t slot = sequence_ % kHistory;
   state_sent_ns_[slot] = monotonic_ns();
   answered_[slot] = false;
@@ -318,6 +344,7 @@ DeviceHostStatus DeviceHostClient::status() const noexcept {
   s.force_n = force_n_.load(std::memory_order_relaxed);
   s.force_at_last_model_n = force_at_last_model_n_.load(std::memory_order_relaxed);
   s.peak_force_n = peak_force_n_.load(std::memory_order_relaxed);
+  s.peak_joint_torque_nm = peak_joint_torque_nm_.load(std::memory_order_relaxed);
   s.rate_limited_cycles = rate_limited_.load(std::memory_order_relaxed);
   s.scene_changes = scene_changes_.load(std::memory_order_relaxed);
   s.round_trip_us = round_trip_us_.summary();

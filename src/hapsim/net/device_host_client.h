@@ -15,6 +15,8 @@
 //   5. the force's change per cycle is limited (a step from a bad model is felt as a ramp);
 //   6. after the device write, the state (input, velocity, what was rendered after the loop's
 //      safety layer) goes out on the DeviceState topic.
+// A rig's master arm (DeviceHostOptions::rig) renders its carried tool's model where the slave's
+// target puts the tool, and feels the force as joint torques through the master's Jᵀ.
 // `raw` mode renders the newest model's f0 as it came, as the knee paper sent raw forces: for
 // comparison only, unstable beyond a few ms of delay (docs/benchmarks.md).
 // Models that answer a state this host did not send (sequence 0: the simulation's own script)
@@ -30,6 +32,7 @@
 #include "hapsim/net/participant.h"
 #include "hapsim/net/topic_reader.h"
 #include "hapsim/net/topic_writer.h"
+#include "hapsim/rig/rig_controller.h"
 #include "hapsim/runtime/haptic_loop.h"
 #include "hapsim/runtime/latency_histogram.h"
 
@@ -60,6 +63,13 @@ struct DeviceHostOptions {
   /// random, so a second host on the same device id (a name already taken) tells the models
   /// answering the other's states from its own (DeviceHostStatus::models_other_device_host).
   std::uint64_t state_sequence_base = 0;
+  /// A served rig (a scene's "rig"): this host is its master arm. Its one tool is the tool the
+  /// slave carries, placed each cycle where the slave's target puts it for the master's joints
+  /// (RigController::flange_point_target_world, `rig_tool_flange_m` its centre in the flange
+  /// frame), and the force rendered there goes to the master's joints as the rig's own command
+  /// does (RigController::master_command): joint torques, not a tip force. Null: a probe or glove.
+  std::shared_ptr<const RigController> rig;
+  Vec3 rig_tool_flange_m = Vec3::Zero();
 };
 
 /// `options.render` with a finger actuator's rating as its force limit (when one is given).
@@ -100,6 +110,8 @@ struct DeviceHostStatus {
   std::uint64_t last_model_cycle = 0;
   std::uint64_t last_force_cycle = 0;
   double peak_force_n = 0.0;  ///< over the run
+  /// A rig's master (DeviceHostOptions::rig): its largest joint torque over the run, N·m.
+  double peak_joint_torque_nm = 0.0;
   std::uint64_t rate_limited_cycles = 0;
   std::uint64_t scene_changes = 0;
   /// Models the receive-side link shim lost (any reason) and delivered (zero without one).
@@ -165,6 +177,8 @@ class DeviceHostClient final : public HapticClient {
   /// monotonic_ns() when each state went out (by sequence), and whether a model answered it.
   std::array<std::int64_t, kHistory> state_sent_ns_{};
   std::array<bool, kHistory> answered_{};
+  /// A rig's master: the force at the slave's tool this cycle's torques render.
+  Vec3 rig_force_world_n_ = Vec3::Zero();
   std::uint64_t sequence_base_ = 0;  ///< states are numbered from sequence_base_ + 1
   std::uint64_t sequence_ = 0;
   /// The simulation host followed: the writer of the first model accepted for the current scene,
@@ -192,6 +206,7 @@ class DeviceHostClient final : public HapticClient {
   std::atomic<double> force_at_last_model_n_{0.0};
   bool took_model_ = false;  ///< this cycle accepted a model (haptic thread)
   std::atomic<double> peak_force_n_{0.0};
+  std::atomic<double> peak_joint_torque_nm_{0.0};
   std::atomic<std::uint64_t> rate_limited_{0};
   std::atomic<std::uint64_t> scene_changes_{0};
   LatencyHistogram round_trip_us_;

@@ -2,7 +2,6 @@
 
 #include "hapsim/core/error.h"
 #include "hapsim/net/scene_hash.h"
-#include "hapsim/rig/rig_controller.h"
 #include "hapsim/scene/scene_file.h"
 
 #include <chrono>
@@ -90,9 +89,6 @@ RunSetup build_served_scene(const SceneInfoSample& info, const DeviceChoice& cho
     throw Error(info.scene_file, "the scene built here (hash " + hex(ours) +
                                      ") is not the one served (hash " + hex(info.scene_hash) +
                                      "): give this machine the host's data folder (--data)");
-  }
-  if (rig_state(*setup.world) != nullptr) {
-    throw Error(info.scene_file, "a teleoperation rig is not served over the network yet");
   }
   return setup;
 }

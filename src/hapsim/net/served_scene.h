@@ -42,7 +42,7 @@ struct ServedDeviceHost {
 /// The served scene built here, with `choice` as its device (external for a viewer, the scene's
 /// script for a simulated device), from `data_dir` if given, else the host's. Throws
 /// hapsim::Error ("--connect"-style, naming both hashes) when the world built here is another
-/// one, and when it is a teleoperation rig (not served yet).
+/// one.
 [[nodiscard]] RunSetup build_served_scene(const SceneInfoSample& info, const DeviceChoice& choice,
                                           const std::string& data_dir = {});
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace hapsim {
 
@@ -79,23 +80,42 @@ void RigState::command(const WorldModel& /*model*/, const WorldState& state,
     slave_joint_torques(rig, tool.p_world, tool.force_world_n, r);
   }
   r.tool_force_world_n = at_tool;
-  const Vec3 at_master = d.mapping.X_slave_master.linear().transpose() * at_tool * d.force_scale;
-  const MasterTorques t =
-      controller->master().torques(r.master_arm_rad, at_master, r.gripper.grasp_force_n());
+  controller->master_command(r.master_arm_rad, at_tool, r.gripper.grasp_force_n(), r.command);
+  command = r.command;
+}
+
+// haptic path
+void RigController::master_command(const std::array<double, 3>& arm_rad,
+                                   const Vec3& force_at_slave_tool_world_n, double grasp_force_n,
+                                   DeviceCommand& command) const noexcept {
+  const TeleopRigDescription& d = description_;
+  const Vec3 at_master =
+      d.mapping.X_slave_master.linear().transpose() * force_at_slave_tool_world_n * d.force_scale;
+  const MasterTorques t = master_.torques(arm_rad, at_master, grasp_force_n);
   for (std::size_t i = 0; i < 3; ++i) {
-    r.command.joint_torque_nm[i] = t.arm_n_m[i];
+    command.joint_torque_nm[i] = t.arm_n_m[i];
   }
-  r.command.joint_torque_nm[3] = t.fingers_n_m[0];
-  r.command.joint_torque_nm[4] = t.fingers_n_m[1];
-  r.command.joint_count = 5;
-  const double grasp = r.gripper.grasp_force_n();
-  r.command.finger_force_n[0] = std::isfinite(grasp) ? grasp : 0.0;
-  r.command.finger_force_n[1] = r.command.finger_force_n[0];
-  r.command.finger_count = 2;
-  for (double& torque : r.command.joint_torque_nm) {
+  command.joint_torque_nm[3] = t.fingers_n_m[0];
+  command.joint_torque_nm[4] = t.fingers_n_m[1];
+  command.joint_count = 5;
+  command.finger_force_n[0] = std::isfinite(grasp_force_n) ? grasp_force_n : 0.0;
+  command.finger_force_n[1] = command.finger_force_n[0];
+  command.finger_count = 2;
+  for (double& torque : command.joint_torque_nm) {
     torque = std::isfinite(torque) ? torque : 0.0;
   }
-  command = r.command;
+}
+
+// haptic path
+Vec3 RigController::flange_point_target_world(const DeviceInput& input,
+                                              const Vec3& p_flange_m) const noexcept {
+  const std::array<double, 3> arm{input.joint_rad[0], input.joint_rad[1], input.joint_rad[2]};
+  if (input.joint_count < 3 || !std::isfinite(arm[0]) || !std::isfinite(arm[1]) ||
+      !std::isfinite(arm[2])) {
+    return Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  }
+  const Iso3 hand = master_.hand_pose(arm);
+  return slave_target(description_.mapping, hand.translation(), arm[0]) * p_flange_m;
 }
 
 }  // namespace hapsim

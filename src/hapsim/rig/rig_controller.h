@@ -47,6 +47,20 @@ class RigController final : public WorldController {
   /// onto the slave's.
   [[nodiscard]] double slave_width_for(double master_opening_m) const noexcept;
 
+  /// The master's command for a force at the slave's tool (world frame) and a grasp force: the
+  /// force scaled (force_scale) into the master's frame through the master's Jᵀ at `arm_rad`, the
+  /// grasp through its fingers and on both finger channels; a non-finite torque or grasp is zero.
+  /// What the rig's command writes each step, and what a device host playing the master renders
+  /// from a served contact model (net/device_host_client.h). haptic path
+  void master_command(const std::array<double, 3>& arm_rad, const Vec3& force_at_slave_tool_world_n,
+                      double grasp_force_n, DeviceCommand& command) const noexcept;
+  /// Where a point fixed in the slave's flange frame (a carried tool's centre, `p_flange_m`) is
+  /// when the slave stands on the target this master input asks for: the follower's lag left out,
+  /// the device host's stand-in for where the served slave carries its tool. NaN when the input
+  /// is not a master's (fewer than three finite arm joints). haptic path
+  [[nodiscard]] Vec3 flange_point_target_world(const DeviceInput& input,
+                                               const Vec3& p_flange_m) const noexcept;
+
  private:
   TeleopRigDescription description_;
   MasterArm master_;

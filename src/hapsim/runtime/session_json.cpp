@@ -53,6 +53,35 @@ nlohmann::json fem_summary_json(const FemSummary& f) {
       {"error", f.error}};
 }
 
+namespace {
+
+// A rig's figures (the session's TeleopSummary): its pick-and-place, the carried tool's force and
+// the master's torque, the slave's tracking and collisions.
+void add_rig_json(nlohmann::json& j, const TeleopSummary& t) {
+  j["grasped"] = t.grasped;
+  j["grasp_time_s"] = t.grasped ? nlohmann::json(t.grasp_time_s) : nlohmann::json(nullptr);
+  j["release_time_s"] =
+      t.release_time_s >= 0.0 ? nlohmann::json(t.release_time_s) : nlohmann::json(nullptr);
+  j["ball_lift_m"] = t.ball_lift_m;
+  j["ball_final_position_m"] = {t.ball_final_world.x(), t.ball_final_world.y(),
+                                t.ball_final_world.z()};
+  j["ball_target_error_m"] =
+      t.target_error_m ? nlohmann::json(*t.target_error_m) : nlohmann::json(nullptr);
+  j["peak_grasp_force_n"] = t.peak_grasp_force_n;
+  j["max_sheet_deflection_m"] = t.max_sheet_deflection_m;
+  j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
+  j["peak_tool_force_n"] = t.peak_tool_force_n;
+  j["peak_master_torque_nm"] = t.peak_master_torque_nm;
+  j["slave_collisions"] = {
+      {"steps", t.slave_collision_steps},
+      {"pairs", t.slave_collisions},
+      {"first_s", t.slave_collision_steps > 0 ? nlohmann::json(t.first_slave_collision_s)
+                                              : nlohmann::json(nullptr)},
+      {"bodies", t.slave_collision_bodies}};
+}
+
+}  // namespace
+
 nlohmann::json session_summary_json(const SceneDescription& scene, const World& world,
                                     const SessionSummary& s, const std::string& device_name) {
   nlohmann::json j;
@@ -136,6 +165,9 @@ nlohmann::json session_summary_json(const SceneDescription& scene, const World& 
   }
   j["world_build_ms"] = world.build_ms();
   j["query_memory_bytes"] = world.query_memory_bytes();
+  if (s.teleop) {
+    add_rig_json(j, *s.teleop);
+  }
   return j;
 }
 
@@ -167,28 +199,7 @@ nlohmann::json run_summary_json(const RunSetup& setup, const SessionSummary& sum
   // Stopped early (SIGINT in `hapsim run`): the figures are of the cycles run.
   j["interrupted"] = summary.interrupted;
   if (summary.teleop) {
-    const TeleopSummary& t = *summary.teleop;
     j["slave"] = setup.slave_name;
-    j["grasped"] = t.grasped;
-    j["grasp_time_s"] = t.grasped ? nlohmann::json(t.grasp_time_s) : nlohmann::json(nullptr);
-    j["release_time_s"] =
-        t.release_time_s >= 0.0 ? nlohmann::json(t.release_time_s) : nlohmann::json(nullptr);
-    j["ball_lift_m"] = t.ball_lift_m;
-    j["ball_final_position_m"] = {t.ball_final_world.x(), t.ball_final_world.y(),
-                                  t.ball_final_world.z()};
-    j["ball_target_error_m"] =
-        t.target_error_m ? nlohmann::json(*t.target_error_m) : nlohmann::json(nullptr);
-    j["peak_grasp_force_n"] = t.peak_grasp_force_n;
-    j["max_sheet_deflection_m"] = t.max_sheet_deflection_m;
-    j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
-    j["peak_tool_force_n"] = t.peak_tool_force_n;
-    j["peak_master_torque_nm"] = t.peak_master_torque_nm;
-    j["slave_collisions"] = {
-        {"steps", t.slave_collision_steps},
-        {"pairs", t.slave_collisions},
-        {"first_s", t.slave_collision_steps > 0 ? nlohmann::json(t.first_slave_collision_s)
-                                                : nlohmann::json(nullptr)},
-        {"bodies", t.slave_collision_bodies}};
   }
   bool ok = run_failures(setup, summary).empty();
   if (replay != nullptr) {

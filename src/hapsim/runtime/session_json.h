@@ -24,7 +24,8 @@ namespace hapsim {
 /// module's World.fem_stats() returns the same.
 [[nodiscard]] nlohmann::json fem_summary_json(const FemSummary& fem);
 
-/// Everything a session summary says, plus the scene, world and device it ran.
+/// Everything a session summary says, plus the scene, world and device it ran; for a rig, its
+/// figures (pick-and-place, the carried tool's peak force, the master's peak joint torque).
 [[nodiscard]] nlohmann::json session_summary_json(const SceneDescription& scene, const World& world,
                                                   const SessionSummary& s,
                                                   const std::string& device_name);
@@ -35,7 +36,7 @@ namespace hapsim {
 [[nodiscard]] std::vector<std::string> run_failures(const RunSetup& setup,
                                                     const SessionSummary& summary);
 
-/// The whole `hapsim run --json` document: session_summary_json, a rig's pick-and-place fields,
+/// The whole `hapsim run --json` document: session_summary_json, a rig's slave,
 /// with `replay` (a replay's comparison with its recording) `replay_identical` and any
 /// `replay_difference`, and `ok` (no run_failures and an identical replay).
 [[nodiscard]] nlohmann::json run_summary_json(const RunSetup& setup, const SessionSummary& summary,

@@ -1,0 +1,98 @@
+// A rig served (issue 33, item 3): `hapsim serve scenes/telepalpation.json --wait-for-device` +
+// `hapsim device` (the simulated master playing the scene's tele-palpation) on loopback, against
+// the same run in one process. The master's joints drive the served slave, whose pad palpates the
+// FEM knee; serve sends the pad's local contact models; the device host renders them where the
+// slave's target puts the pad and feels them through the master's Jᵀ, and tells serve the force
+// its torques stand for, which the tissue takes as its load (SPEC §8).
+//  * The served world reproduces the one-process run within the knee's three-process tolerances:
+//    the pad's peak force and the master's peak joint torque within 5 %, its contacts within 5 %
+//    of the one-process count (allowing for serve's pace).
+//  * What the device host rendered from those models, and the master's torque it made of it,
+//    peak between 0.85 and 2 times the one-process peaks (measured 1.3x idle, 1.7x under load).
+#include "apps/hapsim_process.h"
+#include "net/net_test_support.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace hapsim::net {
+namespace {
+
+using namespace std::chrono_literals;
+using hapsim::test::BackgroundHapsim;
+
+const std::string kScene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/telepalpation.json";
+
+nlohmann::json read_json(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in);
+}
+
+TEST(RigServe, ServeAndMasterReproduceTheOneProcessTelepalpation) {
+  ASSERT_TRUE(test::on_loopback_config());
+  const auto one_json = hapsim::test::temp_path("rig_one.json");
+  const auto served_json = hapsim::test::temp_path("rig_served.json");
+  const auto device_json = hapsim::test::temp_path("rig_device.json");
+  const hapsim::test::RunResult one = hapsim::test::run_hapsim(
+      "run " + kScene + " --duration 10.5 --quiet --json " + one_json.string());
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+
+  const std::string net = " --session rig-serve --domain 81";
+  BackgroundHapsim serve(
+      "serve " + kScene + " --wait-for-device --duration 10.5 --json " + served_json.string() + net,
+      hapsim::test::temp_path("rig_serve.log"));
+  ASSERT_TRUE(serve.wait_for("waiting", 60s)) << serve.output();
+  BackgroundHapsim device("device --duration 11" + net + " --json " + device_json.string(),
+                          hapsim::test::temp_path("rig_device.log"));
+  EXPECT_EQ(serve.wait(), 0) << serve.output();
+  EXPECT_EQ(device.wait(), 0) << device.output();
+  std::printf("%s\n%s\n", serve.output().c_str(), device.output().c_str());
+  EXPECT_NE(device.output().find("master arm   of the served rig"), std::string::npos);
+  if (const std::string why = test::serve_too_slow_for_real_time(serve.output()); !why.empty()) {
+    GTEST_SKIP() << why;
+  }
+
+  const nlohmann::json a = read_json(one_json);
+  const nlohmann::json b = read_json(served_json);
+  const nlohmann::json d = read_json(device_json);
+  const double one_peak_n = a["peak_tool_force_n"].get<double>();
+  const double one_torque_nm = a["peak_master_torque_nm"].get<double>();
+  EXPECT_GT(one_peak_n, 3.0);  // the pad pressed the knee
+  EXPECT_GT(one_torque_nm, 0.5);
+  // The served world: the same presses through the master's joints, as hard as in one process.
+  EXPECT_NEAR(b["peak_tool_force_n"].get<double>(), one_peak_n, 0.05 * one_peak_n);
+  EXPECT_NEAR(b["peak_master_torque_nm"].get<double>(), one_torque_nm, 0.05 * one_torque_nm);
+  const double pace = test::serve_pace(serve.output());
+  ASSERT_GT(pace, 0.0) << serve.output();
+  const double one_contacts = a["tools"][0]["contact_steps"].get<double>();
+  const double served_contacts = b["tools"][0]["contact_steps"].get<double>();
+  // Both runs hold the master still after its script's 10.2 s, out of contact; serve steps by the
+  // device's clock, and a serve behind real time counts a touch in fewer steps
+  // (three_process_test.cpp).
+  EXPECT_GE(served_contacts, 0.95 * std::min(pace, 1.0) * one_contacts - 1.0);
+  EXPECT_LE(served_contacts, 1.05 * one_contacts + 1.0);
+  EXPECT_EQ(b["pop_throughs"].get<int>(), 0);
+  EXPECT_EQ(b["serve"]["device_states"]["malformed"].get<int>(), 0);
+  EXPECT_GT(b["serve"]["device_host_cycles"].get<int>(), 9'000);  // the master drove it all
+  EXPECT_EQ(b["slave_collisions"]["steps"].get<int>(), 0);
+
+  // The master: the pad's models rendered at its own pose, felt through its joints. Its peak is
+  // above the world's: 9.2 N against 7.07 N on an idle machine (1.3x), 12 N beside stress-ng
+  // (1.7x; the FEM's updates adopted 30 ms late), where a probe on the same FEM knee peaks within
+  // 1 %: not yet understood (docs/architecture.md, "A rig served"). Held here: it felt the presses,
+  // and at most twice what the world pushed.
+  EXPECT_GT(d["peak_force_n"].get<double>(), 0.85 * one_peak_n);
+  EXPECT_LT(d["peak_force_n"].get<double>(), 2.0 * one_peak_n);
+  EXPECT_GT(d["peak_joint_torque_nm"].get<double>(), 0.85 * one_torque_nm);
+  EXPECT_LT(d["peak_joint_torque_nm"].get<double>(), 2.0 * one_torque_nm);
+  EXPECT_EQ(d["models"]["malformed"].get<int>(), 0);
+  EXPECT_GT(d["models_rendered"].get<int>(), 5'000);
+}
+
+}  // namespace
+}  // namespace hapsim::net
