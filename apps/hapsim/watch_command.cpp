@@ -70,6 +70,8 @@ void watch(const WatchArgs& args, JsonOutput& json_out) {
   std::fflush(stdout);
 
   WorldSnapshot snapshot = make_world_snapshot(world);
+  // View states carry a rig's bodies, not its joints: the rig's part would stay at the start.
+  snapshot.teleop.reset();
   std::optional<WorldSnapshot> at_peak;
   net::ViewStateDecoder decoder(world);
   std::uint64_t views = 0;

@@ -53,6 +53,11 @@ class DeviceHostClientTest : public ::testing::Test {
   // One loop cycle at device position p (the loop's read, step and write, without the thread).
   const DeviceCommand& cycle(const Vec3& p_m) {
     input.p_world = p_m;
+    return step_once();
+  }
+
+  // One loop cycle on `input` as it is.
+  const DeviceCommand& step_once() {
     const DeviceCommand& command = client->step(input, 0.001);
     HapticCycle c;
     c.input = &input;
@@ -242,12 +247,7 @@ class RigMasterHostTest : public DeviceHostClientTest {
 
   const DeviceCommand& master_cycle(const std::array<double, 3>& arm_rad) {
     input = master(arm_rad);
-    const DeviceCommand& command = client->step(input, 0.001);
-    HapticCycle c;
-    c.input = &input;
-    c.output = &command;
-    client->after_cycle(c);
-    return command;
+    return step_once();
   }
 
   inline static const Vec3 kToolInFlange{0.0, 0.0, 0.1};

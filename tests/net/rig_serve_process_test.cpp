@@ -7,6 +7,7 @@
 //  * The served world reproduces the one-process run within the knee's three-process tolerances:
 //    the pad's peak force and the master's peak joint torque within 5 %, its contacts within 5 %
 //    of the one-process count (allowing for serve's pace).
+//  * A headless viewer (hapsim watch) sees the pad's force, not the master's zero tip force.
 //  * What the device host rendered from those models, and the master's torque it made of it,
 //    peak between 0.85 and 2 times the one-process peaks (measured 1.3x idle, 1.7x under load).
 #include "apps/hapsim_process.h"
@@ -47,10 +48,17 @@ TEST(RigServe, ServeAndMasterReproduceTheOneProcessTelepalpation) {
       "serve " + kScene + " --wait-for-device --duration 10.5 --json " + served_json.string() + net,
       hapsim::test::temp_path("rig_serve.log"));
   ASSERT_TRUE(serve.wait_for("waiting", 60s)) << serve.output();
+  // A headless viewer: it draws the served slave by its link bodies and the pad's force.
+  const auto watch_json = hapsim::test::temp_path("rig_watch.json");
+  const auto watch_png = hapsim::test::temp_path("rig_watch.png");
+  BackgroundHapsim watch("watch --duration 11.5 --json " + watch_json.string() + " --snapshot " +
+                             watch_png.string() + net,
+                         hapsim::test::temp_path("rig_watch.log"));
   BackgroundHapsim device("device --duration 11" + net + " --json " + device_json.string(),
                           hapsim::test::temp_path("rig_device.log"));
   EXPECT_EQ(serve.wait(), 0) << serve.output();
   EXPECT_EQ(device.wait(), 0) << device.output();
+  EXPECT_EQ(watch.wait(), 0) << watch.output();
   std::printf("%s\n%s\n", serve.output().c_str(), device.output().c_str());
   EXPECT_NE(device.output().find("master arm   of the served rig"), std::string::npos);
   if (const std::string why = test::serve_too_slow_for_real_time(serve.output()); !why.empty()) {
@@ -80,6 +88,14 @@ TEST(RigServe, ServeAndMasterReproduceTheOneProcessTelepalpation) {
   EXPECT_EQ(b["serve"]["device_states"]["malformed"].get<int>(), 0);
   EXPECT_GT(b["serve"]["device_host_cycles"].get<int>(), 9'000);  // the master drove it all
   EXPECT_EQ(b["slave_collisions"]["steps"].get<int>(), 0);
+
+  // The viewer saw the pad press: the carried tool's force in the view states is its contact
+  // force (the master's command holds torques, no tip force), sampled at ~30 Hz, so below the
+  // served peak and within the held presses' range of it.
+  const nlohmann::json w = read_json(watch_json);
+  EXPECT_LE(w["peak_force_n"].get<double>(), 1.05 * b["peak_tool_force_n"].get<double>());
+  EXPECT_GE(w["peak_force_n"].get<double>(), 0.5 * one_peak_n);
+  EXPECT_TRUE(std::filesystem::exists(watch_png));
 
   // The master: the pad's models rendered at its own pose, felt through its joints. Its peak is
   // above the world's: 9.2 N against 7.07 N on an idle machine (1.3x), 12 N beside stress-ng

@@ -642,22 +642,8 @@ TEST_F(SceneFileTest, TeleopScenesNameTheirMistakes) {
 // paper's scenes/teleop.json as it was before the "rig" key, converted on read, builds a world
 // with the same content hash as today's scenes/teleop.json.
 TEST_F(SceneFileTest, AnOlderTeleopFileIsTheSameWorldAsItsRigScene) {
-  const Json old = Json::parse(R"({
-    "format": "hapsim-scene/1",
-    "teleop": {
-      "slave": { "model": "procedural" },
-      "mapping": { "scale": 1.6, "offset_m": [0.0, 0.0, 0.0] },
-      "gripper": { "max_force_n": 20.0, "max_width_m": 0.10, "speed_m_per_s": 0.25 },
-      "ball": { "mass_kg": 0.1, "radius_m": 0.03, "start_m": [0.5, -0.25, 0.03] },
-      "sheet": { "nodes_per_side": 16, "size_m": 0.2, "position_m": [0.5, 0.25, 0.05] },
-      "floor_z_m": 0.0
-    },
-    "device": {
-      "type": "simulated",
-      "pick_and_place": { "place_m": [0.5, 0.25, 0.08], "clearance_m": 0.12, "carry_s": 2.0 }
-    },
-    "run": { "duration_s": 0.0, "dt_s": 0.001 }
-  })");
+  std::ifstream in(fs::path(HAPSIM_SOURCE_DIR) / "tests" / "data" / "teleop_older_dialect.json");
+  const Json old = Json::parse(in);
   const SceneDescription converted = load_scene(write("teleop.json", old.dump()));
   const SceneDescription written =
       load_scene(fs::path(HAPSIM_SOURCE_DIR) / "scenes" / "teleop.json");

@@ -372,25 +372,9 @@ TEST(SceneSchema, BadScenesAreRefusedByTheSchemaAndTheLoader) {
 }
 
 // The first paper's scenes/teleop.json as it was before the "rig" key (the older dialect, which
-// still loads: converted on read).
+// still loads: converted on read; tests/data/teleop_older_dialect.json).
 Json older_teleop_scene() {
-  return Json::parse(R"({
-    "format": "hapsim-scene/1",
-    "teleop": {
-      "slave": { "model": "procedural" },
-      "mapping": { "scale": 1.6, "offset_m": [0.0, 0.0, 0.0] },
-      "gripper": { "max_force_n": 20.0, "max_width_m": 0.10, "speed_m_per_s": 0.25 },
-      "ball": { "mass_kg": 0.1, "radius_m": 0.03, "start_m": [0.5, -0.25, 0.03] },
-      "sheet": { "nodes_per_side": 16, "size_m": 0.2, "position_m": [0.5, 0.25, 0.05] },
-      "floor_z_m": 0.0
-    },
-    "device": {
-      "type": "simulated",
-      "pick_and_place": { "place_m": [0.5, 0.25, 0.08], "clearance_m": 0.12, "carry_s": 2.0 }
-    },
-    "assessment": { "time_limit_s": 20.0 },
-    "run": { "duration_s": 0.0, "dt_s": 0.001 }
-  })");
+  return read_json(fs::path(HAPSIM_SOURCE_DIR) / "tests" / "data" / "teleop_older_dialect.json");
 }
 
 TEST(SceneSchema, TheOlderTeleopDialectIsStillAValidScene) {

@@ -193,15 +193,7 @@ void WorldScene::build_rig() {
   slave_figure_ = std::make_unique<SlaveFigure>(*rig.slave, scene_,
                                                 SlaveLook{rig_colours_.robot, rig_colours_.joint});
   warnings_ = slave_figure_->warnings();
-  if (slave_figure_->draws_links()) {
-    for (const TeleopRigDescription::SlaveBody& s : rig.slave_bodies) {
-      if (s.frame != kToolFrame) {
-        scene_
-            .mesh(segments_[world_.flat_segment(BodyIndex{s.body}, LocalSegment{0}).index()]->mesh)
-            .visible = false;
-      }
-    }
-  }
+  show_slave_link_bodies(!slave_figure_->draws_links());
   scene_.style.line_width_px = 2.0f;
   Box3 bounds = rest_bounds_world_;
   const BallEnvironmentOptions& env = rig.environment;
@@ -476,6 +468,11 @@ void WorldScene::update(const WorldSnapshot& snapshot) {
   }
   if (rig_ && snapshot.teleop) {
     *rig_ = *snapshot.teleop;  // sized alike: no allocation after the first
+  } else if (rig_ && !rig_from_bodies_) {
+    // A served rig's view states carry its bodies, not its joints: the slave is drawn by its link
+    // bodies where the host put them, and the master, whose joints are not served, not at all.
+    rig_from_bodies_ = true;
+    show_slave_link_bodies(true);
   }
   hand_ = snapshot.hand;
   rebuild_overlays(snapshot.tools, snapshot.tool_force_n);
@@ -656,6 +653,18 @@ void WorldScene::rebuild_overlays(const std::vector<ToolState>& tools,
   }
 }
 
+// The slave's link bodies (collision shapes) drawn, or hidden behind the figure that draws the
+// links itself.
+void WorldScene::show_slave_link_bodies(bool visible) {
+  for (const TeleopRigDescription::SlaveBody& s :
+       rig_description(world_.description())->slave_bodies) {
+    if (s.frame != kToolFrame) {
+      scene_.mesh(segments_[world_.flat_segment(BodyIndex{s.body}, LocalSegment{0}).index()]->mesh)
+          .visible = visible;
+    }
+  }
+}
+
 // What only a rig has, from its snapshot: the pads' colour while they hold, the joint spheres,
 // the shadow mark under the gripper's tool point (between the pads), the master.
 void WorldScene::add_rig_overlays() {
@@ -667,6 +676,9 @@ void WorldScene::add_rig_overlays() {
         scene_.mesh(seg->mesh).colour = s.held ? rig_colours_.pad_holding : rig_colours_.pad;
       }
     }
+  }
+  if (rig_from_bodies_) {
+    return;  // a served rig: its bodies are drawn where they are; its joints are not known here
   }
   if (s.slave_q.size() == frames_.size()) {
     const Iso3 tip_world = rig.slave->frames(s.slave_q, frames_);

@@ -130,6 +130,7 @@ class WorldScene {
  private:
   struct Segment;
   void build_rig();
+  void show_slave_link_bodies(bool visible);
   void apply_colouring();
   void shade_dent(Segment& seg);
   /// kStress: a FEM segment's vertices coloured by their von Mises stress.
@@ -165,6 +166,9 @@ class WorldScene {
   // A rig's part: its latest state, how the slave is drawn, the slave's joint frames (scratch),
   // where the master is drawn.
   std::optional<TeleopSnapshot> rig_;
+  /// Snapshots without the rig's part (a connected viewer's view states): the slave drawn by its
+  /// link bodies, no master.
+  bool rig_from_bodies_ = false;
   std::unique_ptr<SlaveFigure> slave_figure_;
   std::vector<std::string> warnings_;
   std::vector<Iso3> frames_;

@@ -178,11 +178,8 @@ class SessionAccountant {
       const ToolState& tool = r.tools[t];
       ToolSummary& ts = summary_.tools[t];
       const bool own = desc.tools[t].device == 0;
-      // A tool a robot carries reaches the hand through the master's joints, not as a tip force:
-      // its own contact force is what it renders (before the master's scale).
-      const double f = t == carried_tool_
-                           ? tool.force_world_n.norm()
-                           : tool_rendered_force_n(desc.tools[t], tool, out, tip_scale);
+      const double f =
+          tool_rendered_force_n(desc.tools[t], tool, out, tip_scale, t == carried_tool_);
       ts.peak_force_n = std::max(ts.peak_force_n, f);
       if (tool.contact_count > 0) {
         ++ts.contact_steps;

@@ -19,6 +19,9 @@ constexpr std::uint8_t kOwedToAll = 0x7;  // listed for each of the three snapsh
 WorldHapticClient::WorldHapticClient(World& world, WorldHapticClientOptions options)
     : world_(world), options_(options) {
   const WorldDescription& d = world_.description();
+  if (const TeleopRigDescription* rig = rig_description(d); rig != nullptr) {
+    carried_tool_ = rig->carried_tool;
+  }
   max_deflection_m_.assign(world_.flat_segment_count(), 0.0);
   for (std::size_t b = 0; b < d.bodies.size(); ++b) {
     if (world_.sheet(b) != nullptr) {
@@ -173,7 +176,8 @@ void WorldHapticClient::publish_snapshot(const HapticCycle& cycle) noexcept {
     const double tip_n = r.command.force_world_n.norm();
     const double tip_scale = tip_n > 0.0 ? cycle.output->force_world_n.norm() / tip_n : 0.0;
     for (std::size_t t = 0; t < tools; ++t) {
-      s.tool_force_n[t] = tool_rendered_force_n(d.tools[t], r.tools[t], *cycle.output, tip_scale);
+      s.tool_force_n[t] = tool_rendered_force_n(d.tools[t], r.tools[t], *cycle.output, tip_scale,
+                                                t == carried_tool_);
     }
   }
   if (s.teleop && rig_state(world_) != nullptr) {

@@ -119,6 +119,7 @@ class WorldHapticClient final : public HapticClient {
   // which for a served world is the lockstep wait for the device host's state).
   double step_cost_us_ = 0.0;
   DeviceCommand zero_command_;
+  std::size_t carried_tool_ = static_cast<std::size_t>(-1);  // the tool a rig carries, if any
   std::unique_ptr<TripleBuffer<WorldSnapshot>> snapshots_;
   std::unique_ptr<SpscRing<CycleRecord>> records_;
   CycleRecord scratch_record_;

@@ -187,6 +187,16 @@ void read_glove_pick_and_place(const SceneReader& r, const Json& j, const std::s
   }
 }
 
+// The device's "trajectory": a CSV path beside the scene file, which must exist unless the command
+// plays another (--device sim:FILE).
+void read_trajectory_file(const SceneReader& r, const Json& j, const std::string& ptr,
+                          DeviceDescription& d) {
+  const std::string tp = JsonReader::at(ptr, "trajectory");
+  d.trajectory_file = r.options().device_trajectory_played
+                          ? r.existing_file(j["trajectory"], tp, "a trajectory CSV path")
+                          : r.path(j["trajectory"], tp, "a trajectory CSV path");
+}
+
 // A rig's device: the simulated master arm, played from a trajectory of its joints or scripted
 // (a pick-and-place of the rig's ball, or a palpation carried by the slave's tool).
 void read_rig_master(const SceneReader& r, const Json& j, const std::string& ptr,
@@ -211,11 +221,7 @@ void read_rig_master(const SceneReader& r, const Json& j, const std::string& ptr
            "f1), 'pick_and_place' or 'palpation' (a script)");
   }
   if (j.contains("trajectory")) {
-    // Not needed when the command plays another (--device sim:FILE).
-    const std::string tp = JsonReader::at(ptr, "trajectory");
-    d.trajectory_file = r.options().device_trajectory_played
-                            ? r.existing_file(j["trajectory"], tp, "a trajectory CSV path")
-                            : r.path(j["trajectory"], tp, "a trajectory CSV path");
+    read_trajectory_file(r, j, ptr, d);
     return;
   }
   if (j.contains("palpation")) {
@@ -330,11 +336,7 @@ void read_device(const SceneReader& r, const Json& j, const std::string& ptr,
                     "' (a script)");
   }
   if (j.contains("trajectory")) {
-    // Not needed when the command plays another (--device sim:FILE).
-    const std::string tp = JsonReader::at(ptr, "trajectory");
-    d.trajectory_file = r.options().device_trajectory_played
-                            ? r.existing_file(j["trajectory"], tp, "a trajectory CSV path")
-                            : r.path(j["trajectory"], tp, "a trajectory CSV path");
+    read_trajectory_file(r, j, ptr, d);
     return;
   }
   if (glove) {

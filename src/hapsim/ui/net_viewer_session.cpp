@@ -61,6 +61,8 @@ class NetViewerSession final : public ViewerSession {
         net::build_served_scene(info_, DeviceChoice::external(), config.data_dir.string()));
     world_ = setup_->world.get();
     snapshot_ = make_world_snapshot(*world_);
+    // View states carry a rig's bodies, not its joints: the rig's part would stay at the start.
+    snapshot_.teleop.reset();
     decoder_.emplace(*world_);
     view_ = std::make_unique<WorldScene>(*world_);
     // The scene's device is the one served (its limits built the world): its rating, not the
@@ -91,8 +93,9 @@ class NetViewerSession final : public ViewerSession {
       restarted_other_scene_ = info->scene_hash != info_.scene_hash;
       info_.serve_id = info->serve_id;
       if (!restarted_other_scene_) {
-        if (commands_)
+        if (commands_) {
           commands_->retarget(*info);  // Pause and Reset go to the host that runs now
+        }
       }
     }
     bool fresh = false;
