@@ -171,6 +171,36 @@ TEST(LocalModelRenderer, BlendsANewModelInOverTheBlendTime) {
   EXPECT_NEAR(r.render(x0, Vec3::Zero(), 0.07).z(), 3.0, 1e-12);
 }
 
+// A served rig's pad leaving the knee (2026-11-29): the master steps out quickly, the contact's
+// damping would pull for that cycle (zeroed, as a pull is never felt), and the simulation's
+// models alternate between the contact and a step with no touch (valid, no normal). The blend
+// started from the old model's bare force, a pull, and the free-space model rendered it with no
+// push-only rule: the pulls stacked up to 11 N into the tissue. The blend starts from what was
+// felt, so the force stays a push no larger than the contact's.
+TEST(LocalModelRenderer, AStreamAlternatingWithFreeSpaceNeverStacksAPull) {
+  LocalModelRenderer r({10.0, 0.02, 0.1, 0.05});
+  LocalContactModel touch_free;
+  touch_free.valid = true;  // the simulation's tool is usable, it touches nothing this step
+  touch_free.validity_radius_m = 0.01;
+  Vec3 x_m(0.0, 0.0, -0.001);
+  double largest_push_n = 0.0;
+  for (int k = 0; k < 200; ++k) {  // 1 ms cycles
+    const double t_s = 1e-3 * k;
+    LocalContactModel contact = wall_model(static_cast<std::uint64_t>(k) + 1);
+    contact.x0_world_m = x_m;
+    contact.f0_world_n.z() = 1.5;
+    contact.damping_n_s_per_m = Vec3(0.0, 0.0, 16.0).asDiagonal();
+    r.receive(k % 4 == 1 ? touch_free : contact, t_s);
+    // Every fourth cycle the device steps 0.16 mm out of the tissue: 0.16 m/s for one cycle.
+    const Vec3 v_m_per_s = k % 4 == 0 ? Vec3(0.0, 0.0, 0.16) : Vec3::Zero();
+    const Vec3 f_n = r.render(x_m, v_m_per_s, t_s);
+    ASSERT_GE(f_n.z(), -1e-12) << "a pull into the tissue at cycle " << k;
+    largest_push_n = std::max(largest_push_n, f_n.norm());
+  }
+  EXPECT_LE(largest_push_n, 1.5 + 1e-9);  // never more than the contact's own push
+  EXPECT_GT(r.counts().pull_zeroed, 0u);  // the damping did pull on the steps out
+}
+
 TEST(LocalModelRenderer, ReceivingAndRenderingAllocateNothing) {
   LocalModelRenderer r;
   const long before = test::allocation_count();

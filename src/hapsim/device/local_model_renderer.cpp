@@ -87,14 +87,17 @@ void LocalModelRenderer::receive(const LocalContactModel& model, double now_s) n
   ++counts_.models_received;
   // Start from what the old model renders now (its offset decayed to now, so a stream of
   // agreeing models lets an offset die out at the blend's rate), or from what was last felt
-  // when the old model went stale, or from nothing before any.
+  // when the old model went stale, or from nothing before any. "Renders" by every rule, as the
+  // hand would feel it, not the bare sum: a model that would pull (its damping against a quick
+  // step out) is not felt, and blending from its pull left one in the offset, which a free-space
+  // model after it rendered (no normal, so no push-only rule); a served rig's pad leaving the
+  // knee, its models alternating between contact and free space, stacked those pulls to 11 N.
   const Vec3 x_m = has_rendered_ ? last_x_m_ : model.x0_world_m;
   const Vec3 v_m_per_s = has_rendered_ ? last_v_m_per_s_ : model.v0_world_m_per_s;
   Vec3 start_n = Vec3::Zero();
   const bool stale = has_model_ && freshness(now_s) < 1.0;
   if (has_model_ && has_rendered_) {
-    start_n =
-        stale ? last_force_n_ : Vec3(local_model_force(newest_, x_m, v_m_per_s) + offset(now_s));
+    start_n = stale ? last_force_n_ : shaped(x_m, v_m_per_s, now_s, nullptr);
   }
   Vec3 total_offset_n = start_n - local_model_force(model, x_m, v_m_per_s);
   if (!total_offset_n.allFinite()) {
@@ -142,44 +145,46 @@ Vec3 LocalModelRenderer::render(const Vec3& x_world_m, const Vec3& v_world_m_per
   has_rendered_ = true;
   last_x_m_ = x_world_m;
   last_v_m_per_s_ = v_world_m_per_s;
-  last_force_n_ = shaped(x_world_m, v_world_m_per_s, now_s);
+  last_force_n_ = shaped(x_world_m, v_world_m_per_s, now_s, &counts_);
   return last_force_n_;
 }
 
 // haptic path
-Vec3 LocalModelRenderer::shaped(const Vec3& x_world_m, const Vec3& v_world_m_per_s,
-                                double now_s) noexcept {
+Vec3 LocalModelRenderer::shaped(const Vec3& x_world_m, const Vec3& v_world_m_per_s, double now_s,
+                                LocalModelRenderCounts* counts) const noexcept {
+  LocalModelRenderCounts uncounted;
+  LocalModelRenderCounts& c = counts != nullptr ? *counts : uncounted;
   if (newest_.valid && (x_world_m - newest_.x0_world_m).norm() > newest_.validity_radius_m) {
-    ++counts_.outside_radius;
+    ++c.outside_radius;
     return Vec3::Zero();
   }
   // An invalid (free-space) model renders zero, but for what is left of the blend from the
   // contact before it: letting go is a ramp too.
   Vec3 f = local_model_force(newest_, x_world_m, v_world_m_per_s) + offset(now_s);
   if (!f.allFinite()) {
-    ++counts_.nonfinite;
+    ++c.nonfinite;
     return Vec3::Zero();
   }
   if (newest_.valid && f.dot(newest_.normal_world) < 0.0) {
-    ++counts_.pull_zeroed;
+    ++c.pull_zeroed;
     return Vec3::Zero();
   }
   // A saturating contact pushes no harder deeper in: its cap bounds the push along the normal.
   if (newest_.valid && !newest_.normal_world.isZero()) {
     const double push_n = f.dot(newest_.normal_world);
     if (push_n > newest_.max_normal_force_n) {
-      ++counts_.capped;
+      ++c.capped;
       f -= (push_n - newest_.max_normal_force_n) * newest_.normal_world;
     }
   }
   const double fresh = freshness(now_s);
   if (fresh < 1.0) {
-    ++counts_.fading;
+    ++c.fading;
     f *= fresh;
   }
   const double magnitude = f.norm();
   if (magnitude > options_.max_force_n) {
-    ++counts_.clamped;
+    ++c.clamped;
     f *= options_.max_force_n / magnitude;
   }
   return f;

@@ -69,9 +69,10 @@ class LocalModelRenderer {
   [[nodiscard]] const LocalModelRenderOptions& options() const noexcept { return options_; }
 
  private:
-  /// The force at (x, v) by every rule of the header but the non-finite input check.
-  [[nodiscard]] Vec3 shaped(const Vec3& x_world_m, const Vec3& v_world_m_per_s,
-                            double now_s) noexcept;
+  /// The force at (x, v) by every rule of the header but the non-finite input check; what each
+  /// rule did is counted into `counts` (none: a look at what would be felt, counted nowhere).
+  [[nodiscard]] Vec3 shaped(const Vec3& x_world_m, const Vec3& v_world_m_per_s, double now_s,
+                            LocalModelRenderCounts* counts) const noexcept;
   /// What is left of the blend's and the re-engagement's offsets at `now_s`.
   [[nodiscard]] Vec3 offset(double now_s) const noexcept;
   [[nodiscard]] Vec3 reengage_offset(double now_s) const noexcept;
