@@ -1,6 +1,6 @@
 // The master arm against its geometry worked out by hand (forward kinematics, τ = Jᵀ·F, the
 // grip), and the slave following it: within its joint speed limits at every cycle, on target to
-// 0.1 mm / 0.1° while tracking, slowed but never faster after a jump, safe on bad targets.
+// 1 µm / 1e-5 rad while tracking, slowed but never faster after a jump, safe on bad targets.
 #include "hapsim/kinematics/master_arm.h"
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/slave_follower.h"
@@ -22,6 +22,8 @@ namespace {
 
 constexpr double kTolM = 1e-4;
 constexpr double kTolRad = 0.1 * std::numbers::pi / 180.0;
+constexpr double kTrackTolM = 1e-6;  // SlaveFollowerOptions::real_time_ik()
+constexpr double kTrackTolRad = 1e-5;
 
 TEST(MasterArm, HandPoseMatchesItsGeometry) {
   const MasterArm master;
@@ -108,8 +110,11 @@ void expect_tracks(const SerialChain& slave_chain) {
     }
     limited += s.velocity_limited ? 1 : 0;
     ASSERT_TRUE(s.ik_reached) << k;
-    ASSERT_LE(s.position_error_m, kTolM) << k;
-    ASSERT_LE(s.rotation_error_rad, kTolRad) << k;
+    // On the moving target every cycle, to a micrometre: with the solver's 0.1 mm tolerance the
+    // tip stayed put until the target was 0.1 mm away and then jumped there, a 0.1 m/s spike in
+    // the carried pad's velocity that the tissue's damping turned into 2 N spikes (2026-11-29).
+    ASSERT_LE(s.position_error_m, kTrackTolM) << k;
+    ASSERT_LE(s.rotation_error_rad, kTrackTolRad) << k;
   }
   EXPECT_EQ(limited, 0);  // a hand-speed motion is well within an industrial arm's speeds
 }

@@ -4,11 +4,14 @@
 // master's first pose asks.
 #include "hapsim/kinematics/procedural_motoman.h"
 #include "hapsim/kinematics/slave_follower.h"
+#include "hapsim/script/master_flange_ik.h"
 #include "hapsim/script/slave_start.h"
 #include "hapsim/script/teleop_pick_and_place_plan.h"
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <limits>
 #include <memory>
 
 namespace hapsim {
@@ -52,6 +55,32 @@ TEST(TeleopMasterPlan, SlaveStartPutsTheFlangeWhereTheMastersFirstPoseAsks) {
       first.joint_rad[0]);
   EXPECT_LT((d.slave->forward(d.slave_start_rad).translation() - target.translation()).norm(),
             1e-3);
+}
+
+// A master script is solved sample by sample from the last solution. With the solver's 0.1 mm
+// tolerance a slow press left the joints where they were until the path had moved 0.1 mm away,
+// then jumped: the master (and the slave after it) moved in 0.2 mm steps every 3-4 ms, velocity
+// spikes of 0.2 m/s that a served master rendered through the tissue's damping (2026-11-29). Each
+// sample now puts the flange where it was asked, to a micrometre, so the path keeps its speed.
+TEST(TeleopMasterPlan, ASlowPressMovesTheMasterEverySampleNotInSteps) {
+  const TeleopRigDescription d = motoman_rig();
+  const MasterArm master(d.master);
+  MasterFlangeIk ik(master, d.mapping, d.follower.gripper_max_width_m, "a slow press");
+  const Vec3 start(0.5, 0.0, 0.25);
+  Vec3 previous_flange = Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  for (int k = 0; k <= 400; ++k) {  // 20 mm down at 0.05 m/s, sampled at 1 kHz
+    const Vec3 asked = start - Vec3::UnitZ() * (0.05e-3 * k);
+    const DeviceInput in = ik.input_for(1e-3 * k, asked, 0.0);
+    const std::array<double, 3> q{in.joint_rad[0], in.joint_rad[1], in.joint_rad[2]};
+    const Vec3 flange =
+        slave_target(d.mapping, master.hand_pose(q).translation(), q[0]).translation();
+    ASSERT_LT((flange - asked).norm(), 2e-6) << "sample " << k;
+    if (k > 0) {
+      // Every sample moves it by the path's 0.05 mm: never a pause and then a double step.
+      ASSERT_NEAR((flange - previous_flange).norm(), 0.05e-3, 4e-6) << "sample " << k;
+    }
+    previous_flange = flange;
+  }
 }
 
 TEST(TeleopMasterPlan, SlaveStartOutOfReachIsFalse) {

@@ -26,6 +26,11 @@ DeviceInput MasterFlangeIk::input_for(double time_s, const Vec3& flange_world, d
   IkOptions ik;
   ik.orientation = false;
   ik.restarts = 8;
+  // To a micrometre, not the solver's 0.1 mm: tracked from the last solution, a path that moves
+  // less than the tolerance per sample leaves the joints where they were, and a 0.05 m/s press
+  // moved the master in 0.2 mm steps every 3-4 ms: velocity spikes of 0.2 m/s, which a device
+  // host renders through the contact's damping.
+  ik.position_tolerance_m = 1e-6;
   std::array<double, 3> solved{};
   const IkResult r = solve_ik(master_->arm(), target, q_, solved, ik);
   if (!r.reached) {
