@@ -41,6 +41,14 @@ struct FemCoupling::Body {
   /// Per tool: its patch's weighted displacement at the last update (body frame), to find the
   /// same material point again when the tool has pushed the surface in.
   std::array<Vec3, kMaxTools> patch_shift;
+  /// Per tool: the shift the material point's search last took off the tool's position, its last
+  /// step, and the share of a step it takes (1 until the steps reverse; see update_body).
+  struct QueryShift {
+    Vec3 shift = Vec3::Zero();
+    Vec3 last_step = Vec3::Zero();
+    double relaxation = 1.0;
+  };
+  std::array<QueryShift, kMaxTools> query{};
   /// Per tool, quasi-static only: the last update's load and its patch's displacement along the
   /// normal, and how much softer than compliance_along the tissue answered a change of load
   /// (see update_body).
@@ -144,6 +152,16 @@ constexpr double kFemMaxSoftening = 10.0;
 // over a patch 12 mm across the compliance barely changes in half a millimetre.
 constexpr double kFemComplianceReuseM = 0.5e-3;
 constexpr double kFemComplianceReuseCos = 0.9994;  // 2°
+
+// The material point's search (update_body) is a fixed-point iteration, X = closest(p - u(X)),
+// one step per update: where the displacement under the patch changes faster than the patch
+// moves (a stretch of coarse surface, the patch's nodes few and far), it overshoots and the
+// contact flips between two points every update (1.6 mm apart, 1.4 and 5.9 N: the
+// tele-palpation's second press on the 20k knee). A step that reverses the last one by more than
+// this halves the share of each step taken, down to the smallest; a contact that never reverses
+// takes whole steps, as before.
+constexpr double kFemQueryReversalM = 1e-4;
+constexpr double kFemQueryMinRelaxation = 1.0 / 16.0;
 
 // The thinnest tissue a stiffening rate is taken over: a surface vertex on (or at) a fixed node
 // would otherwise stiffen without bound.
@@ -511,6 +529,8 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     patch.clear();
     Body::Secant secant = body.secant[t];  // kept only while the tool stays in contact
     body.secant[t] = Body::Secant{};
+    Body::QueryShift query = body.query[t];  // likewise
+    body.query[t] = Body::QueryShift{};
     if (!launch.usable[t]) {
       continue;
     }
@@ -521,8 +541,16 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
     // point, not the rim of its own dent). Its gap is measured along the patch's normal from
     // where the patch is now: exactly the series law the model linearises,
     // F = k_c·(d − n·H·u), whatever the dent's shape.
-    const SurfacePoint sp =
-        body.rest_bvh->closest_point(p_body - body.patch_shift[t], &body.hints[t]);
+    // One step of the search towards the patch's displacement; a step that reverses the last one
+    // (the search overshot) makes the following steps shorter.
+    const Vec3 step = body.patch_shift[t] - query.shift;
+    if (step.norm() > kFemQueryReversalM && step.dot(query.last_step) < 0.0) {
+      query.relaxation = std::max(kFemQueryMinRelaxation, 0.5 * query.relaxation);
+    }
+    query.shift =
+        query.relaxation < 1.0 ? Vec3(query.shift + query.relaxation * step) : body.patch_shift[t];
+    query.last_step = step;
+    const SurfacePoint sp = body.rest_bvh->closest_point(p_body - query.shift, &body.hints[t]);
     body.patch_shift[t].setZero();
     if (!sp.found() || !std::isfinite(sp.signed_distance) ||
         sp.triangle >= body.surface.triangles.size()) {
@@ -587,6 +615,7 @@ void FemCoupling::update_body(std::size_t b, const FemLaunch& launch, FemUpdate&
       continue;
     }
     body.patch_shift[t] = shift;
+    body.query[t] = query;
     const Vec3 n_world = body.X_world_body.linear() * normal;
     const double rendered_n =
         std::max(0.0, launch.push_world_n[t * kMaxFemBodies + b].dot(n_world));
@@ -670,6 +699,7 @@ void FemCoupling::reset() {
       p.clear();
     }
     body->hints = {};
+    body->query = {};
     for (Vec3& shift : body->patch_shift) {
       shift.setZero();
     }
