@@ -314,6 +314,29 @@ TEST_F(RigMasterHostTest, TheCarriedToolsForceIsFeltThroughTheMastersJacobian) {
       << newest.rendered.force_world_n.transpose();
 }
 
+// The master's cycle on the haptic path: where the slave's target puts the tool, the rendered
+// model, the master's Jᵀ and the state it sends allocate nothing, as the probe's cycle does.
+TEST_F(RigMasterHostTest, AMasterCycleAllocatesNothing) {
+  const std::array<double, 3> at_state{0.1, 0.7, 1.4};
+  for (int k = 0; k < 5; ++k) {
+    (void)master_cycle(at_state);
+  }
+  const DeviceStateSample state = newest_state();
+  const Vec3 x0 = rig->flange_point_target_world(master(at_state), kToolInFlange);
+  models_out.write(encode_local_model(wall_model(1, state.sequence, x0), {0, 0}, kHash));
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  for (int k = 0; k < 30; ++k) {  // blended in (20 ms of the host's clock)
+    (void)master_cycle(at_state);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  const long before = hapsim::test::thread_allocation_count();
+  for (int k = 0; k < 500; ++k) {
+    (void)master_cycle({0.1, 0.7, 1.4 + 1e-6 * k});
+  }
+  EXPECT_EQ(hapsim::test::thread_allocation_count() - before, 0);
+  EXPECT_GT(client->status().peak_joint_torque_nm, 0.1);  // it rendered the model meanwhile
+}
+
 TEST_F(DeviceHostClientTest, ASecondHostOnTheSameDeviceIdTellsTheOthersModelsFromItsOwn) {
   DeviceHostClient second(participant, options());
   second.set_scene(scene());

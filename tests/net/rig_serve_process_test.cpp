@@ -4,14 +4,15 @@
 // FEM knee; serve sends the pad's local contact models; the device host renders them where the
 // slave's target puts the pad and feels them through the master's Jᵀ, and tells serve the force
 // its torques stand for, which the tissue takes as its load (SPEC §8).
-//  * The served world reproduces the one-process run within the knee's three-process tolerances:
-//    the pad's peak force and the master's peak joint torque within 10 % (0.2 % idle, up to 5.6 %
-//    beside stress-ng), its contacts within 5 % of the one-process count (allowing for serve's
-//    pace).
+//  * The served world and what the device host rendered reproduce the one-process run within the
+//    knee's three-process tolerances: the pad's peak force and the master's peak joint torque
+//    within 5 % (measured within 0.05 % on an idle machine), its contacts within 5 % of the
+//    one-process count (allowing for serve's pace).
+//  * Those 5 % hold while serve's FEM keeps up. Beside stress-ng its updates come at half their
+//    rate or less, and the pad sliding between the landmarks meets models 30 ms old: the served
+//    tissue is then not the one-process run's (+28 % in 1 of 3 such runs), as for a served FEM
+//    block (fem_serve_process_test.cpp), and the bounds are that test's.
 //  * A headless viewer (hapsim watch) sees the pad's force, not the master's zero tip force.
-//  * What the device host rendered from those models, and the master's torque it made of it,
-//    peak between 0.5 and 2 times the one-process peaks (measured 1.3x idle, 0.84x to 1.7x under
-//    load: not yet understood).
 #include "apps/hapsim_process.h"
 #include "net/net_test_support.h"
 
@@ -74,15 +75,24 @@ TEST(RigServe, ServeAndMasterReproduceTheOneProcessTelepalpation) {
   const double one_torque_nm = a["peak_master_torque_nm"].get<double>();
   EXPECT_GT(one_peak_n, 3.0);  // the pad pressed the knee
   EXPECT_GT(one_torque_nm, 0.5);
+  // Serve's FEM keeps up when it made most of its updates: 69-77 % of 1 050 on an idle machine
+  // (its 24k-tet update takes 12-13 ms against its 10 ms period), 36-50 % beside stress-ng.
+  const double fem_updates = b["fem"]["updates"].get<double>();
+  const double fem_periods = 10.5 / (1e-3 * b["fem"]["period_steps"].get<double>());
+  const bool fem_kept_up = fem_updates >= 0.6 * fem_periods;
+  const double low = fem_kept_up ? 0.95 : 0.85;
+  const double high = fem_kept_up ? 1.05 : 1.6;
+  if (!fem_kept_up) {
+    std::printf(
+        "serve's FEM made %.0f of %.0f updates: this machine could not keep it in real "
+        "time, so the forces are held to the served FEM block's bounds, not the 5 %%\n",
+        fem_updates, fem_periods);
+  }
   // The served world: the same presses through the master's joints, as hard as in one process.
-  // Idle within 0.2 %; beside stress-ng 6.68 to 7.07 N (-5.4 %): the FEM tissue takes the
-  // master's push (SPEC §8), whose rendering is not yet right (below). 10 % here; the knee's
-  // three-process test holds 5 % on a world without FEM.
-  EXPECT_NEAR(b["peak_tool_force_n"].get<double>(), one_peak_n, 0.10 * one_peak_n);
-  // The torque is Jᵀ·F at the master's pose of that moment: a device loop late under load plays
-  // its script at slightly other times, and the same press meets a slightly other pose (1.994
-  // against 2.112 N·m beside stress-ng, while the force held 7.04 against 7.06 N).
-  EXPECT_NEAR(b["peak_master_torque_nm"].get<double>(), one_torque_nm, 0.10 * one_torque_nm);
+  EXPECT_GE(b["peak_tool_force_n"].get<double>(), low * one_peak_n);
+  EXPECT_LE(b["peak_tool_force_n"].get<double>(), high * one_peak_n);
+  EXPECT_GE(b["peak_master_torque_nm"].get<double>(), low * one_torque_nm);
+  EXPECT_LE(b["peak_master_torque_nm"].get<double>(), high * one_torque_nm);
   const double pace = test::serve_pace(serve.output());
   ASSERT_GT(pace, 0.0) << serve.output();
   const double one_contacts = a["tools"][0]["contact_steps"].get<double>();
@@ -92,6 +102,15 @@ TEST(RigServe, ServeAndMasterReproduceTheOneProcessTelepalpation) {
   // (three_process_test.cpp).
   EXPECT_GE(served_contacts, 0.95 * std::min(pace, 1.0) * one_contacts - 1.0);
   EXPECT_LE(served_contacts, 1.05 * one_contacts + 1.0);
+  // The master: the pad's models rendered at its own pose, felt through its joints, as the
+  // one-process master felt the pad (4.520 against 4.518 N, 1.295 against 1.294 N·m, idle).
+  // Before: 1.3x idle and up to 1.7x loaded, from two faults since fixed: the renderer's blend
+  // stacked the pulls a step out of the tissue would have made (device/local_model_renderer.cpp),
+  // and the master's script moved it in 0.2 mm steps (script/master_flange_ik.cpp).
+  EXPECT_GE(d["peak_force_n"].get<double>(), low * one_peak_n);
+  EXPECT_LE(d["peak_force_n"].get<double>(), high * one_peak_n);
+  EXPECT_GE(d["peak_joint_torque_nm"].get<double>(), low * one_torque_nm);
+  EXPECT_LE(d["peak_joint_torque_nm"].get<double>(), high * one_torque_nm);
   EXPECT_EQ(b["pop_throughs"].get<int>(), 0);
   EXPECT_EQ(b["serve"]["device_states"]["malformed"].get<int>(), 0);
   EXPECT_GT(b["serve"]["device_host_cycles"].get<int>(), 9'000);  // the master drove it all
@@ -105,15 +124,6 @@ TEST(RigServe, ServeAndMasterReproduceTheOneProcessTelepalpation) {
   EXPECT_GE(w["peak_force_n"].get<double>(), 0.5 * one_peak_n);
   EXPECT_TRUE(std::filesystem::exists(watch_png));
 
-  // The master: the pad's models rendered at its own pose, felt through its joints. Its peak is
-  // not yet the world's: 9.2 N against 7.07 N on an idle machine (1.3x); beside stress-ng from
-  // 6.15 N to 12 N (0.87x to 1.7x; torques 0.84x to 1.7x), where a probe on the same served FEM
-  // knee peaks within 1 %. Not understood yet (docs/architecture.md, "A rig served"). Held here:
-  // it felt the presses, and at most twice what the world pushed.
-  EXPECT_GT(d["peak_force_n"].get<double>(), 0.5 * one_peak_n);
-  EXPECT_LT(d["peak_force_n"].get<double>(), 2.0 * one_peak_n);
-  EXPECT_GT(d["peak_joint_torque_nm"].get<double>(), 0.5 * one_torque_nm);
-  EXPECT_LT(d["peak_joint_torque_nm"].get<double>(), 2.0 * one_torque_nm);
   EXPECT_EQ(d["models"]["malformed"].get<int>(), 0);
   EXPECT_GT(d["models_rendered"].get<int>(), 5'000);
 }

@@ -279,9 +279,11 @@ const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_
     command_ = DeviceCommand{};
     options_.rig->master_command({input.joint_rad[0], input.joint_rad[1], input.joint_rad[2]},
                                  at_slave_tool_n, 0.0, command_);
+    double largest_torque_nm = 0.0;
     for (const double torque_nm : command_.joint_torque_nm) {
-      raise_to(peak_joint_torque_nm_, std::abs(torque_nm));
+      largest_torque_nm = std::max(largest_torque_nm, std::abs(torque_nm));
     }
+    raise_to(peak_joint_torque_nm_, largest_torque_nm);  // one atomic a cycle, not one a joint
   }
   rate_limited_.fetch_add(limited ? 1 : 0, std::memory_order_relaxed);
   passivity_cycles_.fetch_add(acted > 0 ? 1 : 0, std::memory_order_relaxed);
