@@ -284,10 +284,15 @@ void use_served_rig(const DeviceArgs& args, const net::SceneInfoSample& info, Ho
         "master arm   of the served rig: tool '%s' at the slave's flange, its force felt "
         "through the master's joints\n",
         world.tools[carried].name.c_str());
-  } else {
+  }
+  if (grasps_ball(rig->description())) {
     std::printf(
-        "master arm   of the served rig: it carries no tool, so nothing is felt here (the "
-        "gripper's pads are not served as contact models)\n");
+        "master arm   of the served rig: its gripper's pads on the ball felt through the "
+        "master's joints (what the ball weighs on them) and fingers (their grip)\n");
+  } else if (carried >= world.tools.size()) {
+    std::printf(
+        "master arm   of the served rig: it carries no tool and grasps no ball, so nothing is "
+        "felt here\n");
   }
 }
 
@@ -546,8 +551,14 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
               s.passivity_dissipated_j * 1e3);
   if (options.rig) {
     std::printf(
-        "master arm   peak joint torque %.3f N m (the carried tool's force through its Jt)\n",
-        s.peak_joint_torque_nm);
+        "master arm   peak joint torque %.3f N m (the force at the slave's tool through its Jt), "
+        "peak grasp %.3f N\n",
+        s.peak_joint_torque_nm, s.peak_grasp_force_n);
+    if (s.held_cycles > 0) {
+      std::printf("master arm   held the ball %" PRIu64
+                  " cycles, feeling %.3f N at the slave's tool on average\n",
+                  s.held_cycles, s.mean_held_force_n);
+    }
   }
   std::printf("models       %" PRIu64 " rendered (%" PRIu64 " answering the script, not us);",
               s.models_accepted, s.models_not_ours);
@@ -569,6 +580,9 @@ void run_device(const DeviceArgs& args, JsonOutput& json_out) {
     j["peak_force_n"] = s.peak_force_n;
     if (options.rig) {
       j["peak_joint_torque_nm"] = s.peak_joint_torque_nm;
+      j["peak_grasp_force_n"] = s.peak_grasp_force_n;
+      j["mean_held_force_n"] = s.mean_held_force_n;
+      j["held_cycles"] = s.held_cycles;
     }
     j["rate_limited_cycles"] = s.rate_limited_cycles;
     j["passivity"] = {{"cycles_acted", s.passivity_cycles},

@@ -337,6 +337,140 @@ TEST_F(RigMasterHostTest, AMasterCycleAllocatesNothing) {
   EXPECT_GT(client->status().peak_joint_torque_nm, 0.1);  // it rendered the model meanwhile
 }
 
+// A rig that grasps a ball: the served world sends its two pads' models (rig/pad_models.h) in the
+// grip's frame after the master's tools (here none), and the master feels their push on its
+// fingers and their sum (what the ball weighs on them) through its arm's Jᵀ. Carrying the grip
+// squeezes nothing; opening it lets the pads off the ball by the pads' spring.
+class RigGraspHostTest : public DeviceHostClientTest {
+ protected:
+  [[nodiscard]] DeviceHostOptions options() const override {
+    DeviceHostOptions o;
+    o.rig = rig;
+    o.render.max_force_n = 100.0;  // the simulated master's rating: the 2 x 20 N are not clamped
+    // The models start preloaded (the grip this host never saw close), so letting it off gives
+    // back energy the observer never saw go in: it would damp the opening checked below.
+    o.passivity.enabled = false;
+    return o;
+  }
+  [[nodiscard]] ServedScene scene() const override {
+    ServedScene s = DeviceHostClientTest::scene();
+    s.tool_count = 0;  // the pick-and-place rig carries no tool: only its pads are served
+    return s;
+  }
+
+  static std::shared_ptr<const RigController> make_rig() {
+    TeleopRigDescription d;
+    d.slave = std::make_shared<const SerialChain>(make_procedural_motoman());
+    d.ball_body = 0;  // the host never reads the bodies: only that there are a ball and pads
+    d.pad_body = {1, 2};
+    return std::make_shared<const RigController>(std::move(d));
+  }
+
+  static DeviceInput master(const std::array<double, 3>& arm_rad, double finger_rad) {
+    DeviceInput in;
+    in.healthy = true;
+    in.joint_count = 3;
+    in.finger_count = 2;
+    for (std::size_t i = 0; i < 3; ++i) {
+      in.joint_rad[i] = arm_rad[i];
+    }
+    in.finger_rad[0] = in.finger_rad[1] = finger_rad;
+    return in;
+  }
+
+  // Pad `i`'s model for the pads where the master `in` puts them: in the grip's frame (from the
+  // pads' midpoint), pushing `push_n` out of the ball and carrying half the ball's 1 N weight.
+  LocalContactModel pad_model(const DeviceInput& in, std::size_t i, double push_n,
+                              std::uint64_t sequence, std::uint64_t answered) const {
+    const Vec3 p0 = rig->pad_centre_target_world(in, 0);
+    const Vec3 p1 = rig->pad_centre_target_world(in, 1);
+    const Vec3 x0 = i == 0 ? Vec3(0.5 * (p0 - p1)) : Vec3(0.5 * (p1 - p0));
+    const Vec3 n = x0.normalized();
+    LocalContactModel m;
+    m.x0_world_m = x0;
+    m.f0_world_n = push_n * n + Vec3(0.0, 0.0, -0.5);
+    m.stiffness_n_per_m = kPadStiffness * n * n.transpose();
+    m.normal_world = n;
+    m.validity_radius_m = 0.01;
+    m.max_normal_force_n = 20.0;
+    m.sequence = sequence;
+    m.device_sequence = answered;
+    m.valid = true;
+    return m;
+  }
+
+  static constexpr double kPadStiffness = 5000.0;
+  std::shared_ptr<const RigController> rig = make_rig();
+};
+
+TEST_F(RigGraspHostTest, TheMasterFeelsTheGripAndTheBallsWeight) {
+  const std::array<double, 3> at_state{0.1, 0.7, 1.4};
+  constexpr double kFinger = 0.3;
+  for (int k = 0; k < 5; ++k) {
+    input = master(at_state, kFinger);
+    EXPECT_EQ(step_once().finger_force_n[0], 0.0);  // no model yet
+  }
+  const DeviceStateSample state = newest_state();
+  ASSERT_GT(state.sequence, 0u);
+  const DeviceInput there = master(at_state, kFinger);
+  ASSERT_TRUE(rig->pad_centre_target_world(there, 0).allFinite());
+  // Since that state the master carried the grip 2 mrad of shoulder on (millimetres in the world).
+  const std::array<double, 3> carried{0.1, 0.702, 1.4};
+  ASSERT_GT((rig->pad_centre_target_world(master(carried, kFinger), 0) -
+             rig->pad_centre_target_world(there, 0))
+                .norm(),
+            5e-4);
+  std::uint64_t sent = 0;
+  auto last_written = std::chrono::steady_clock::now();
+  DeviceCommand command;
+  for (int k = 0; k < 60; ++k) {  // models for 30 ms, then the blend runs out
+    if (k % 10 == 0 && k < 30) {
+      ++sent;
+      for (std::size_t i = 0; i < 2; ++i) {
+        models_out.write(encode_local_model(pad_model(there, i, 15.0, sent, state.sequence),
+                                            {0, static_cast<std::uint16_t>(i)}, kHash));
+      }
+      last_written = std::chrono::steady_clock::now();
+    }
+    input = master(carried, kFinger);
+    command = step_once();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_GE(client->status().models_accepted, 2u);
+  const double since_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - last_written)
+          .count();
+  if (since_ms > 90.0) {
+    GTEST_SKIP() << "this thread stalled: the last model is " << since_ms << " ms old (stale)";
+  }
+  // Carried, not squeezed: the grip is the models' 15 N, the pads' sum the ball's weight.
+  EXPECT_NEAR(command.finger_force_n[0], 15.0, 1e-9);
+  EXPECT_NEAR(command.finger_force_n[1], 15.0, 1e-9);
+  DeviceCommand want;
+  rig->master_command(carried, Vec3(0.0, 0.0, -1.0), 15.0, want);
+  for (std::size_t j = 0; j < 5; ++j) {
+    EXPECT_NEAR(command.joint_torque_nm[j], want.joint_torque_nm[j], 1e-9) << j;
+  }
+  EXPECT_GT(std::abs(want.joint_torque_nm[1]) + std::abs(want.joint_torque_nm[2]), 0.01);
+  EXPECT_EQ(command.force_world_n, Vec3::Zero());
+  // Opening the grip lets each pad off by how far it moved out along its normal.
+  const DeviceInput opened = master(carried, kFinger + 0.005);
+  const Vec3 x_before = rig->pad_centre_target_world(master(carried, kFinger), 0) -
+                        rig->pad_centre_target_world(master(carried, kFinger), 1);
+  const Vec3 x_after =
+      rig->pad_centre_target_world(opened, 0) - rig->pad_centre_target_world(opened, 1);
+  const double out_m = 0.5 * (x_after.norm() - x_before.norm());
+  ASSERT_GT(out_m, 1e-5);
+  ASSERT_LT(kPadStiffness * out_m, 2.0);  // within a cycle's rate limit
+  input = opened;
+  command = step_once();
+  EXPECT_NEAR(command.finger_force_n[0], 15.0 - kPadStiffness * out_m, 1e-6);
+  const DeviceHostStatus status = client->status();
+  EXPECT_NEAR(status.peak_grasp_force_n, 15.0, 1e-9);
+  EXPECT_GT(status.held_cycles, 10u);
+  EXPECT_NEAR(status.mean_held_force_n, 1.0, 0.5);  // the weight, after the blend from nothing
+}
+
 TEST_F(DeviceHostClientTest, ASecondHostOnTheSameDeviceIdTellsTheOthersModelsFromItsOwn) {
   DeviceHostClient second(participant, options());
   second.set_scene(scene());

@@ -103,6 +103,44 @@ TEST_F(RemoteDeviceTest, TheFirstStateAfterAReckonedCycleIsAtLeastAStepLater) {
   EXPECT_NEAR(remote.read(0.004).time_s - late.time_s, 0.001, 1e-12);
 }
 
+// A master arm's joints (and fingers) move on at the rate of its last two states in a cycle
+// without one, as the tip does at its velocity: held, the served slave would stand a cycle and
+// then jump two, and a ball its pads hold would take that stop's deceleration.
+TEST_F(RemoteDeviceTest, AMastersJointsMoveOnAtTheirRateInACycleWithoutAState) {
+  TopicWriter<hapsim_msg_DeviceState> host(participant);
+  matched(host);
+  const auto master_state = [](std::uint64_t n, double host_time_s, double shoulder_rad,
+                               double finger_rad) {
+    DeviceStateSample s;
+    s.sequence = n;
+    s.input.time_s = host_time_s;
+    s.input.joint_count = 3;
+    s.input.joint_rad = {0.1, shoulder_rad, 1.4};
+    s.input.finger_count = 2;
+    s.input.finger_rad = {finger_rad, finger_rad};
+    return encode_device_state(s, kHash);
+  };
+  // The shoulder at 2 rad/s, the fingers closing at 1 rad/s.
+  ASSERT_TRUE(host.write(master_state(1, 5.000, 0.700, 0.300)));
+  settle();
+  (void)remote.read(0.000);
+  ASSERT_TRUE(host.write(master_state(2, 5.001, 0.702, 0.299)));
+  settle();
+  const DeviceInput b = remote.read(0.001);
+  EXPECT_NEAR(b.joint_rad[1], 0.702, 1e-15);
+  const DeviceInput reckoned = remote.read(0.002);  // no state
+  EXPECT_NEAR(reckoned.joint_rad[1], 0.704, 1e-12);
+  EXPECT_NEAR(reckoned.joint_rad[0], 0.1, 1e-15);  // standing joints stand
+  EXPECT_NEAR(reckoned.finger_rad[0], 0.298, 1e-12);
+  EXPECT_NEAR(reckoned.finger_rad[1], 0.298, 1e-12);
+  const DeviceInput twice = remote.read(0.003);  // still none
+  EXPECT_NEAR(twice.joint_rad[1], 0.706, 1e-12);
+  // The real state takes over where it says the master is.
+  ASSERT_TRUE(host.write(master_state(3, 5.004, 0.7075, 0.296)));
+  settle();
+  EXPECT_NEAR(remote.read(0.004).joint_rad[1], 0.7075, 1e-15);
+}
+
 // Several users: the other users' states reach every link in serve; each link skips its
 // siblings' without a verdict, so "other device" counts only strangers' states.
 TEST_F(RemoteDeviceTest, AnotherUsersStatesAreNotCountedAsAStrangersDevice) {

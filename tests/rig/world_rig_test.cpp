@@ -5,6 +5,8 @@
 #include "hapsim/rig/rig_controller.h"
 #include "hapsim/rig/rig_world.h"
 #include "hapsim/world/world.h"
+#include "hapsim/world/world_model.h"
+#include "hapsim/world/world_state.h"
 
 #include "hapsim/kinematics/procedural_motoman.h"
 
@@ -12,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <memory>
@@ -97,6 +100,54 @@ TEST(WorldRig, UnusableMasterInputHoldsTheSlaveAndSendsNoTorque) {
   bad = master(0.2);
   bad.healthy = false;
   EXPECT_EQ(world.step(bad, 1e-3).command.joint_count, 0);
+}
+
+// The grasp report, observed from a step's result alone: both pads pressing the ball from opposite
+// sides hold it; a pad off the ball for a step or two (a served slave jerked by a stalled cycle)
+// lets nothing go; off for kReleaseAfterS it is a release, dated when the pad left.
+TEST(WorldRig, APadOffTheBallForAStepIsNoRelease) {
+  World world(rig());
+  (void)world.step(master(0.2), 1e-3);
+  RigState& state = const_cast<RigState&>(*rig_state(world));  // observe() is the test's to call
+  const TeleopRigDescription& d = *state.description;
+  // What the body-contact stage reports: each pad's push on the ball, its normal out of the pad.
+  const auto contact = [&](std::size_t pad, double push_n) {
+    BodyContact c;
+    c.body = BodyIndex{d.ball_body};
+    c.other_body = BodyIndex{d.pad_body[pad]};
+    c.normal_world = pad == 0 ? Vec3(0.0, -1.0, 0.0) : Vec3(0.0, 1.0, 0.0);
+    c.force_world_n = push_n * c.normal_world;
+    return c;
+  };
+  const std::array<BodyContact, 2> both{contact(0, 20.0), contact(1, 20.0)};
+  const std::array<BodyContact, 1> one{contact(0, 20.0)};
+  StepResult step = world.last_result();
+  const auto observe = [&](double time_s, std::span<const BodyContact> contacts) {
+    step.time_s = time_s;
+    step.body_contacts = contacts;
+    // The pads' pushes, as the command stage reads them off the same contacts.
+    state.result.gripper.pad_force_n = {20.0, contacts.size() == 2 ? 20.0 : 0.0};
+    state.observe(world.model(), step);
+    return state.result.gripper;
+  };
+  EXPECT_TRUE(observe(1.000, both).grasped_now);
+  for (int k = 1; k <= 3; ++k) {  // one pad lifted for 3 ms: still held
+    const GripperReport g = observe(1.000 + 1e-3 * k, one);
+    EXPECT_TRUE(g.held);
+    EXPECT_FALSE(g.released_now);
+  }
+  EXPECT_TRUE(observe(1.004, both).held);
+  // Lifted for good at 1.005 s: held for 20 ms more, then released, dated 1.005 s.
+  for (int k = 5; k < 25; ++k) {
+    const GripperReport g = observe(1.000 + 1e-3 * k, one);
+    EXPECT_TRUE(g.held) << k;
+    EXPECT_FALSE(g.released_now) << k;
+  }
+  const GripperReport released = observe(1.025, one);
+  EXPECT_FALSE(released.held);
+  EXPECT_TRUE(released.released_now);
+  EXPECT_DOUBLE_EQ(released.released_at_s, 1.005);
+  EXPECT_FALSE(observe(1.026, one).released_now);  // said once
 }
 
 }  // namespace

@@ -82,6 +82,7 @@ DeviceHostClient::DeviceHostClient(const Participant& participant, const DeviceH
   sequence_base_ =
       options.state_sequence_base != 0 ? options.state_sequence_base : (draw_serve_id() >> 2U) + 1;
   sequence_ = sequence_base_;
+  rig_grasps_ = options.rig && grasps_ball(options.rig->description());
 }
 
 void DeviceHostClient::set_scene(const ServedScene& scene) noexcept {
@@ -103,7 +104,9 @@ void DeviceHostClient::apply_scene() noexcept {
   unpack_layout(pending_layout_.load(std::memory_order_relaxed), scene_);
   // A new simulation numbers its models from 1 again and knows nothing of the old one's: start
   // from no model (the renderers blend the first one in from zero).
-  gate_ = LocalModelGate(options_.device_id, scene_.scene_hash, std::max<int>(1, scene_.tool_count),
+  // A grasping rig's pads are keyed after the master's tools.
+  const int keys = std::min<int>(scene_.tool_count + (rig_grasps_ ? 2 : 0), kMaxFingers);
+  gate_ = LocalModelGate(options_.device_id, scene_.scene_hash, std::max<int>(1, keys),
                          options_.limits);
   // A tool on a finger renders to the finger actuator's rating, the others to the tip's.
   for (std::size_t t = 0; t < renderers_.size(); ++t) {
@@ -194,15 +197,15 @@ void DeviceHostClient::admit_model(const hapsim_msg_LocalModel& m, double now_s,
 }
 
 // haptic path
-Vec3 DeviceHostClient::tool_force(std::size_t tool, const Vec3& p_device_m, double now_s) noexcept {
+Vec3 DeviceHostClient::key_force(std::size_t key, std::size_t point, double now_s) noexcept {
   if (options_.mode == ForceMode::kRaw) {
-    const LocalModelRenderOptions& o = renderers_[tool].options();
-    const LocalContactModel& m = raw_models_[tool];
+    const LocalModelRenderOptions& o = renderers_[key].options();
+    const LocalContactModel& m = raw_models_[key];
     if (!m.valid) {
       return Vec3::Zero();
     }
     // The paper's raw force, held; still faded when stale and clamped (safety is not optional).
-    const double age_s = now_s - raw_received_s_[tool];
+    const double age_s = now_s - raw_received_s_[key];
     const double fresh =
         age_s <= o.stale_after_s
             ? 1.0
@@ -211,14 +214,37 @@ Vec3 DeviceHostClient::tool_force(std::size_t tool, const Vec3& p_device_m, doub
     const double magnitude = f.norm();
     return magnitude > o.max_force_n ? Vec3(f * (o.max_force_n / magnitude)) : f;
   }
-  LocalModelRenderer& renderer = renderers_[tool];
+  LocalModelRenderer& renderer = renderers_[key];
   const LocalContactModel& m = renderer.newest();
   // Where the tool is now: where the simulation had it, moved as the device moved since.
   Vec3 x_tool_m = m.x0_world_m;
   if (m.valid && m.device_sequence > 0 && sequence_ - m.device_sequence < kHistory) {
-    x_tool_m += p_device_m - p_history_m_[m.device_sequence % kHistory];
+    x_tool_m += p_m_[point] - p_history_m_[m.device_sequence % kHistory][point];
   }
-  return renderer.render(x_tool_m, v_m_per_s_, now_s);
+  return renderer.render(x_tool_m, v_m_per_s_[point], now_s);
+}
+
+// haptic path
+Vec3 DeviceHostClient::render_key(std::size_t key, std::size_t point, double dt_s, double now_s,
+                                  bool& limited, std::uint64_t& acted,
+                                  double& dissipated_j) noexcept {
+  Vec3 f = key_force(key, point, now_s);
+  PassivityObserver& observer = passivity_[key];
+  if (f.isZero()) {
+    observer.reset();  // free space: nothing stored, nothing owed
+  }
+  const std::uint64_t acted_before = observer.counts().acted;
+  f = observer.filter(f, v_m_per_s_[point], dt_s);
+  acted += observer.counts().acted - acted_before;
+  dissipated_j += observer.counts().dissipated_j;
+  const double max_step_n = options_.max_force_rate_n_per_s * dt_s;
+  const Vec3 change = f - previous_force_n_[key];
+  if (change.norm() > max_step_n) {
+    f = previous_force_n_[key] + change * (max_step_n / change.norm());
+    limited = true;
+  }
+  previous_force_n_[key] = f;
+  return f;
 }
 
 // haptic path
@@ -227,40 +253,40 @@ const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_
   const double now_s = static_cast<double>(now_ns) * 1e-9;
   apply_scene();
   ++sequence_;
-  // A rig's master: the position that moves with it is the carried tool's on the slave's target.
-  const Vec3 p_input_m =
-      options_.rig ? options_.rig->flange_point_target_world(input, options_.rig_tool_flange_m)
-                   : input.p_world;
-  const Vec3 p_m = p_input_m.allFinite() ? p_input_m : p_previous_m_;
-  v_m_per_s_ = sequence_ > sequence_base_ + 1 && dt_s > 0.0 ? Vec3((p_m - p_previous_m_) / dt_s)
-                                                            : Vec3::Zero();
-  p_previous_m_ = p_m;
-  p_history_m_[sequence_ % kHistory] = p_m;
+  // The points that move with the device: its own, or a rig master's carried tool on the slave's
+  // target; a grasping rig's pads where that target and the master's grip put them.
+  std::array<Vec3, kPoints> p_now{};
+  p_now[0] = options_.rig
+                 ? options_.rig->flange_point_target_world(input, options_.rig_tool_flange_m)
+                 : input.p_world;
+  if (rig_grasps_) {
+    // The pads in the grip's frame, as their models are (rig/pad_models.h): relative to their
+    // midpoint, so carrying the ball moves nothing and only the grip's opening squeezes it.
+    const Vec3 pads[2] = {options_.rig->pad_centre_target_world(input, 0),
+                          options_.rig->pad_centre_target_world(input, 1)};
+    const Vec3 mid = 0.5 * (pads[0] + pads[1]);
+    p_now[1] = pads[0] - mid;
+    p_now[2] = pads[1] - mid;
+  } else {
+    p_now[1] = p_now[2] = p_now[0];
+  }
+  const bool has_previous = sequence_ > sequence_base_ + 1 && dt_s > 0.0;
+  for (std::size_t j = 0; j < kPoints; ++j) {
+    const Vec3 p = p_now[j].allFinite() ? p_now[j] : p_m_[j];
+    v_m_per_s_[j] = has_previous ? Vec3((p - p_m_[j]) / dt_s) : Vec3::Zero();
+    p_m_[j] = p;
+    p_history_m_[sequence_ % kHistory][j] = p;
+  }
   took_model_ = false;
   take_models(now_s, now_ns);
 
   command_ = DeviceCommand{};
-  const double max_step_n = options_.max_force_rate_n_per_s * dt_s;
   double largest_n = 0.0;
   bool limited = false;
   std::uint64_t acted = 0;
   double dissipated_j = 0.0;
   for (std::size_t t = 0; t < scene_.tool_count; ++t) {
-    Vec3 f = tool_force(t, p_m, now_s);
-    PassivityObserver& observer = passivity_[t];
-    if (f.isZero()) {
-      observer.reset();  // free space: nothing stored, nothing owed
-    }
-    const std::uint64_t acted_before = observer.counts().acted;
-    f = observer.filter(f, v_m_per_s_, dt_s);
-    acted += observer.counts().acted - acted_before;
-    dissipated_j += observer.counts().dissipated_j;
-    const Vec3 change = f - previous_force_n_[t];
-    if (change.norm() > max_step_n) {
-      f = previous_force_n_[t] + change * (max_step_n / change.norm());
-      limited = true;
-    }
-    previous_force_n_[t] = f;
+    const Vec3 f = render_key(t, 0, dt_s, now_s, limited, acted, dissipated_j);
     largest_n = std::max(largest_n, f.norm());
     const int finger = scene_.tool_finger[t];
     if (finger >= 0 && finger < kMaxFingers) {
@@ -272,18 +298,43 @@ const DeviceCommand& DeviceHostClient::step(const DeviceInput& input, double dt_
     }
   }
   if (options_.rig) {
-    // The master feels the carried tool's force through its joints, as the served rig's command
-    // would make it (no grasp: the pads' contacts are not served as models).
-    const Vec3 at_slave_tool_n = command_.force_world_n;
-    rig_force_world_n_ = at_slave_tool_n;
+    // The master feels the force at the slave's tool through its joints and the grasp through its
+    // fingers, as the served rig's command makes them (rig_command.cpp): the carried tool's force
+    // and the pads' (what the ball pushes on them), and the pads' mean push.
+    rig_force_world_n_ = command_.force_world_n;
+    Vec3 at_slave_tool_n = rig_force_world_n_;
+    double grasp_n = 0.0;
+    int pressing = 0;
+    for (std::size_t i = 0; i < 2 && rig_grasps_; ++i) {
+      const std::size_t key = scene_.tool_count + i;
+      if (key >= static_cast<std::size_t>(kMaxFingers)) {
+        break;
+      }
+      const Vec3 f = render_key(key, 1 + i, dt_s, now_s, limited, acted, dissipated_j);
+      const LocalContactModel& m =
+          options_.mode == ForceMode::kRaw ? raw_models_[key] : renderers_[key].newest();
+      at_slave_tool_n += f;
+      const double push_n = f.dot(m.normal_world);
+      grasp_n += 0.5 * std::max(0.0, push_n);
+      pressing += push_n > 0.0 ? 1 : 0;
+    }
+    if (pressing == 2) {
+      ++held_cycles_;
+      mean_held_force_n_ +=
+          (at_slave_tool_n.norm() - mean_held_force_n_) / static_cast<double>(held_cycles_);
+      published_mean_held_force_n_.store(mean_held_force_n_, std::memory_order_relaxed);
+      published_held_cycles_.store(held_cycles_, std::memory_order_relaxed);
+    }
+    largest_n = at_slave_tool_n.norm();
     command_ = DeviceCommand{};
     options_.rig->master_command({input.joint_rad[0], input.joint_rad[1], input.joint_rad[2]},
-                                 at_slave_tool_n, 0.0, command_);
+                                 at_slave_tool_n, grasp_n, command_);
     double largest_torque_nm = 0.0;
-    for (const double torque_nm : command_.joint_torque_nm) {
-      largest_torque_nm = std::max(largest_torque_nm, std::abs(torque_nm));
+    for (std::size_t j = 0; j < 3; ++j) {  // the arm's: the fingers' are the grasp's
+      largest_torque_nm = std::max(largest_torque_nm, std::abs(command_.joint_torque_nm[j]));
     }
     raise_to(peak_joint_torque_nm_, largest_torque_nm);  // one atomic a cycle, not one a joint
+    raise_to(peak_grasp_force_n_, command_.finger_force_n[0]);
   }
   rate_limited_.fetch_add(limited ? 1 : 0, std::memory_order_relaxed);
   passivity_cycles_.fetch_add(acted > 0 ? 1 : 0, std::memory_order_relaxed);
@@ -309,7 +360,7 @@ void DeviceHostClient::after_cycle(const HapticCycle& cycle) noexcept {
   state_.device_id = options_.device_id;
   state_.sequence = sequence_;
   state_.input = *cycle.input;
-  state_.v_world_m_per_s = v_m_per_s_;
+  state_.v_world_m_per_s = v_m_per_s_[0];
   state_.rendered = *cycle.output;
   if (options_.rig) {
     // A master renders joint torques: the push its tissue takes (SPEC §8) is the force at the
@@ -347,6 +398,9 @@ DeviceHostStatus DeviceHostClient::status() const noexcept {
   s.force_at_last_model_n = force_at_last_model_n_.load(std::memory_order_relaxed);
   s.peak_force_n = peak_force_n_.load(std::memory_order_relaxed);
   s.peak_joint_torque_nm = peak_joint_torque_nm_.load(std::memory_order_relaxed);
+  s.peak_grasp_force_n = peak_grasp_force_n_.load(std::memory_order_relaxed);
+  s.mean_held_force_n = published_mean_held_force_n_.load(std::memory_order_relaxed);
+  s.held_cycles = published_held_cycles_.load(std::memory_order_relaxed);
   s.rate_limited_cycles = rate_limited_.load(std::memory_order_relaxed);
   s.scene_changes = scene_changes_.load(std::memory_order_relaxed);
   s.round_trip_us = round_trip_us_.summary();

@@ -16,7 +16,8 @@
 //   6. after the device write, the state (input, velocity, what was rendered after the loop's
 //      safety layer) goes out on the DeviceState topic.
 // A rig's master arm (DeviceHostOptions::rig) renders its carried tool's model where the slave's
-// target puts the tool, and feels the force as joint torques through the master's Jᵀ.
+// target puts the tool, and a grasping rig's pads' models where it puts the pads, and feels the
+// force as joint torques through the master's Jᵀ and the pads' grip on its fingers.
 // `raw` mode renders the newest model's f0 as it came, as the knee paper sent raw forces: for
 // comparison only, unstable beyond a few ms of delay (docs/benchmarks.md).
 // Models that answer a state this host did not send (sequence 0: the simulation's own script)
@@ -67,7 +68,11 @@ struct DeviceHostOptions {
   /// slave carries, placed each cycle where the slave's target puts it for the master's joints
   /// (RigController::flange_point_target_world, `rig_tool_flange_m` its centre in the flange
   /// frame), and the force rendered there goes to the master's joints as the rig's own command
-  /// does (RigController::master_command): joint torques, not a tip force. Null: a probe or glove.
+  /// does (RigController::master_command): joint torques, not a tip force. A rig that grasps a
+  /// ball (grasps_ball) has its two pads' models served after its tools (net/model_publisher.h):
+  /// each is rendered where the slave's target puts that pad (RigController::
+  /// pad_centre_target_world), their sum joins the tool's force at the slave's tool and their push
+  /// is the grasp on the master's fingers. Null: a probe or glove.
   std::shared_ptr<const RigController> rig;
   Vec3 rig_tool_flange_m = Vec3::Zero();
 };
@@ -102,7 +107,9 @@ struct DeviceHostStatus {
   /// (0: never).
   std::int64_t last_model_ns = 0;
   std::int64_t last_force_ns = 0;
-  double force_n = 0.0;  ///< what this cycle rendered (largest over tools)
+  /// What this cycle rendered: the largest over tools, or a rig master's force at the slave's
+  /// tool (its carried tool's and its pads' together).
+  double force_n = 0.0;
   /// What the cycle that took the newest model rendered (largest over tools).
   double force_at_last_model_n = 0.0;
   /// The same two moments as cycles of the device loop (this client's steps): how long a fade
@@ -110,8 +117,14 @@ struct DeviceHostStatus {
   std::uint64_t last_model_cycle = 0;
   std::uint64_t last_force_cycle = 0;
   double peak_force_n = 0.0;  ///< over the run
-  /// A rig's master (DeviceHostOptions::rig): its largest joint torque over the run, N·m.
+  /// A rig's master (DeviceHostOptions::rig): its arm's largest joint torque over the run, N·m,
+  /// and the largest grasp its fingers rendered (the pads' mean push), N.
   double peak_joint_torque_nm = 0.0;
+  double peak_grasp_force_n = 0.0;
+  /// A grasping rig's master: the mean force at the slave's tool it rendered over the cycles both
+  /// pads pressed the ball (what it felt of the carried ball), and how many cycles that was.
+  double mean_held_force_n = 0.0;
+  std::uint64_t held_cycles = 0;
   std::uint64_t rate_limited_cycles = 0;
   std::uint64_t scene_changes = 0;
   /// Models the receive-side link shim lost (any reason) and delivered (zero without one).
@@ -147,7 +160,15 @@ class DeviceHostClient final : public HapticClient {
   /// `writer`: the DDS writer the model came from (0: not known, as through the link shim).
   void admit_model(const hapsim_msg_LocalModel& m, double now_s, std::int64_t now_ns,
                    dds_instance_handle_t writer) noexcept;
-  [[nodiscard]] Vec3 tool_force(std::size_t tool, const Vec3& p_device_m, double now_s) noexcept;
+  /// The points that move with the device, each with its own history: the device's own (a rig
+  /// master's: its carried tool's), then a grasping rig's two pads.
+  static constexpr std::size_t kPoints = 3;
+  /// Key `key`'s force where point `point` is now (its model's x0 moved by how far the point
+  /// moved since the state the model answered). haptic path
+  [[nodiscard]] Vec3 key_force(std::size_t key, std::size_t point, double now_s) noexcept;
+  /// key_force through key's passivity observer and the force rate limit. haptic path
+  [[nodiscard]] Vec3 render_key(std::size_t key, std::size_t point, double dt_s, double now_s,
+                                bool& limited, std::uint64_t& acted, double& dissipated_j) noexcept;
 
   DeviceHostOptions options_;
   TopicReader<hapsim_msg_LocalModel> models_in_;
@@ -173,12 +194,14 @@ class DeviceHostClient final : public HapticClient {
   std::array<LocalContactModel, kMaxFingers> raw_models_{};
   std::array<double, kMaxFingers> raw_received_s_{};
   std::array<Vec3, kMaxFingers> previous_force_n_{};
-  std::array<Vec3, kHistory> p_history_m_{};
+  std::array<std::array<Vec3, kPoints>, kHistory> p_history_m_{};
   /// monotonic_ns() when each state went out (by sequence), and whether a model answered it.
   std::array<std::int64_t, kHistory> state_sent_ns_{};
   std::array<bool, kHistory> answered_{};
-  /// A rig's master: the force at the slave's tool this cycle's torques render.
+  /// A rig's master: the carried tool's force this cycle's torques render (the push its tissue
+  /// takes), and whether its pads' models are served (grasps_ball).
   Vec3 rig_force_world_n_ = Vec3::Zero();
+  bool rig_grasps_ = false;
   std::uint64_t sequence_base_ = 0;  ///< states are numbered from sequence_base_ + 1
   std::uint64_t sequence_ = 0;
   /// The simulation host followed: the writer of the first model accepted for the current scene,
@@ -186,8 +209,8 @@ class DeviceHostClient final : public HapticClient {
   /// are refused (kOtherHost): a second serve on the session cannot take the device over.
   dds_instance_handle_t followed_writer_ = 0;
   std::int64_t followed_seen_ns_ = 0;
-  Vec3 p_previous_m_ = Vec3::Zero();
-  Vec3 v_m_per_s_ = Vec3::Zero();
+  std::array<Vec3, kPoints> p_m_{};  ///< this cycle's
+  std::array<Vec3, kPoints> v_m_per_s_{};
   DeviceCommand command_;
   DeviceStateSample state_;
 
@@ -207,6 +230,11 @@ class DeviceHostClient final : public HapticClient {
   bool took_model_ = false;  ///< this cycle accepted a model (haptic thread)
   std::atomic<double> peak_force_n_{0.0};
   std::atomic<double> peak_joint_torque_nm_{0.0};
+  std::atomic<double> peak_grasp_force_n_{0.0};
+  double mean_held_force_n_ = 0.0;  ///< haptic thread's running mean; published below
+  std::uint64_t held_cycles_ = 0;
+  std::atomic<double> published_mean_held_force_n_{0.0};
+  std::atomic<std::uint64_t> published_held_cycles_{0};
   std::atomic<std::uint64_t> rate_limited_{0};
   std::atomic<std::uint64_t> scene_changes_{0};
   LatencyHistogram round_trip_us_;

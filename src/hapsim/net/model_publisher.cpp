@@ -1,5 +1,8 @@
 #include "hapsim/net/model_publisher.h"
 
+#include "hapsim/rig/pad_models.h"
+#include "hapsim/rig/rig_controller.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -31,6 +34,12 @@ LocalModelPublisher::LocalModelPublisher(const Participant& participant, const W
   }
   models_.resize(tools.size());
   rendered_push_n_.assign(tools.size(), std::numeric_limits<double>::quiet_NaN());
+  const TeleopRigDescription* rig = rig_description(world.description());
+  if (rig != nullptr && grasps_ball(*rig) && !devices_.empty() &&
+      devices_[0].tools.size() + 2 <= static_cast<std::size_t>(kMaxFingers)) {
+    grasp_rig_ = rig;
+  }
+  validity_radius_m_ = options.validity_radius_m;
 }
 
 // haptic path
@@ -94,6 +103,9 @@ void LocalModelPublisher::after_step(const World& world, const HapticCycle& cycl
     (void)legacy_->send_command(*cycle.output, legacy_finger_max_n_);  // failures are counted
   }
   builder_.build(world.state(), ++sequence_, 0, models_);
+  if (grasp_rig_ != nullptr) {
+    build_pad_models(*grasp_rig_, world.state(), sequence_, validity_radius_m_, pad_models_);
+  }
   write_models();
   for (std::size_t k = 0; k < devices_.size(); ++k) {
     const RemoteDevice& link = *devices_[k].link;
@@ -121,6 +133,11 @@ void LocalModelPublisher::after_paused_cycle(const World& world,
     m.sequence = sequence_;
     m.sim_time_s = world.state().time_s;
   }
+  for (LocalContactModel& m : pad_models_) {
+    m = LocalContactModel{};
+    m.sequence = sequence_;
+    m.sim_time_s = world.state().time_s;
+  }
   write_models();
 }
 
@@ -132,13 +149,20 @@ void LocalModelPublisher::write_models() noexcept {
     const DeviceTools& d = devices_[k];
     const std::uint64_t answered = d.link->host_driving() ? d.link->host_state().sequence : 0;
     const auto device_id = static_cast<std::uint16_t>(first_device_id_ + k);
-    for (std::size_t i = 0; i < d.tools.size(); ++i) {
-      LocalContactModel& m = models_[d.tools[i]];
+    const auto write = [&](LocalContactModel& m, std::size_t key) {
       m.device_sequence = answered;
       const bool ok = writer_.write(
-          encode_local_model(m, {device_id, static_cast<std::uint16_t>(i)}, scene_hash_));
+          encode_local_model(m, {device_id, static_cast<std::uint16_t>(key)}, scene_hash_));
       written += ok ? 1 : 0;
       refused += ok ? 0 : 1;
+    };
+    for (std::size_t i = 0; i < d.tools.size(); ++i) {
+      write(models_[d.tools[i]], i);
+    }
+    if (k == 0 && grasp_rig_ != nullptr) {
+      for (std::size_t i = 0; i < pad_models_.size(); ++i) {
+        write(pad_models_[i], d.tools.size() + i);  // the rig's master: its pads after its tools
+      }
     }
   }
   published_.fetch_add(written, std::memory_order_relaxed);

@@ -3,13 +3,16 @@
 // silent: the tools jump, and no proxy, velocity or stick point should survive that) and hands
 // the world the other users' inputs; after the step, it builds each tool's local contact model
 // (world/local_model_builder.h) and writes it on the session's LocalModel topic, answering the
-// state of that tool's device host the step used. Allocation-free.
+// state of that tool's device host the step used. A rig that grasps a ball also has its gripper
+// pads' models served (rig/pad_models.h), keyed after its master's tools, so the master feels the
+// grasp. Allocation-free.
 #pragma once
 
 #include "hapsim/net/legacy_force_udp.h"
 #include "hapsim/net/local_model_codec.h"
 #include "hapsim/net/remote_device.h"
 #include "hapsim/net/topic_writer.h"
+#include "hapsim/rig/rig_description.h"
 #include "hapsim/runtime/world_haptic_client.h"
 #include "hapsim/world/local_model_builder.h"
 
@@ -35,7 +38,9 @@ class LocalModelPublisher final : public WorldCycleObserver {
   /// device; one per named device host, or the one device of a one-user scene). Device k's models
   /// are keyed (first_device_id + k, the tool's index among k's tools); a device's tools beyond
   /// kMaxFingers get none. Device 0 is the session's step input; the others' inputs are read here
-  /// each cycle (World::set_device_input). The devices must outlive the publisher.
+  /// each cycle (World::set_device_input). A world with a rig that grasps (grasps_ball) also
+  /// gets its two pads' models, keyed (first_device_id, device 0's tool count + pad): the rig's
+  /// master is device 0. The devices must outlive the publisher.
   LocalModelPublisher(const Participant& participant, const World& world,
                       std::span<RemoteDevice* const> devices, std::uint16_t first_device_id,
                       std::uint64_t scene_hash, LocalModelBuildOptions options = {});
@@ -85,6 +90,11 @@ class LocalModelPublisher final : public WorldCycleObserver {
   std::vector<DeviceTools> devices_;
   std::vector<LocalContactModel> models_;  ///< per world tool
   std::vector<double> rendered_push_n_;    ///< per world tool, for World::set_rendered_push
+  /// The world's rig when it grasps a ball (and its master has room for two more keys), else
+  /// null; its pads' models this step.
+  const TeleopRigDescription* grasp_rig_ = nullptr;
+  std::array<LocalContactModel, 2> pad_models_{};
+  double validity_radius_m_ = 0.0;
   /// Sets each keyed tool's device_sequence (the state of its host the step used, 0: none) and
   /// writes them. haptic path
   void write_models() noexcept;

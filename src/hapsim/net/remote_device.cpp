@@ -108,6 +108,7 @@ DeviceInput RemoteDevice::read(double time_s) noexcept {
       // A host that comes back (or a restarted one) numbers its states afresh.
       gate_.forget_order();
     }
+    has_rates_from_ = false;  // nor are the old host's joints a rate's start
   }
   // The fallback is read every cycle, so a script keeps its own time while a host drives.
   DeviceInput input = fallback_.read(time_s);
@@ -129,12 +130,28 @@ DeviceInput RemoteDevice::read(double time_s) noexcept {
     // A cycle without a new state (late, lost) moves the device on at its reported velocity
     // instead of holding it: held, then caught up, it would jump two cycles at once, and the
     // world's velocity (and damping force) with it. A few cycles at most, then it holds.
+    if (fresh) {
+      note_rates(host_state_.input);
+    }
     const bool after_reckoning = fresh && missed_states_ > 0;
     missed_states_ = fresh ? 0 : std::min(missed_states_ + 1, kMaxDeadReckoned);
     const double reckoned_s = dt_s * missed_states_;
     input.time_s = host_state_.input.time_s + host_time_offset_s_ + reckoned_s;
     if (missed_states_ > 0 && host_state_.v_world_m_per_s.allFinite()) {
       input.p_world += host_state_.v_world_m_per_s * reckoned_s;
+    }
+    // A master arm's joints too: held, the served slave would stand a cycle and then jump two,
+    // and the ball its pads hold would take that step's acceleration (a 0.2 m/s carry stopping
+    // and restarting within 1 ms is 20 N on a 100 g ball).
+    if (missed_states_ > 0) {
+      for (int j = 0; j < std::min(input.joint_count, kMaxDeviceJoints); ++j) {
+        const auto k = static_cast<std::size_t>(j);
+        input.joint_rad[k] += joint_rate_rad_per_s_[k] * reckoned_s;
+      }
+      for (int f = 0; f < std::min(input.finger_count, kMaxFingers); ++f) {
+        const auto k = static_cast<std::size_t>(f);
+        input.finger_rad[k] += finger_rate_rad_per_s_[k] * reckoned_s;
+      }
     }
     // The first real state after reckoned ones corrects the estimate: that correction is not
     // motion the device made in the little host time since the estimate's stamp (a state late
@@ -148,6 +165,27 @@ DeviceInput RemoteDevice::read(double time_s) noexcept {
     cycles_driven_.fetch_add(1, std::memory_order_relaxed);
   }
   return input;
+}
+
+// haptic path
+void RemoteDevice::note_rates(const DeviceInput& newest) noexcept {
+  // Differenced over the host's own clock; a gap longer than a few cycles is no rate.
+  const double dt_s = newest.time_s - rates_from_.time_s;
+  const bool usable = has_rates_from_ && dt_s > 0.0 && dt_s <= 0.05 &&
+                      newest.joint_count == rates_from_.joint_count &&
+                      newest.finger_count == rates_from_.finger_count;
+  const auto rate = [&](double now, double before) {
+    const double r = usable ? (now - before) / dt_s : 0.0;
+    return std::isfinite(r) ? r : 0.0;
+  };
+  for (std::size_t j = 0; j < joint_rate_rad_per_s_.size(); ++j) {
+    joint_rate_rad_per_s_[j] = rate(newest.joint_rad[j], rates_from_.joint_rad[j]);
+  }
+  for (std::size_t f = 0; f < finger_rate_rad_per_s_.size(); ++f) {
+    finger_rate_rad_per_s_[f] = rate(newest.finger_rad[f], rates_from_.finger_rad[f]);
+  }
+  rates_from_ = newest;
+  has_rates_from_ = true;
 }
 
 bool RemoteDevice::wait_for_host(double timeout_s, const std::atomic<bool>* stop) {

@@ -129,6 +129,14 @@ class RemoteDevice final : public Device {
   std::unique_ptr<LinkShim<hapsim_msg_DeviceState, kLinkCapacity>> link_;
   std::int64_t link_epoch_ns_ = 0;
   std::atomic<std::uint64_t> link_lost_{0};
+  /// The host's joint and finger rates between its two newest states (rad/s): a master arm's or
+  /// a glove's reading moves on at them in a cycle without a new state, as the tip moves on at
+  /// its velocity. haptic path
+  void note_rates(const DeviceInput& newest) noexcept;
+  std::array<double, kMaxDeviceJoints> joint_rate_rad_per_s_{};
+  std::array<double, kMaxFingers> finger_rate_rad_per_s_{};
+  DeviceInput rates_from_;  ///< the state the rates were differenced from
+  bool has_rates_from_ = false;
   /// Cycles in a row without a new host state, dead-reckoned up to kMaxDeadReckoned.
   static constexpr int kMaxDeadReckoned = 3;
   int missed_states_ = 0;

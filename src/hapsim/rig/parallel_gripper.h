@@ -34,9 +34,13 @@ struct GripperReport {
   /// Pad opening actually reached (≥ the command when the pads press the ball at their limit).
   double width_m = 0.0;
   bool held = false;
-  /// This step the grasp began / ended.
+  /// This step the grasp began / ended. A grasp ends once either pad has been off the ball for
+  /// kReleaseAfterS (a pad a jerk of the slave lifts off for a step or two lets nothing go), and
+  /// `released_at_s` is when that began.
   bool grasped_now = false;
   bool released_now = false;
+  double released_at_s = -1.0;
+  static constexpr double kReleaseAfterS = 0.02;
   /// (N₁ + N₂) / 2: what the master's fingers feel.
   [[nodiscard]] double grasp_force_n() const { return 0.5 * (pad_force_n[0] + pad_force_n[1]); }
 };

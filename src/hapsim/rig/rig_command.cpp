@@ -118,4 +118,21 @@ Vec3 RigController::flange_point_target_world(const DeviceInput& input,
   return slave_target(description_.mapping, hand.translation(), arm[0]) * p_flange_m;
 }
 
+// haptic path
+Vec3 RigController::pad_centre_target_world(const DeviceInput& input,
+                                            std::size_t pad) const noexcept {
+  const double fingers[2] = {input.finger_rad[0], input.finger_rad[1]};
+  if (pad > 1 || input.finger_count < 2 || !std::isfinite(fingers[0]) ||
+      !std::isfinite(fingers[1])) {
+    return Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  }
+  // As place_pads (rig_place.cpp) puts them about the tool: along its y, pad_depth_m out.
+  const ParallelGripperParams& g = description_.gripper;
+  const double width =
+      std::max(slave_width_for(master_.grip_opening_m({fingers[0], fingers[1]})), 0.0);
+  const double side = pad == 0 ? 1.0 : -1.0;
+  return flange_point_target_world(
+      input, Vec3(0.0, side * (0.5 * width + g.pad_half_m.y()), g.pad_depth_m));
+}
+
 }  // namespace hapsim

@@ -153,6 +153,7 @@ void RigState::reset() noexcept {
   input_usable = false;
   has_pad_previous = false;
   held = false;
+  grip_lost_since_s = -1.0;
   result = TeleopStepResult{};
 }
 

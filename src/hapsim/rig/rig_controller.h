@@ -60,6 +60,14 @@ class RigController final : public WorldController {
   /// is not a master's (fewer than three finite arm joints). haptic path
   [[nodiscard]] Vec3 flange_point_target_world(const DeviceInput& input,
                                                const Vec3& p_flange_m) const noexcept;
+  /// Where gripper pad `pad` (0: the +y side) is centred when the slave stands on the target
+  /// this master input asks for and its pads stand at the opening the master's grip asks: the
+  /// follower's and the gripper's lag left out, and the stop at the gripper's force limit (the
+  /// pads' served models cap their push there). The device host's stand-in for where the served
+  /// slave holds that pad. NaN when the input is not a master's (three arm joints and two
+  /// fingers, all finite). haptic path
+  [[nodiscard]] Vec3 pad_centre_target_world(const DeviceInput& input,
+                                             std::size_t pad) const noexcept;
 
  private:
   TeleopRigDescription description_;
@@ -123,6 +131,8 @@ class RigState final : public ControllerState {
   /// Observed: the grasp holds (both pads press the ball from opposite sides hard enough that
   /// friction carries its weight). A report: the ball is held by friction, not attached.
   bool held = false;
+  /// Observed: when a held grasp's pad left the ball (-1: none has), for its release's delay.
+  double grip_lost_since_s = -1.0;
   TeleopStepResult result;
 };
 

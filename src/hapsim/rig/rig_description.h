@@ -67,4 +67,12 @@ struct TeleopRigDescription {
   std::size_t carried_tool = kNoTool;
 };
 
+/// The rig grasps a ball with its two pads (pick-and-place, not only palpation): their contacts
+/// with it are what a served master feels of the grasp (rig/pad_models.h).
+[[nodiscard]] inline bool grasps_ball(const TeleopRigDescription& d) noexcept {
+  return d.ball_body != TeleopRigDescription::kNoBody &&
+         d.pad_body[0] != TeleopRigDescription::kNoBody &&
+         d.pad_body[1] != TeleopRigDescription::kNoBody;
+}
+
 }  // namespace hapsim

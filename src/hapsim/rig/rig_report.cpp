@@ -13,12 +13,14 @@ namespace hapsim {
 namespace {
 
 // The grasp holds when both pads press the ball from opposite sides with friction able to carry
-// its weight, μ·(N₁ + N₂) ≥ safety · m·g; it ends when either lets go. The ball stays a free body
-// held by friction: this is a report. haptic path
+// its weight, μ·(N₁ + N₂) ≥ safety · m·g; it ends when either has let go for kReleaseAfterS (a
+// served slave jerked by a stalled cycle lifts a pad off for a step, and the ball is carried on).
+// The ball stays a free body held by friction: this is a report. haptic path
 void observe_grasp(const TeleopRigDescription& d, const WorldModel& model, const StepResult& step,
-                   bool& held, GripperReport& g) noexcept {
+                   bool& held, double& lost_since_s, GripperReport& g) noexcept {
   g.grasped_now = false;
   g.released_now = false;
+  g.released_at_s = -1.0;
   std::array<Vec3, 2> normals{Vec3::Zero(), Vec3::Zero()};
   for (const BodyContact& c : step.body_contacts) {
     for (std::size_t i = 0; i < 2; ++i) {
@@ -35,9 +37,20 @@ void observe_grasp(const TeleopRigDescription& d, const WorldModel& model, const
       friction * (g.pad_force_n[0] + g.pad_force_n[1]) >= d.gripper.safety_factor * weight) {
     held = true;
     g.grasped_now = true;
-  } else if (held && !both) {
-    held = false;
-    g.released_now = true;
+    lost_since_s = -1.0;
+  } else if (held && both) {
+    lost_since_s = -1.0;
+  } else if (held) {
+    if (lost_since_s < 0.0) {
+      lost_since_s = step.time_s;
+    }
+    // Half a microsecond short: the step times are sums of dt_s.
+    if (step.time_s - lost_since_s >= GripperReport::kReleaseAfterS - 5e-7) {
+      held = false;
+      g.released_now = true;
+      g.released_at_s = lost_since_s;
+      lost_since_s = -1.0;
+    }
   }
   g.held = held;
 }
@@ -72,7 +85,7 @@ void RigState::observe(const WorldModel& model, const StepResult& step) noexcept
   const TeleopRigDescription& d = *description;
   result.time_s = step.time_s;
   if (d.ball_body != TeleopRigDescription::kNoBody) {
-    observe_grasp(d, model, step, held, result.gripper);
+    observe_grasp(d, model, step, held, grip_lost_since_s, result.gripper);
     observe_ball(d, step, result);
   }
   result.held = result.gripper.held;

@@ -295,10 +295,15 @@ class SessionAccountant {
       t.grasp_time_s = r.time_s;
     }
     if (r.gripper.released_now && t.grasped && t.release_time_s < 0.0) {
-      t.release_time_s = r.time_s;
+      t.release_time_s = r.gripper.released_at_s;  // when the pad left, not when that was sure
     }
     t.ball_lift_m = std::max(t.ball_lift_m, r.ball_p_world.z() - ball_start_z_);
     t.peak_grasp_force_n = std::max(t.peak_grasp_force_n, r.gripper.grasp_force_n());
+    if (r.held) {
+      ++t.held_steps;  // a running mean: no sum to lose digits in
+      t.mean_held_tool_force_n += (r.tool_force_world_n.norm() - t.mean_held_tool_force_n) /
+                                  static_cast<double>(t.held_steps);
+    }
     t.max_sheet_deflection_m = std::max(t.max_sheet_deflection_m, r.sheet_depth_m);
     t.nonfinite_ball_steps += r.ball_p_world.allFinite() ? 0 : 1;
   }

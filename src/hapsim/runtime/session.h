@@ -148,6 +148,11 @@ struct TeleopSummary {
   /// joint torque the master's arm motors were asked for, over the run.
   double peak_tool_force_n = 0.0;
   double peak_master_torque_nm = 0.0;
+  /// The mean force at the slave's tool over the steps the grasp held (the ball's weight and its
+  /// carry's accelerations, through the pads), and how many steps that was: what the master felt
+  /// of the carried ball, steadier than a peak a single jerk of the slave sets.
+  double mean_held_tool_force_n = 0.0;
+  std::size_t held_steps = 0;
   /// With SessionOptions::teleop_target_world: the ball's final distance from it.
   std::optional<double> target_error_m;
   /// Grasped, released, the ball finite and (with a target) within 5 mm of it.

@@ -72,6 +72,8 @@ void add_rig_json(nlohmann::json& j, const TeleopSummary& t) {
   j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
   j["peak_tool_force_n"] = t.peak_tool_force_n;
   j["peak_master_torque_nm"] = t.peak_master_torque_nm;
+  j["mean_held_tool_force_n"] = t.mean_held_tool_force_n;
+  j["held_steps"] = t.held_steps;
   j["slave_collisions"] = {
       {"steps", t.slave_collision_steps},
       {"pairs", t.slave_collisions},
