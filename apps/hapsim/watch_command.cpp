@@ -69,15 +69,16 @@ void watch(const WatchArgs& args, JsonOutput& json_out) {
               args.dds.session.c_str(), session.domain().config().c_str());
   std::fflush(stdout);
 
-  WorldSnapshot snapshot = make_world_snapshot(world);
-  // View states carry a rig's bodies, not its joints: the rig's part would stay at the start.
-  snapshot.teleop.reset();
+  WorldSnapshot snapshot = make_world_snapshot(world);  // a rig's part too: view states carry it
   std::optional<WorldSnapshot> at_peak;
   net::ViewStateDecoder decoder(world);
   std::uint64_t views = 0;
   std::uint64_t refused = 0;
   std::string last_refusal;
   double peak_force_n = 0.0;
+  // A rig's grasp (its pads' mean push on the ball), and the larger of the two: the view drawn.
+  double peak_grasp_force_n = 0.0;
+  double peak_felt_n = 0.0;
   double max_deflection_m = 0.0;
   std::uint64_t first_cycle = 0;
   std::uint64_t last_cycle = 0;
@@ -101,8 +102,11 @@ void watch(const WatchArgs& args, JsonOutput& json_out) {
         max_deflection_m = std::max(max_deflection_m, d);
       }
       const double force_n = peak_tool_force_n(snapshot);
-      if (force_n > peak_force_n || !at_peak) {
-        peak_force_n = std::max(peak_force_n, force_n);
+      const double grasp_n = snapshot.teleop ? snapshot.teleop->grasp_force_n : 0.0;
+      peak_force_n = std::max(peak_force_n, force_n);
+      peak_grasp_force_n = std::max(peak_grasp_force_n, grasp_n);
+      if (std::max(force_n, grasp_n) > peak_felt_n || !at_peak) {
+        peak_felt_n = std::max(peak_felt_n, std::max(force_n, grasp_n));
         at_peak = snapshot;  // a copy now and then, off any haptic path
       }
     });
@@ -116,6 +120,9 @@ void watch(const WatchArgs& args, JsonOutput& json_out) {
       "saw          peak tool force %.3f N, largest deflection %.2f mm, simulation "
       "cycles %" PRIu64 " to %" PRIu64 "\n",
       peak_force_n, max_deflection_m * 1e3, first_cycle, last_cycle);
+  if (snapshot.teleop) {
+    std::printf("saw          the rig's peak grasp %.3f N\n", peak_grasp_force_n);
+  }
   // The snapshot's failure is said after the JSON, which records it: a full disk must not cost
   // the run's numbers.
   std::string snapshot_error;
@@ -132,7 +139,7 @@ void watch(const WatchArgs& args, JsonOutput& json_out) {
                                           snapshot_yaw_rad(world), snapshot_pitch_rad(world)));
         writer.write_png(scene.scene(), camera, args.snapshot_path);
         std::printf("snapshot     %s (the view at the largest force, %.3f N, t = %.3f s)\n",
-                    args.snapshot_path.c_str(), peak_force_n, at_peak->time_s);
+                    args.snapshot_path.c_str(), peak_felt_n, at_peak->time_s);
       } catch (const Error& e) {
         snapshot_error = "--snapshot " + std::string(e.what());  // e names the path
       }
@@ -147,6 +154,9 @@ void watch(const WatchArgs& args, JsonOutput& json_out) {
     j["wall_s"] = wall_s;
     j["views_per_s"] = rate_hz;
     j["peak_force_n"] = peak_force_n;
+    if (snapshot.teleop) {
+      j["peak_grasp_force_n"] = peak_grasp_force_n;
+    }
     j["max_deflection_m"] = max_deflection_m;
     j["cycles"] = {first_cycle, last_cycle};
     if (*stop_signal_name() != '\0') {

@@ -3,6 +3,7 @@
 // precision — whether it joined at the start or late; a vertex back at rest is put back; a sample
 // that does not fit the viewer's world is refused whole, naming why, and changes nothing.
 #include "hapsim/net/view_state_codec.h"
+#include "hapsim/runtime/teleop_snapshot.h"
 #include "hapsim/scene/run_setup.h"
 #include "hapsim/scene/scene_file.h"
 
@@ -185,6 +186,61 @@ TEST(ViewStateCodec, CarriesTheGlovesHandAndRefusesANonFiniteOne) {
   EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
   EXPECT_NE(why.find("hand"), std::string::npos) << why;
   EXPECT_EQ(seen.hand.angles_rad, before.hand.angles_rad);
+}
+
+// A rig's part: the viewer draws the served master and slave from their joints, as one process
+// does (before, view states carried the rig's bodies only, and a connected viewer drew no master).
+TEST(ViewStateCodec, CarriesTheRigsMasterSlaveAndGraspAndRefusesAForeignOne) {
+  const std::string scene = std::string(HAPSIM_SOURCE_DIR) + "/scenes/teleop.json";
+  Served host(scene);
+  ViewStateEncoder encoder(host.world);
+  Served viewer_side(scene);
+  WorldSnapshot seen = make_world_snapshot(viewer_side.world);
+  ASSERT_TRUE(seen.teleop.has_value());
+  ViewStateDecoder decoder(viewer_side.world);
+  std::string why;
+
+  run_to(host, 5.0);  // grasped at 3.946 s, carried since
+  WorldSnapshot truth = snapshot_of(host.world);
+  ASSERT_TRUE(truth.teleop.has_value());
+  fill_teleop_snapshot(*truth.teleop, host.world);
+  truth.teleop->output = host.world.last_result().command;
+  const TeleopSnapshot& want = *truth.teleop;
+  ASSERT_TRUE(want.held) << "the script should hold the ball at 5 s";
+  ASSERT_GT(std::abs(want.master_joint_rad[0]) + std::abs(want.slave_q[0]), 0.1);
+  hapsim_msg_ViewState m = encoder.encode(truth, kHash, 7, true);
+  ASSERT_TRUE(decoder.decode(m, kHash, seen, why)) << why;
+  const TeleopSnapshot& got = *seen.teleop;
+  EXPECT_EQ(got.master_joint_rad, want.master_joint_rad);
+  EXPECT_EQ(got.master_finger_rad, want.master_finger_rad);
+  EXPECT_EQ(got.slave_q, want.slave_q);
+  EXPECT_LE((got.X_world_tool.matrix() - want.X_world_tool.matrix()).norm(), 1e-12);
+  // The hand is the viewer's own master's for those joints: the host's.
+  EXPECT_LE((got.X_master_hand.matrix() - want.X_master_hand.matrix()).norm(), 1e-12);
+  for (std::size_t j = 0; j < 5; ++j) {
+    EXPECT_EQ(got.output.joint_torque_nm[j], want.output.joint_torque_nm[j]) << j;
+  }
+  EXPECT_EQ(got.pad_force_n, want.pad_force_n);
+  EXPECT_DOUBLE_EQ(got.grasp_force_n, want.grasp_force_n);
+  EXPECT_TRUE(got.held);
+  EXPECT_EQ(got.gripper_width_m, want.gripper_width_m);
+  EXPECT_EQ(got.sheet_depth_m, want.sheet_depth_m);
+
+  // Another slave (a scene with a different robot), a non-finite joint, a pose that is no
+  // rotation: refused whole, naming why.
+  const TeleopSnapshot before = got;
+  m.rig.slave_dof = 7;
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  EXPECT_NE(why.find("slave with 7 joints"), std::string::npos) << why;
+  m = encoder.encode(truth, kHash, 7, true);
+  m.rig.master_joint_rad[1] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  EXPECT_NE(why.find("rig"), std::string::npos) << why;
+  m = encoder.encode(truth, kHash, 7, true);
+  m.rig.tool_q_wxyz[0] = 2.0;
+  EXPECT_FALSE(decoder.decode(m, kHash, seen, why));
+  EXPECT_NE(why.find("rig"), std::string::npos) << why;
+  EXPECT_EQ(seen.teleop->slave_q, before.slave_q);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "hapsim/net/view_state_codec.h"
 
+#include "hapsim/rig/rig_controller.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -32,6 +34,81 @@ static_assert(kFingers * kAngles == sizeof(hapsim_msg_ViewState::hand_angles_rad
 
 bool finite3(const double (&in)[3]) {
   return std::isfinite(in[0]) && std::isfinite(in[1]) && std::isfinite(in[2]);
+}
+
+void put_pose(double (&p_m)[3], double (&q_wxyz)[4], const Iso3& X) {
+  put3(p_m, X.translation());
+  const Quat q(X.linear());
+  q_wxyz[0] = q.w();
+  q_wxyz[1] = q.x();
+  q_wxyz[2] = q.y();
+  q_wxyz[3] = q.z();
+}
+
+void encode_rig(const TeleopSnapshot& s, hapsim_msg_RigView& v) {
+  std::copy(s.master_joint_rad.begin(), s.master_joint_rad.end(), v.master_joint_rad);
+  std::copy(s.master_finger_rad.begin(), s.master_finger_rad.end(), v.master_finger_rad);
+  for (int j = 0; j < std::min(s.output.joint_count, 5); ++j) {
+    v.master_torque_nm[j] = s.output.joint_torque_nm[static_cast<std::size_t>(j)];
+  }
+  const std::size_t dof = std::min<std::size_t>(s.slave_q.size(), std::size(v.slave_q));
+  v.slave_dof = static_cast<std::uint16_t>(dof);
+  std::copy_n(s.slave_q.begin(), dof, v.slave_q);
+  put_pose(v.tool_p_m, v.tool_q_wxyz, s.X_world_tool);
+  v.gripper_width_m = s.gripper_width_m;
+  v.pad_force_n[0] = s.pad_force_n[0];
+  v.pad_force_n[1] = s.pad_force_n[1];
+  v.held = s.held;
+  v.sheet_depth_m = s.sheet_depth_m;
+}
+
+bool rig_view_fits(const hapsim_msg_RigView& v, std::size_t slave_dof, std::string& why) {
+  if (v.slave_dof != slave_dof) {
+    why = "a slave with " + std::to_string(v.slave_dof) + " joints (the scene's has " +
+          std::to_string(slave_dof) + ")";
+    return false;
+  }
+  const auto finite = [](const auto& values) {
+    return std::all_of(std::begin(values), std::end(values),
+                       [](double a) { return std::isfinite(a); });
+  };
+  const Quat q(v.tool_q_wxyz[0], v.tool_q_wxyz[1], v.tool_q_wxyz[2], v.tool_q_wxyz[3]);
+  if (!finite(v.master_joint_rad) || !finite(v.master_finger_rad) || !finite(v.master_torque_nm) ||
+      !finite(v.slave_q) || !finite3(v.tool_p_m) || !q.coeffs().allFinite() ||
+      std::abs(q.norm() - 1.0) > 1e-3 || !std::isfinite(v.gripper_width_m) ||
+      !finite(v.pad_force_n) || !std::isfinite(v.sheet_depth_m)) {
+    why = "the rig's part has a non-finite number or its tool no rigid motion (|q| = " +
+          std::to_string(q.norm()) + ")";
+    return false;
+  }
+  return true;
+}
+
+// `master`: the viewer's own master arm, for the hand the joints put (not sent: it follows).
+void decode_rig(const hapsim_msg_RigView& v, const MasterArm* master, TeleopSnapshot& s) {
+  std::copy(std::begin(v.master_joint_rad), std::end(v.master_joint_rad),
+            s.master_joint_rad.begin());
+  std::copy(std::begin(v.master_finger_rad), std::end(v.master_finger_rad),
+            s.master_finger_rad.begin());
+  if (master != nullptr) {
+    s.X_master_hand = master->hand_pose(s.master_joint_rad);
+  }
+  s.output = DeviceCommand{};
+  s.output.joint_count = 5;
+  std::copy(std::begin(v.master_torque_nm), std::end(v.master_torque_nm),
+            s.output.joint_torque_nm.begin());
+  std::copy_n(v.slave_q, std::min<std::size_t>(v.slave_dof, s.slave_q.size()), s.slave_q.begin());
+  s.X_world_tool = Iso3::Identity();
+  s.X_world_tool.linear() =
+      Quat(v.tool_q_wxyz[0], v.tool_q_wxyz[1], v.tool_q_wxyz[2], v.tool_q_wxyz[3])
+          .normalized()
+          .toRotationMatrix();
+  s.X_world_tool.translation() = get3(v.tool_p_m);
+  s.gripper_width_m = v.gripper_width_m;
+  s.pad_force_n = {v.pad_force_n[0], v.pad_force_n[1]};
+  s.grasp_force_n = 0.5 * (v.pad_force_n[0] + v.pad_force_n[1]);
+  s.held = v.held;
+  s.sheet_depth_m = v.sheet_depth_m;
 }
 
 }  // namespace
@@ -68,16 +145,15 @@ const hapsim_msg_ViewState& ViewStateEncoder::encode(const WorldSnapshot& s,
     // -1: not in the world (ToolState::present), without a field the IDL does not have.
     v.contact_count = s.tools[t].present ? s.tools[t].contact_count : -1;
   }
-  put3(m.hand_p_m, s.hand.X_world_hand.translation());
-  const Quat hand_q(s.hand.X_world_hand.linear());
-  m.hand_q_wxyz[0] = hand_q.w();
-  m.hand_q_wxyz[1] = hand_q.x();
-  m.hand_q_wxyz[2] = hand_q.y();
-  m.hand_q_wxyz[3] = hand_q.z();
+  put_pose(m.hand_p_m, m.hand_q_wxyz, s.hand.X_world_hand);
   for (std::size_t f = 0; f < kFingers; ++f) {
     for (std::size_t a = 0; a < kAngles; ++a) {
       m.hand_angles_rad[f * kAngles + a] = s.hand.angles_rad[f][a];
     }
+  }
+  if (s.teleop) {
+    m.rig_present = true;
+    encode_rig(*s.teleop, m.rig);
   }
   bodies_.resize(s.body_poses_world.size());
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
@@ -140,6 +216,9 @@ ViewStateDecoder::ViewStateDecoder(const World& world)
   for (std::size_t b = 0; b < world.body_count(); ++b) {
     segments_per_body_.push_back(world.segment_count(b));
   }
+  if (const RigController* rig = rig_controller(world.description())) {
+    master_ = &rig->master();
+  }
 }
 
 bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene_hash,
@@ -200,6 +279,15 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
       return false;
     }
   }
+  if (m.rig_present) {
+    if (!s.teleop) {
+      why = "a rig's part, for a scene without a rig";
+      return false;
+    }
+    if (!rig_view_fits(m.rig, s.teleop->slave_q.size(), why)) {
+      return false;
+    }
+  }
   for (std::size_t t = 0; t < m.tool_count; ++t) {
     const hapsim_msg_ToolView& v = m.tools[t];
     if (!finite3(v.p_m) || !finite3(v.proxy_m) || !finite3(v.force_n) ||
@@ -250,6 +338,11 @@ bool ViewStateDecoder::decode(const hapsim_msg_ViewState& m, std::uint64_t scene
     for (std::size_t a = 0; a < kAngles; ++a) {
       s.hand.angles_rad[f][a] = m.hand_angles_rad[f * kAngles + a];
     }
+  }
+  if (m.rig_present) {
+    decode_rig(m.rig, master_, *s.teleop);
+    s.teleop->cycle = m.cycle;
+    s.teleop->time_s = m.sim_time_s;
   }
   for (std::uint32_t b = 0; b < m.bodies._length; ++b) {
     const hapsim_msg_BodyPose& p = m.bodies._buffer[b];

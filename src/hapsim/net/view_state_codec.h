@@ -1,11 +1,13 @@
 // A running world as a viewer on another process sees it (net/idl ViewState): tools, contacts,
-// body poses, and every vertex of a deformed surface that is away from its rest position. The
+// body poses, every vertex of a deformed surface that is away from its rest position, and a rig's
+// master, slave joints and grasp (drawn as in one process). The
 // message is complete, not a delta, so a viewer that joins late (or lost samples) draws the
 // current deformation from the next one it gets. Both sides know the rest surfaces: they build
 // the same world from the same scene (SceneInfo), checked by the scene hash.
 // Off the haptic path: the simulation host encodes from the loop's snapshot at display rate.
 #pragma once
 
+#include "hapsim/kinematics/master_arm.h"
 #include "hapsim/runtime/world_snapshot.h"
 #include "hapsim_messages.h"
 
@@ -58,6 +60,7 @@ class ViewStateDecoder {
   std::vector<std::uint64_t> versions_;
   std::vector<std::size_t> segments_per_body_;
   std::vector<bool> changed_;
+  const MasterArm* master_ = nullptr;  ///< a rig's, for the hand its joints put
 };
 
 }  // namespace hapsim::net

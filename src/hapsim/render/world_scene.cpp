@@ -468,11 +468,6 @@ void WorldScene::update(const WorldSnapshot& snapshot) {
   }
   if (rig_ && snapshot.teleop) {
     *rig_ = *snapshot.teleop;  // sized alike: no allocation after the first
-  } else if (rig_ && !rig_from_bodies_) {
-    // A served rig's view states carry its bodies, not its joints: the slave is drawn by its link
-    // bodies where the host put them, and the master, whose joints are not served, not at all.
-    rig_from_bodies_ = true;
-    show_slave_link_bodies(true);
   }
   hand_ = snapshot.hand;
   rebuild_overlays(snapshot.tools, snapshot.tool_force_n);
@@ -676,9 +671,6 @@ void WorldScene::add_rig_overlays() {
         scene_.mesh(seg->mesh).colour = s.held ? rig_colours_.pad_holding : rig_colours_.pad;
       }
     }
-  }
-  if (rig_from_bodies_) {
-    return;  // a served rig: its bodies are drawn where they are; its joints are not known here
   }
   if (s.slave_q.size() == frames_.size()) {
     const Iso3 tip_world = rig.slave->frames(s.slave_q, frames_);

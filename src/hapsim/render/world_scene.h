@@ -166,9 +166,6 @@ class WorldScene {
   // A rig's part: its latest state, how the slave is drawn, the slave's joint frames (scratch),
   // where the master is drawn.
   std::optional<TeleopSnapshot> rig_;
-  /// Snapshots without the rig's part (a connected viewer's view states): the slave drawn by its
-  /// link bodies, no master.
-  bool rig_from_bodies_ = false;
   std::unique_ptr<SlaveFigure> slave_figure_;
   std::vector<std::string> warnings_;
   std::vector<Iso3> frames_;

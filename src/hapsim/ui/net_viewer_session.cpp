@@ -60,9 +60,7 @@ class NetViewerSession final : public ViewerSession {
     setup_.emplace(
         net::build_served_scene(info_, DeviceChoice::external(), config.data_dir.string()));
     world_ = setup_->world.get();
-    snapshot_ = make_world_snapshot(*world_);
-    // View states carry a rig's bodies, not its joints: the rig's part would stay at the start.
-    snapshot_.teleop.reset();
+    snapshot_ = make_world_snapshot(*world_);  // a rig's part too: view states carry it
     decoder_.emplace(*world_);
     view_ = std::make_unique<WorldScene>(*world_);
     // The scene's device is the one served (its limits built the world): its rating, not the
