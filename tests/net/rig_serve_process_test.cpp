@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <fstream>
 #include <string>
 
@@ -192,15 +193,28 @@ TEST(RigServe, ServeAndMasterReproduceTheOneProcessPickAndPlace) {
 
   // The master felt the grasp: the grip on its fingers (20 N, the gripper's limit, in both) and
   // the ball on the pads through its arm, as one process's master: 0.894 N over 4.5 s of hold,
-  // served 0.84-0.90 N idle (within 10 %: the served world's own mean is +4 to +77 % from the
-  // jerks, which the master's rate limit takes out unevenly).
+  // served 0.84-0.90 N idle. Within 10 % while the served world's own mean is; a loaded machine
+  // stalls cycles, the served slave jerks and the ball's one-step forces raise the served mean
+  // (+4 to +77 % idle, more beside stress-ng), and then the master feels that, smoothed by its
+  // rate limit: between one process's and the served world's.
   const nlohmann::json d = read_json(device_json);
   EXPECT_NE(device.output().find("its gripper's pads on the ball felt"), std::string::npos);
   EXPECT_NEAR(d["peak_grasp_force_n"].get<double>(), a["peak_grasp_force_n"].get<double>(),
               0.05 * a["peak_grasp_force_n"].get<double>());
   const double one_held_n = a["mean_held_tool_force_n"].get<double>();
   EXPECT_NEAR(one_held_n, 0.98, 0.15);  // about the 100 g ball's weight (the floor bears some)
-  EXPECT_NEAR(d["mean_held_force_n"].get<double>(), one_held_n, 0.1 * one_held_n);
+  const double served_held_n = b["mean_held_tool_force_n"].get<double>();
+  const double master_held_n = d["mean_held_force_n"].get<double>();
+  if (std::abs(served_held_n - one_held_n) <= 0.1 * one_held_n) {
+    EXPECT_NEAR(master_held_n, one_held_n, 0.1 * one_held_n);
+  } else {
+    std::printf(
+        "the served world's mean over the hold is %.3f N against one process's %.3f N (its "
+        "slave jerked by stalled cycles): the master's %.3f N is held between the two\n",
+        served_held_n, one_held_n, master_held_n);
+    EXPECT_GE(master_held_n, 0.9 * std::min(one_held_n, served_held_n));
+    EXPECT_LE(master_held_n, 1.1 * std::max(one_held_n, served_held_n));
+  }
   EXPECT_GE(d["held_cycles"].get<double>(), 0.9 * a["held_steps"].get<double>());
   EXPECT_LE(d["held_cycles"].get<double>(), 1.1 * a["held_steps"].get<double>());
   EXPECT_EQ(d["models"]["malformed"].get<int>(), 0);
