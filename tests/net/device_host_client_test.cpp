@@ -78,6 +78,12 @@ class DeviceHostClientTest : public ::testing::Test {
     return newest;
   }
 
+  // Milliseconds since `t`: a model older than the renderer's 100 ms is faded, so a test whose
+  // thread stalled that long checks nothing.
+  static double ms_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+  }
+
   // A wall below z = 0 answering the state `answered`: the device at x0, pressing 2 N, 1000 N/m.
   LocalContactModel wall_model(std::uint64_t sequence, std::uint64_t answered, const Vec3& x0) {
     LocalContactModel m;
@@ -286,10 +292,7 @@ TEST_F(RigMasterHostTest, TheCarriedToolsForceIsFeltThroughTheMastersJacobian) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   ASSERT_GE(client->status().models_accepted, 1u);
-  const double since_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - last_written)
-          .count();
-  if (since_ms > 90.0) {
+  if (const double since_ms = ms_since(last_written); since_ms > 90.0) {
     GTEST_SKIP() << "this thread stalled: the last model is " << since_ms << " ms old (stale)";
   }
   DeviceCommand want;
@@ -437,10 +440,7 @@ TEST_F(RigGraspHostTest, TheMasterFeelsTheGripAndTheBallsWeight) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   ASSERT_GE(client->status().models_accepted, 2u);
-  const double since_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - last_written)
-          .count();
-  if (since_ms > 90.0) {
+  if (const double since_ms = ms_since(last_written); since_ms > 90.0) {
     GTEST_SKIP() << "this thread stalled: the last model is " << since_ms << " ms old (stale)";
   }
   // Carried, not squeezed: the grip is the models' 15 N, the pads' sum the ball's weight.
