@@ -218,9 +218,19 @@ TEST_F(GloveHostTest, AFingerToolRendersIntoItsFingerAtTheFingersRating) {
   EXPECT_NEAR(said.rendered.finger_force_n[1], 4.0, 1e-9);
 }
 
-// Two device hosts on one device id (a second `hapsim device --name trainee`): each numbers its
-// states from its own random base, so the models answering the first host's states are the
-// second's "another host's", refused and counted, never rendered; the first renders them.
+// A master arm's reading: its three arm joints and both fingers at `finger_rad`.
+DeviceInput master_reading(const std::array<double, 3>& arm_rad, double finger_rad) {
+  DeviceInput in;
+  in.healthy = true;
+  in.joint_count = 3;
+  in.finger_count = 2;
+  for (std::size_t i = 0; i < 3; ++i) {
+    in.joint_rad[i] = arm_rad[i];
+  }
+  in.finger_rad[0] = in.finger_rad[1] = finger_rad;
+  return in;
+}
+
 // A rig's master arm (DeviceHostOptions::rig): its one tool is the tool the slave carries, placed
 // where the slave's target puts it for the master's joints; the force rendered there reaches the
 // master as the rig's own command makes it (RigController::master_command: Jᵀ), no tip force, and
@@ -240,15 +250,8 @@ class RigMasterHostTest : public DeviceHostClientTest {
     return std::make_shared<const RigController>(std::move(d));
   }
 
-  DeviceInput master(const std::array<double, 3>& arm_rad) const {
-    DeviceInput in;
-    in.healthy = true;
-    in.joint_count = 3;
-    in.finger_count = 2;
-    for (std::size_t i = 0; i < 3; ++i) {
-      in.joint_rad[i] = arm_rad[i];
-    }
-    return in;
+  static DeviceInput master(const std::array<double, 3>& arm_rad) {
+    return master_reading(arm_rad, 0.0);
   }
 
   const DeviceCommand& master_cycle(const std::array<double, 3>& arm_rad) {
@@ -370,15 +373,7 @@ class RigGraspHostTest : public DeviceHostClientTest {
   }
 
   static DeviceInput master(const std::array<double, 3>& arm_rad, double finger_rad) {
-    DeviceInput in;
-    in.healthy = true;
-    in.joint_count = 3;
-    in.finger_count = 2;
-    for (std::size_t i = 0; i < 3; ++i) {
-      in.joint_rad[i] = arm_rad[i];
-    }
-    in.finger_rad[0] = in.finger_rad[1] = finger_rad;
-    return in;
+    return master_reading(arm_rad, finger_rad);
   }
 
   // Pad `i`'s model for the pads where the master `in` puts them: in the grip's frame (from the
@@ -471,6 +466,9 @@ TEST_F(RigGraspHostTest, TheMasterFeelsTheGripAndTheBallsWeight) {
   EXPECT_NEAR(status.mean_held_force_n, 1.0, 0.5);  // the weight, after the blend from nothing
 }
 
+// Two device hosts on one device id (a second `hapsim device --name trainee`): each numbers its
+// states from its own random base, so the models answering the first host's states are the
+// second's "another host's", refused and counted, never rendered; the first renders them.
 TEST_F(DeviceHostClientTest, ASecondHostOnTheSameDeviceIdTellsTheOthersModelsFromItsOwn) {
   DeviceHostClient second(participant, options());
   second.set_scene(scene());
