@@ -10,6 +10,7 @@
 #include "hapsim/rig/contact_spring.h"
 
 #include <array>
+#include <cstddef>
 
 namespace hapsim {
 
@@ -25,6 +26,14 @@ struct ParallelGripperParams {
   /// Friction must carry this multiple of the ball's weight to call it held.
   double safety_factor = 1.5;
 };
+
+/// Where pad `pad` (0: the +y side) is centred in the tool frame at the opening `width_m`: along
+/// the tool's y, half the opening and half its own thickness out, pad_depth_m along its z.
+[[nodiscard]] inline Vec3 pad_centre_tool(const ParallelGripperParams& g, double width_m,
+                                          std::size_t pad) noexcept {
+  const double side = pad == 0 ? 1.0 : -1.0;
+  return {0.0, side * (0.5 * width_m + g.pad_half_m.y()), g.pad_depth_m};
+}
 
 struct GripperReport {
   /// Normal force of each pad on the ball, newtons (≥ 0).

@@ -126,13 +126,10 @@ Vec3 RigController::pad_centre_target_world(const DeviceInput& input,
       !std::isfinite(fingers[1])) {
     return Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
   }
-  // As place_pads (rig_place.cpp) puts them about the tool: along its y, pad_depth_m out.
-  const ParallelGripperParams& g = description_.gripper;
+  // Where place_pads (rig_place.cpp) puts it about the tool, at the opening the grip asks for.
   const double width =
       std::max(slave_width_for(master_.grip_opening_m({fingers[0], fingers[1]})), 0.0);
-  const double side = pad == 0 ? 1.0 : -1.0;
-  return flange_point_target_world(
-      input, Vec3(0.0, side * (0.5 * width + g.pad_half_m.y()), g.pad_depth_m));
+  return flange_point_target_world(input, pad_centre_tool(description_.gripper, width, pad));
 }
 
 }  // namespace hapsim

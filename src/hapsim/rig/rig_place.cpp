@@ -40,10 +40,8 @@ void place_pads(const TeleopRigDescription& d, RigState& rig, WorldState& state,
   }
   rig.tool_previous_R = X_world_tool.linear();
   for (std::size_t i = 0; i < 2; ++i) {
-    const double side = i == 0 ? 1.0 : -1.0;
     BodyState& pad = state.bodies[d.pad_body[i]];
-    pad.X_world_body =
-        X_world_tool * Eigen::Translation3d(0.0, side * (0.5 * width + half.y()), g.pad_depth_m);
+    pad.X_world_body = X_world_tool * Eigen::Translation3d(pad_centre_tool(g, width, i));
     pad.X_body_world = pad.X_world_body.inverse();
     const Vec3 p = pad.X_world_body.translation();
     pad.v_world = rig.has_pad_previous && dt_s > 0.0 ? Vec3((p - rig.pad_previous_world[i]) / dt_s)
