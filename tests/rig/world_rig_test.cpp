@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -86,20 +87,34 @@ TEST(WorldRig, ResetAllocatesNothingAndTheRunAfterItIsAFreshRun) {
             fresh.last_result().command.joint_torque_nm);
 }
 
-TEST(WorldRig, UnusableMasterInputHoldsTheSlaveAndSendsNoTorque) {
+// A master whose reading is unusable (NaN, or not healthy) moves nothing and is sent no torque;
+// the slave brakes to rest at its acceleration limit and stands, as a real arm stops.
+TEST(WorldRig, UnusableMasterInputStopsTheSlaveAndSendsNoTorque) {
   World world(rig());
   for (int k = 0; k < 50; ++k) {
-    (void)world.step(master(0.2), 1e-3);
+    (void)world.step(master(0.2 + 2e-3 * k), 1e-3);
   }
-  const Iso3 tool = rig_state(world)->slave->tip_pose();
+  const SlaveFollower& slave = *rig_state(world)->slave;
+  double fastest = 0.0;
+  for (const double v : slave.velocity()) {
+    fastest = std::max(fastest, std::abs(v));
+  }
+  ASSERT_GT(fastest, 0.0);  // moving when the master goes
+  const double dv = SlaveFollowerOptions{}.max_joint_acceleration_per_s2 * 1e-3;
   DeviceInput bad = master(std::numeric_limits<double>::quiet_NaN());
-  const StepResult& r = world.step(bad, 1e-3);
-  EXPECT_EQ(r.command.joint_count, 0);
-  EXPECT_EQ(r.command.finger_count, 0);
-  EXPECT_TRUE(rig_state(world)->slave->tip_pose().isApprox(tool, 1e-12));
+  for (int k = 0; k < static_cast<int>(std::ceil(fastest / dv)); ++k) {
+    const StepResult& r = world.step(bad, 1e-3);
+    EXPECT_EQ(r.command.joint_count, 0);
+    EXPECT_EQ(r.command.finger_count, 0);
+  }
+  for (const double v : slave.velocity()) {
+    EXPECT_EQ(v, 0.0);
+  }
+  const Iso3 stood = slave.tip_pose();
   bad = master(0.2);
   bad.healthy = false;
   EXPECT_EQ(world.step(bad, 1e-3).command.joint_count, 0);
+  EXPECT_TRUE(slave.tip_pose().isApprox(stood, 1e-12));
 }
 
 // The grasp report, observed from a step's result alone: both pads pressing the ball from opposite

@@ -386,6 +386,19 @@ TEST(SceneSchema, TheOlderTeleopDialectIsStillAValidScene) {
   fs::remove(file);
 }
 
+// The slave's acceleration limit: 30 rad/s² unless the scene says, and what it says is read.
+TEST(SceneSchema, TheSlavesAccelerationLimitIsReadWithItsDefault) {
+  const fs::path file = fs::temp_directory_path() / "hapsim_schema_slave_acceleration.json";
+  Json scene = read_json(kScenes / "teleop.json");
+  std::ofstream(file) << scene.dump();
+  EXPECT_EQ(load_scene(file).teleop.slave_max_acceleration_per_s2, 30.0);
+  scene["rig"]["slave"]["max_joint_acceleration_per_s2"] = 12.5;
+  EXPECT_EQ(schema().validate(scene), "");
+  std::ofstream(file) << scene.dump();
+  EXPECT_EQ(load_scene(file).teleop.slave_max_acceleration_per_s2, 12.5);
+  fs::remove(file);
+}
+
 // The rig scene's own mistakes: a rigid material with a stiffness, a rig naming a tool that is not
 // there, a world with neither tools nor a rig.
 TEST(SceneSchema, BadRigScenesAreRefusedByTheSchemaAndTheLoader) {
@@ -397,6 +410,8 @@ TEST(SceneSchema, BadRigScenesAreRefusedByTheSchemaAndTheLoader) {
       {"rigid is not a boolean", [](Json& j) { j["materials"]["ball"]["rigid"] = "yes"; }},
       {"neither tools nor a rig", [](Json& j) { j.erase("rig"); }},
       {"unknown rig key", [](Json& j) { j["rig"]["robot"] = "gp7"; }},
+      {"a slave that cannot accelerate",
+       [](Json& j) { j["rig"]["slave"]["max_joint_acceleration_per_s2"] = 0; }},
       {"a ball named by position",
        [](Json& j) {
          j["rig"]["ball"] = {0.5, 0.1, 0.0};

@@ -104,7 +104,8 @@ void RigController::check(const WorldDescription& world) const {
 }
 
 void RigController::fingerprint(ContentFingerprint& h) const {
-  // What makes two rigs step differently: the slave, its start, the mapping, the ball, the sheet.
+  // What makes two rigs step differently: the slave, its start and limits, the mapping, the ball,
+  // the sheet.
   h.number(description_.slave ? description_.slave->dof() : -1);
   for (const double q : description_.slave_start_rad) {
     h.number(q);
@@ -113,7 +114,8 @@ void RigController::fingerprint(ContentFingerprint& h) const {
   h.bytes(description_.mapping.X_slave_master.matrix().data(), sizeof(double) * 16);
   for (const double x :
        {description_.ball.mass_kg, description_.ball.radius_m, description_.gripper.max_force_n,
-        description_.follower.gripper_max_width_m, description_.sheet.side_m,
+        description_.follower.gripper_max_width_m, description_.follower.gripper_speed_m_per_s,
+        description_.follower.max_joint_acceleration_per_s2, description_.sheet.side_m,
         description_.force_scale}) {
     h.number(x);
   }

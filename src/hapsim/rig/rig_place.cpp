@@ -93,7 +93,7 @@ void place_slave_bodies(const TeleopRigDescription& d, RigState& rig, WorldState
 
 // The rig's tool is the slave's gripper: the master's hand pose, scaled into the slave's frame,
 // is the slave's IK target; the master's grip opening is the gripper's. On an unusable input the
-// slave holds where it is.
+// slave brakes to rest at its acceleration limit and stands, its gripper as it was.
 }  // namespace
 
 // haptic path
@@ -109,16 +109,15 @@ void RigState::place(const WorldModel& model, WorldState& state, const DeviceInp
   for (const double v : {arm[0], arm[1], arm[2], fingers[0], fingers[1]}) {
     rig.input_usable = rig.input_usable && std::isfinite(v);
   }
-  double width_command = rig.slave->gripper_width_m();
   if (rig.input_usable) {
     r.master_arm_rad = arm;
     r.master_finger_rad = fingers;
     r.master_hand = controller->master().hand_pose(arm);
     const Iso3 target = slave_target(d.mapping, r.master_hand.translation(), arm[0]);
-    width_command = controller->slave_width_for(controller->master().grip_opening_m(fingers));
+    const double width_command = controller->slave_width_for(controller->master().grip_opening_m(fingers));
     r.slave = rig.slave->step(target, width_command, dt_s);
   } else {
-    r.slave = rig.slave->step(rig.slave->tip_pose(), width_command, dt_s);
+    r.slave = rig.slave->stop(dt_s);
   }
   // One forward kinematics for the tool and the links (the same products as tip_pose()).
   r.slave_tool = rig.slave->chain().frames(rig.slave->q(), rig.frames);

@@ -279,6 +279,7 @@ class SessionAccountant {
           std::max(t.peak_master_torque_nm, std::abs(r.command.joint_torque_nm[j]));
     }
     t.max_slave_tracking_error_m = std::max(t.max_slave_tracking_error_m, r.slave.position_error_m);
+    t.slave_limited_steps += r.slave.acceleration_limited || r.slave.velocity_limited ? 1 : 0;
     if (r.slave_collisions > 0) {
       ++t.slave_collision_steps;
       t.slave_collisions += static_cast<std::size_t>(r.slave_collisions);
@@ -721,8 +722,9 @@ std::string format_session_summary(const SessionSummary& s) {
         line, sizeof line,
         "slave tool   peak force %.3f N (what the master's hand feels, before the scale); "
         "master peak joint torque %.3f N m\nslave        largest tip error while "
-        "tracking %.3f mm\n",
-        t.peak_tool_force_n, t.peak_master_torque_nm, t.max_slave_tracking_error_m * 1e3);
+        "tracking %.3f mm; held to its joint limits on %zu steps\n",
+        t.peak_tool_force_n, t.peak_master_torque_nm, t.max_slave_tracking_error_m * 1e3,
+        t.slave_limited_steps);
     out << line;
   } else if (s.teleop) {
     const TeleopSummary& t = *s.teleop;
@@ -748,8 +750,9 @@ std::string format_session_summary(const SessionSummary& s) {
     }
     std::snprintf(line, sizeof line,
                   "\nsheet        deepest dent %.3f mm\nslave        largest tip error while "
-                  "tracking %.3f mm\n",
-                  t.max_sheet_deflection_m * 1e3, t.max_slave_tracking_error_m * 1e3);
+                  "tracking %.3f mm; held to its joint limits on %zu steps\n",
+                  t.max_sheet_deflection_m * 1e3, t.max_slave_tracking_error_m * 1e3,
+                  t.slave_limited_steps);
     out << line;
   }
   if (s.teleop) {

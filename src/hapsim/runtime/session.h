@@ -136,6 +136,10 @@ struct TeleopSummary {
   double peak_grasp_force_n = 0.0;
   double max_sheet_deflection_m = 0.0;
   double max_slave_tracking_error_m = 0.0;
+  /// Steps the slave's joints were held to their speed or acceleration limits (SlaveStep): the
+  /// slave catching up with a master that moved faster than it can follow, or that stalled and
+  /// jumped (a served master's late states). 0 in a smooth scripted run.
+  std::size_t slave_limited_steps = 0;
   std::size_t nonfinite_ball_steps = 0;
   /// Slave collisions (TeleopStepResult::slave_collisions): steps with one, their sum over the
   /// run, the first one's time (-1: none) and the bodies involved (the slave's and what it hit).

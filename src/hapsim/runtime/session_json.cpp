@@ -70,6 +70,7 @@ void add_rig_json(nlohmann::json& j, const TeleopSummary& t) {
   j["peak_grasp_force_n"] = t.peak_grasp_force_n;
   j["max_sheet_deflection_m"] = t.max_sheet_deflection_m;
   j["max_slave_tracking_error_m"] = t.max_slave_tracking_error_m;
+  j["slave_limited_steps"] = t.slave_limited_steps;
   j["peak_tool_force_n"] = t.peak_tool_force_n;
   j["peak_master_torque_nm"] = t.peak_master_torque_nm;
   j["mean_held_tool_force_n"] = t.mean_held_tool_force_n;

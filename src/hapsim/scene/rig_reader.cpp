@@ -11,7 +11,7 @@ void read_rig_arm(const SceneReader& r, const Json& j, const std::string& ptr,
   if (j.contains("slave")) {
     const std::string sp = JsonReader::at(ptr, "slave");
     const Json& s = r.object(j["slave"], sp, "the slave arm");
-    r.allow_keys(s, sp, {"model", "urdf", "tip"});
+    r.allow_keys(s, sp, {"model", "urdf", "tip", "max_joint_acceleration_per_s2"});
     if (s.contains("model") == s.contains("urdf")) {
       r.fail(sp, "expected one of 'model' (\"procedural\") or 'urdf' (a URDF file)");
     }
@@ -27,6 +27,9 @@ void read_rig_arm(const SceneReader& r, const Json& j, const std::string& ptr,
     if (s.contains("tip")) {
       t.slave_tip = r.nonempty_string(s["tip"], JsonReader::at(sp, "tip"), "a link name");
     }
+    t.slave_max_acceleration_per_s2 =
+        r.number_in(s, sp, "max_joint_acceleration_per_s2", t.slave_max_acceleration_per_s2, 0.0,
+                    1e4, "rad/s²", true);
   }
   if (j.contains("mapping")) {
     const std::string mp = JsonReader::at(ptr, "mapping");

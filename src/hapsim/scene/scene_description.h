@@ -52,6 +52,8 @@ struct TeleopSceneDescription {
   /// Empty: the procedural Motoman; else a URDF file and its tip link (empty: the deepest).
   std::filesystem::path slave_urdf;
   std::string slave_tip;
+  /// Every slave joint's acceleration limit (SlaveFollowerOptions), rad/s² (m/s² if prismatic).
+  double slave_max_acceleration_per_s2 = 30.0;
   double scale = 1.6;
   Vec3 offset_m = Vec3::Zero();
   double gripper_max_force_n = 20.0;

@@ -48,6 +48,7 @@ TeleopRigDescription rig_from_scene(const SceneDescription& scene, bool load_lin
   d.gripper.max_force_n = t.gripper_max_force_n;
   d.follower.gripper_max_width_m = t.gripper_max_width_m;
   d.follower.gripper_speed_m_per_s = t.gripper_speed_m_per_s;
+  d.follower.max_joint_acceleration_per_s2 = t.slave_max_acceleration_per_s2;
   d.force_scale = t.force_scale;
   const WorldDescription& w = scene.world;
   d.ball_body = t.ball_body.empty() ? TeleopRigDescription::kNoBody : body_index(w, t.ball_body);

@@ -17,7 +17,18 @@ bool solve_slave_start(TeleopRigDescription& rig, const MasterArm& master,
       first.joint_rad[0]);
   const std::vector<double> seed(static_cast<std::size_t>(rig.slave->dof()), 0.0);
   rig.slave_start_rad.assign(seed.size(), 0.0);
-  return solve_ik(*rig.slave, start, seed, rig.slave_start_rad).reached;
+  if (!solve_ik(*rig.slave, start, seed, rig.slave_start_rad).reached) {
+    return false;
+  }
+  // Then onto it to the follower's micrometre: the slave starts at rest, and a start a tenth of a
+  // millimetre off is a lag its acceleration limit takes several cycles to close.
+  // When that finer answer is not found, the coarse start stands and the first cycles close the gap.
+  std::vector<double> fine(seed.size());
+  if (solve_ik(*rig.slave, start, rig.slave_start_rad, fine, SlaveFollowerOptions::real_time_ik())
+          .reached) {
+    rig.slave_start_rad = fine;
+  }
+  return true;
 }
 
 }  // namespace hapsim
