@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <string>
 
@@ -193,28 +194,28 @@ TEST(RigServe, ServeAndMasterReproduceTheOneProcessPickAndPlace) {
 
   // The master felt the grasp: the grip on its fingers (20 N, the gripper's limit, in both) and
   // the ball on the pads through its arm, as one process's master: 0.894 N over 4.5 s of hold,
-  // served 0.84-0.90 N idle. Within 10 % while the served world's own mean is; a loaded machine
-  // stalls cycles, the served slave jerks and the ball's one-step forces raise the served mean
-  // (+4 to +78 % idle, +16 to +46 % beside stress-ng), and then the master feels that, smoothed by
-  // its rate limit: between one process's and the served world's.
+  // served 0.893-0.896 N idle, within 5 % as the knee's three-process test holds its forces.
+  // A stalled serve or device cycle makes the served slave's target jump; the slave catches up
+  // within its acceleration limit (SlaveFollower), where it used to take the jump in one cycle
+  // and kick the ball with up to 20 N (served mean +4 to +78 % idle).
   const nlohmann::json d = read_json(device_json);
   EXPECT_NE(device.output().find("its gripper's pads on the ball felt"), std::string::npos);
   EXPECT_NEAR(d["peak_grasp_force_n"].get<double>(), a["peak_grasp_force_n"].get<double>(),
               0.05 * a["peak_grasp_force_n"].get<double>());
   const double one_held_n = a["mean_held_tool_force_n"].get<double>();
   EXPECT_NEAR(one_held_n, 0.98, 0.15);  // about the 100 g ball's weight (the floor bears some)
-  const double served_held_n = b["mean_held_tool_force_n"].get<double>();
-  const double master_held_n = d["mean_held_force_n"].get<double>();
-  if (std::abs(served_held_n - one_held_n) <= 0.1 * one_held_n) {
-    EXPECT_NEAR(master_held_n, one_held_n, 0.1 * one_held_n);
-  } else {
-    std::printf(
-        "the served world's mean over the hold is %.3f N against one process's %.3f N (its "
-        "slave jerked by stalled cycles): the master's %.3f N is held between the two\n",
-        served_held_n, one_held_n, master_held_n);
-    EXPECT_GE(master_held_n, 0.9 * std::min(one_held_n, served_held_n));
-    EXPECT_LE(master_held_n, 1.1 * std::max(one_held_n, served_held_n));
-  }
+  EXPECT_NEAR(d["mean_held_force_n"].get<double>(), one_held_n, 0.05 * one_held_n);
+  EXPECT_NEAR(b["mean_held_tool_force_n"].get<double>(), one_held_n, 0.1 * one_held_n);
+  // The one-process slave follows a smooth master: its limits never act. Served, a catch-up
+  // accelerates the ball at most by the slave's 30 rad/s² over its 1 m reach, and the pads'
+  // springs ring to twice that: 0.1 kg × 30 m/s² × 2 over the ball's weight, under 7 N (it was
+  // 13-21 N before the limit; 1.5-4.6 N with it, idle).
+  EXPECT_EQ(a["slave_limited_steps"].get<int>(), 0);
+  EXPECT_LE(b["peak_tool_force_n"].get<double>(), 7.0);
+  std::printf("peak force at the slave's tool: one process %.3f N, served %.3f N (%d steps "
+              "catching up), the master's %.3f N\n",
+              a["peak_tool_force_n"].get<double>(), b["peak_tool_force_n"].get<double>(),
+              b["slave_limited_steps"].get<int>(), d["peak_force_n"].get<double>());
   EXPECT_GE(d["held_cycles"].get<double>(), 0.9 * a["held_steps"].get<double>());
   EXPECT_LE(d["held_cycles"].get<double>(), 1.1 * a["held_steps"].get<double>());
   EXPECT_EQ(d["models"]["malformed"].get<int>(), 0);

@@ -46,6 +46,7 @@ void SlaveFollower::reset(std::span<const double> q_start) noexcept {
             q_start.begin() + static_cast<std::ptrdiff_t>(std::min(n, q_start.size())), q_.begin());
   chain_->clamp_to_limits({q_.data(), n});
   previous_goal_ = q_;  // at rest on its goal
+  goal_speed_.fill(0.0);
   v_.fill(0.0);
   gripper_width_m_ = options_.gripper_max_width_m;  // starts open
 }
@@ -66,15 +67,19 @@ void SlaveFollower::move_towards_goal(double dt, SlaveStep* out) noexcept {
   const auto nn = static_cast<std::size_t>(chain_->dof());
   const double dv = options_.max_joint_acceleration_per_s2 * dt;
   // Each joint relative to its goal, which moves at u (last cycle's IK answer to this one's): the
-  // joint closes the lag r it had on last cycle's goal no faster than it can brake to a stop on
-  // it, and changes its speed by at most dv. A goal moving smoothly leaves no lag (|r| ≤ dv·dt:
-  // the joint lands on the goal), so the limits never act on a smooth motion.
+  // joint closes the lag r it would have on the goal moving at u no faster than it can brake to
+  // a stop on it, and changes its speed by at most dv. A goal moving smoothly leaves no lag
+  // (|r| ≤ dv·dt: the joint lands on the goal), so the limits never act on a smooth motion.
   std::array<double, kMaxChainJoints> v_new{};
   bool lands = true;
   for (std::size_t i = 0; i < nn; ++i) {
     const double land = (goal_[i] - q_[i]) / dt;
-    const double u = (goal_[i] - previous_goal_[i]) / dt;
-    const double r = previous_goal_[i] - q_[i];
+    // The goal's speed as the joint may take it up: a goal that jumped (several of the master's
+    // cycles at once) is lag to close, not a speed to match in one step.
+    const double u = std::clamp((goal_[i] - previous_goal_[i]) / dt, goal_speed_[i] - dv,
+                                goal_speed_[i] + dv);
+    goal_speed_[i] = u;
+    const double r = goal_[i] - q_[i] - u * dt;
     const double wanted = u + std::copysign(braking_speed(std::abs(r), dv, dt), r);
     const double max_velocity = chain_->joints()[i].max_velocity;
     const double by_acceleration = std::clamp(wanted, v_[i] - dv, v_[i] + dv);
@@ -114,6 +119,7 @@ void SlaveFollower::brake(double dt, SlaveStep* out) noexcept {
     v_[i] = dt > 0.0 ? (q_[i] - q_before[i]) / dt : v_[i];
   }
   previous_goal_ = q_;  // a new target is taken up from rest here
+  goal_speed_.fill(0.0);
 }
 
 SlaveStep SlaveFollower::stop(double dt_s) noexcept {

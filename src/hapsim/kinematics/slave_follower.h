@@ -110,8 +110,10 @@ class SlaveFollower {
   SlaveFollowerOptions options_;
   std::array<double, kMaxChainJoints> q_{};
   std::array<double, kMaxChainJoints> goal_{};
-  /// Last cycle's IK answer (the goal's speed is the change), and the joints' speeds.
+  /// Last cycle's IK answer (the goal's speed is the change), the goal's speed as the joints
+  /// take it up (its change limited as theirs is), and the joints' speeds.
   std::array<double, kMaxChainJoints> previous_goal_{};
+  std::array<double, kMaxChainJoints> goal_speed_{};
   std::array<double, kMaxChainJoints> v_{};
   double gripper_width_m_ = 0.0;
 };
