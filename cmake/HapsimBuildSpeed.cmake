@@ -2,16 +2,16 @@
 # short, without touching what the library computes:
 #  - precompiled headers: the standard and Eigen headers that nearly every file includes, parsed
 #    once per library instead of once per file; the tests share one, with GoogleTest added;
-#  - unity builds of the two targets with the most files (the headless library, the app): files
-#    compiled in batches of 8, so our own headers and their template instances are compiled
-#    once per batch;
+#  - unity builds of the targets with the most files (the headless library, the app, each layer's
+#    tests): files compiled in batches of 8, so our own headers, GoogleTest's and their template
+#    instances are compiled once per batch;
 #  - test code at -O1 (release): tests assert no wall-clock time and the library they call keeps
 #    the release flags; -O3 on gtest's macro-expanded bodies only cost compile time.
 # nlohmann/json stays out of the precompiled headers on purpose: a fifth of the files include
 # it, and the larger header costs the other four fifths more to load than it saves.
 option(HAPSIM_CCACHE "Compile through ccache when it is installed (a warm rebuild in seconds)" ON)
 option(HAPSIM_PCH "Precompile the standard, Eigen and GoogleTest headers (a faster cold build)" ON)
-option(HAPSIM_UNITY_BUILD "Compile the headless library and the app in batches of files (a faster cold build)" ON)
+option(HAPSIM_UNITY_BUILD "Compile the headless library, the app and the tests in batches of files (a faster cold build)" ON)
 
 # ccache, when present (not installed by scripts/setup.sh: a bare machine builds without it), and
 # unless a launcher was chosen: a build folder rebuilt from nothing (`rm -rf build`, a second CI
@@ -93,4 +93,75 @@ function(hapsim_test_code target support)
     target_precompile_headers(hapsim_test_pch PRIVATE ${_headers})
   endif()
   target_precompile_headers(${target} REUSE_FROM hapsim_test_pch)
+endfunction()
+
+# The names a test file declares at namespace scope, where clang-format leaves them at column 0:
+# functions, variables, types, and aliases with what they alias (the same alias in two files is no
+# clash); a using-declaration names nothing new.
+function(_hapsim_namespace_scope_names file out)
+  file(STRINGS "${file}" _lines REGEX "^[A-Za-z[]")
+  set(_names "")
+  foreach(_line IN LISTS _lines)
+    string(REGEX REPLACE "^\\[\\[[a-z_]+\\]\\] " "" _line "${_line}")
+    if(_line MATCHES "^(TEST|TYPED_TEST|INSTANTIATE_|GTEST|HAPSIM_|namespace |template|extern |static_assert)"
+       OR _line MATCHES "^using [A-Za-z0-9_:]+;")
+      continue()
+    elseif(_line MATCHES "^using ([A-Za-z_][A-Za-z0-9_]*) = (.*);")
+      string(REPLACE " " "" _aliased "${CMAKE_MATCH_2}")
+      list(APPEND _names "${CMAKE_MATCH_1}=${_aliased}")
+    elseif(_line MATCHES "^(struct|class|enum class|enum|union) ([A-Za-z_][A-Za-z0-9_]*)")
+      list(APPEND _names "${CMAKE_MATCH_2}")
+    elseif(_line MATCHES "^[^=(]*[ *&]([A-Za-z_][A-Za-z0-9_]*) *(=|{|;|\\[)")
+      list(APPEND _names "${CMAKE_MATCH_1}")
+    elseif(_line MATCHES "([A-Za-z_][A-Za-z0-9_]*)\\(")
+      list(APPEND _names "${CMAKE_MATCH_1}")
+    endif()
+  endforeach()
+  set(${out} ${_names} PARENT_SCOPE)
+endfunction()
+
+# A unity build of a test executable. Test files keep their helpers in anonymous namespaces, which a
+# batch merges: two files' `kScene` would not compile, and two files' `at(...)` of different
+# parameters would overload each other and a call could take the other file's. So a file that
+# declares a name an earlier file of the target declares (or aliases it to another type) is
+# compiled alone; the rest in batches.
+function(hapsim_unity_tests target)
+  if(NOT HAPSIM_UNITY_BUILD)
+    return()
+  endif()
+  get_target_property(_sources ${target} SOURCES)
+  set(_plain "")        # names declared so far, not aliases
+  set(_aliases "")      # aliases so far, as name=type
+  set(_alias_names "")  # their names
+  set(_alone "")
+  foreach(_source IN LISTS _sources)
+    _hapsim_namespace_scope_names("${_source}" _names)
+    set(_clash FALSE)
+    foreach(_name IN LISTS _names)
+      if(_name MATCHES "^([^=]*)=")
+        set(_bare "${CMAKE_MATCH_1}")
+        if(_bare IN_LIST _plain OR (_bare IN_LIST _alias_names AND NOT _name IN_LIST _aliases))
+          set(_clash TRUE)
+        endif()
+      elseif(_name IN_LIST _plain OR _name IN_LIST _alias_names)
+        set(_clash TRUE)
+      endif()
+    endforeach()
+    if(_clash)
+      list(APPEND _alone "${_source}")
+      continue()
+    endif()
+    foreach(_name IN LISTS _names)
+      if(_name MATCHES "^([^=]*)=")
+        list(APPEND _aliases "${_name}")
+        list(APPEND _alias_names "${CMAKE_MATCH_1}")
+      else()
+        list(APPEND _plain "${_name}")
+      endif()
+    endforeach()
+  endforeach()
+  list(LENGTH _sources _count)
+  list(LENGTH _alone _alone_count)
+  message(VERBOSE "hapsim: ${target}: ${_alone_count} of ${_count} files compiled alone")
+  hapsim_unity_build(${target} SKIP ${_alone})
 endfunction()

@@ -4,7 +4,7 @@
 // exceeds 8 levels, and each channel's mean absolute difference). A picture left behind when what
 // the program draws changed (another scene, camera, colour, layout) fails here, naming the picture;
 // regenerate them with the script, look at them, and commit them (docs/testing.md).
-#include "support/temp_path.h"
+#include "apps/hapsim_process.h"
 #include "support/test_data.h"
 
 #include "hapsim/render/image_compare.h"

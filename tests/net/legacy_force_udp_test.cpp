@@ -225,13 +225,13 @@ TEST(LegacyForceUdp, SendAndPollAllocateNothing) {
   c.finger_count = 4;
   (void)sender.send_command(c, 4.0);
   (void)device.read(0.0);
-  const long before = test::thread_allocation_count();
+  const long before = hapsim::test::thread_allocation_count();
   for (int i = 0; i < 1000; ++i) {
     c.finger_force_n[0] = 1e-3 * i;
     (void)sender.send_command(c, 4.0);
     (void)device.read(1e-3 * i);
   }
-  EXPECT_EQ(test::thread_allocation_count() - before, 0);
+  EXPECT_EQ(hapsim::test::thread_allocation_count() - before, 0);
   EXPECT_GT(device.count(LegacyPacketVerdict::kAccepted), 0U);
 }
 
