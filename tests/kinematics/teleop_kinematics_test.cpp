@@ -12,8 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <numbers>
@@ -167,7 +167,7 @@ TEST(SlaveFollower, Gp7TracksTheMaster) {
 // `a`: up at a, (cruise at v_max,) down at a.
 double time_optimal_s(double distance, double v_max, double a) {
   return distance >= v_max * v_max / a ? distance / v_max + v_max / a
-                                        : 2.0 * std::sqrt(distance / a);
+                                       : 2.0 * std::sqrt(distance / a);
 }
 
 // A jump from rest to a far pose: every joint within its limits at every cycle, arriving no
@@ -184,8 +184,8 @@ void expect_jump_in_time_optimal_time(const std::vector<double>& q_goal, double 
   const double dt = 1e-3;
   double optimal_s = 0.0;
   for (std::size_t i = 0; i < 6; ++i) {
-    optimal_s = std::max(optimal_s, time_optimal_s(std::abs(q_goal[i] - q0[i]),
-                                                   arm.joints()[i].max_velocity, a));
+    optimal_s = std::max(
+        optimal_s, time_optimal_s(std::abs(q_goal[i] - q0[i]), arm.joints()[i].max_velocity, a));
   }
   std::vector<double> speed(6, 0.0);
   int velocity_limited = 0;
@@ -209,8 +209,7 @@ void expect_jump_in_time_optimal_time(const std::vector<double>& q_goal, double 
       }
       EXPECT_NEAR(fastest_ratio, 1.0, 1e-9) << k;  // a joint runs at its limit
     }
-    const bool at_rest = std::all_of(speed.begin(), speed.end(),
-                                     [](double v) { return v == 0.0; });
+    const bool at_rest = std::all_of(speed.begin(), speed.end(), [](double v) { return v == 0.0; });
     if (at_rest && s.position_error_m <= kTolM && s.rotation_error_rad <= kTolRad) {
       settled_at = k;
     }

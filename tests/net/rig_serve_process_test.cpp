@@ -215,9 +215,10 @@ TEST(RigServe, ServeAndMasterReproduceTheOneProcessPickAndPlace) {
   if (catching_up < 0.1) {
     EXPECT_NEAR(served_held_n, one_held_n, 0.1 * one_held_n);
   } else {
-    std::printf("the served slave caught up on %.0f %% of the steps: its world's mean over the "
-                "hold is %.3f N against one process's %.3f N\n",
-                100 * catching_up, served_held_n, one_held_n);
+    std::printf(
+        "the served slave caught up on %.0f %% of the steps: its world's mean over the "
+        "hold is %.3f N against one process's %.3f N\n",
+        100 * catching_up, served_held_n, one_held_n);
     EXPECT_NEAR(served_held_n, one_held_n, 0.5 * one_held_n);
   }
   // The one-process slave follows a smooth master: its limits never act. Served, a catch-up
@@ -226,10 +227,11 @@ TEST(RigServe, ServeAndMasterReproduceTheOneProcessPickAndPlace) {
   // 13-21 N before the limit; 1.5-4.6 N with it, idle).
   EXPECT_EQ(a["slave_limited_steps"].get<int>(), 0);
   EXPECT_LE(b["peak_tool_force_n"].get<double>(), 7.0);
-  std::printf("peak force at the slave's tool: one process %.3f N, served %.3f N (%d steps "
-              "catching up), the master's %.3f N\n",
-              a["peak_tool_force_n"].get<double>(), b["peak_tool_force_n"].get<double>(),
-              b["slave_limited_steps"].get<int>(), d["peak_force_n"].get<double>());
+  std::printf(
+      "peak force at the slave's tool: one process %.3f N, served %.3f N (%d steps "
+      "catching up), the master's %.3f N\n",
+      a["peak_tool_force_n"].get<double>(), b["peak_tool_force_n"].get<double>(),
+      b["slave_limited_steps"].get<int>(), d["peak_force_n"].get<double>());
   EXPECT_GE(d["held_cycles"].get<double>(), 0.9 * a["held_steps"].get<double>());
   EXPECT_LE(d["held_cycles"].get<double>(), 1.1 * a["held_steps"].get<double>());
   EXPECT_EQ(d["models"]["malformed"].get<int>(), 0);

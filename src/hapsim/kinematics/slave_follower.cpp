@@ -76,8 +76,8 @@ void SlaveFollower::move_towards_goal(double dt, SlaveStep* out) noexcept {
     const double land = (goal_[i] - q_[i]) / dt;
     // The goal's speed as the joint may take it up: a goal that jumped (several of the master's
     // cycles at once) is lag to close, not a speed to match in one step.
-    const double u = std::clamp((goal_[i] - previous_goal_[i]) / dt, goal_speed_[i] - dv,
-                                goal_speed_[i] + dv);
+    const double u =
+        std::clamp((goal_[i] - previous_goal_[i]) / dt, goal_speed_[i] - dv, goal_speed_[i] + dv);
     goal_speed_[i] = u;
     const double r = goal_[i] - q_[i] - u * dt;
     const double wanted = u + std::copysign(braking_speed(std::abs(r), dv, dt), r);

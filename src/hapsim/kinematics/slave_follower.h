@@ -35,8 +35,8 @@ struct TeleopMapping {
 struct SlaveFollowerOptions {
   IkOptions ik = real_time_ik();
   /// Every joint's acceleration limit, rad/s² (m/s² for a prismatic joint); URDF has none. 30
-  /// rad/s² is an industrial arm's order (the GP7 reaches its 6.5 rad/s in about 0.2 s) and 4×
-  /// the most a scripted hand motion asks of the procedural Motoman (7.7 rad/s²).
+  /// rad/s² is an industrial arm's order (its top speed, 6.5 rad/s here, in about 0.2 s) and 4×
+  /// the most the scripted pick-and-place asks of the procedural Motoman (7.7 rad/s²).
   double max_joint_acceleration_per_s2 = 30.0;
   /// Parallel gripper: fully open width and opening/closing speed.
   double gripper_max_width_m = 0.10;

@@ -114,7 +114,8 @@ void RigState::place(const WorldModel& model, WorldState& state, const DeviceInp
     r.master_finger_rad = fingers;
     r.master_hand = controller->master().hand_pose(arm);
     const Iso3 target = slave_target(d.mapping, r.master_hand.translation(), arm[0]);
-    const double width_command = controller->slave_width_for(controller->master().grip_opening_m(fingers));
+    const double width_command =
+        controller->slave_width_for(controller->master().grip_opening_m(fingers));
     r.slave = rig.slave->step(target, width_command, dt_s);
   } else {
     r.slave = rig.slave->stop(dt_s);

@@ -21,8 +21,8 @@ bool solve_slave_start(TeleopRigDescription& rig, const MasterArm& master,
     return false;
   }
   // Then onto it to the follower's micrometre: the slave starts at rest, and a start a tenth of a
-  // millimetre off is a lag its acceleration limit takes several cycles to close.
-  // When that finer answer is not found, the coarse start stands and the first cycles close the gap.
+  // millimetre off is a lag its acceleration limit takes several cycles to close. Without that
+  // finer answer the coarse start stands and the first cycles close the gap.
   std::vector<double> fine(seed.size());
   if (solve_ik(*rig.slave, start, rig.slave_start_rad, fine, SlaveFollowerOptions::real_time_ik())
           .reached) {
